@@ -1,0 +1,24 @@
+#pragma once
+/// \file CliContext.h
+/// What every subcommand of `granagg` gets: the command line (for provenance headers) and the
+/// conventions shared by all subcommands.
+///
+/// Error convention (README, "Errors"): bad user input throws std::invalid_argument with one
+/// sentence naming the option and the allowed range; main() prints it on one line and exits 2.
+/// Other failures (I/O, a solver that cannot continue) throw std::runtime_error: exit 1.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace granagg::cli {
+
+struct CliContext {
+  std::string command_line;  ///< argv joined, recorded in every output's provenance header
+};
+
+/// Registers `granagg smol ...` (cli/SmolCommand.cpp).
+void registerSmolCommand(CLI::App& app, const CliContext& ctx);
+/// Registers `granagg kinetic ...` (cli/KineticCommand.cpp).
+void registerKineticCommand(CLI::App& app, const CliContext& ctx);
+
+}  // namespace granagg::cli

@@ -1,0 +1,13 @@
+#pragma once
+/// \file Strings.h
+/// Small string helpers shared by the CLI and the readers.
+#include <string>
+#include <vector>
+
+namespace granagg::common {
+std::string trim(const std::string& s);
+std::vector<std::string> split(const std::string& s, char sep);
+std::string join(const std::vector<std::string>& parts, const std::string& sep);
+/// Parses a whole string as a double (also "nan", "inf"); false if anything is left over.
+bool parseReal(const std::string& s, double& out);
+}  // namespace granagg::common

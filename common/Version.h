@@ -1,0 +1,15 @@
+#pragma once
+/// \file Version.h
+/// Version and build provenance, written into every output file granagg makes.
+#include <string>
+
+namespace granagg::common {
+/// Semantic version of granagg (from the top-level CMakeLists.txt).
+const char* version();
+/// `git describe --always --dirty` of the source tree the binary was built from ("unknown" outside git).
+const char* gitCommit();
+/// "granagg <version> (<commit>)", the string written into provenance headers.
+inline std::string versionString() {
+  return std::string("granagg ") + version() + " (" + gitCommit() + ")";
+}
+}  // namespace granagg::common

@@ -1,0 +1,315 @@
+#include "meanfield/solvers/SectionalSolver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "common/Csv.h"
+#include "meanfield/solvers/CvodeSolver.h"
+
+namespace granagg::meanfield {
+
+namespace {
+
+constexpr int MAX_SECTIONS = 4096;
+
+/// Index of the section pair (j, k), j <= k, in the upper-triangular pair table of I sections.
+inline size_t rowStart(size_t j, size_t I) { return j * I - j * (j - 1) / 2 - j; }  // + k gives (j, k)
+
+/// Splits an aggregate of size v between the two pivots around it (Kumar & Ramkrishna 1996, eq. 27):
+/// returns the lower pivot t with x_t <= v <= x_{t+1} and the share b that goes to x_{t+1}; 1 - b
+/// goes to x_t. Then (1 - b) + b = 1 (number) and (1 - b) x_t + b x_{t+1} = v (mass). t = -1 when v
+/// lies beyond the last pivot.
+void splitSize(const std::vector<double>& x, double v, int& t, double& b) {
+  const int I = static_cast<int>(x.size());
+  if (v > x.back()) {
+    t = -1;
+    b = 0.0;
+    return;
+  }
+  // first pivot > v, minus one: x_t <= v < x_{t+1}; v == x.back() goes to (I-2, b = 1)
+  int hi = static_cast<int>(std::upper_bound(x.begin(), x.end(), v) - x.begin());
+  t = std::min(hi - 1, I - 2);
+  b = (v - x[t]) / (x[t + 1] - x[t]);
+  // exact pivots (all sums in the integer region) give b == 0 or 1 exactly
+  if (b < 0.0) b = 0.0;
+  if (b > 1.0) b = 1.0;
+}
+
+/// Pair table and right-hand side of the fixed-pivot equations.
+class FixedPivotRhs {
+ public:
+  FixedPivotRhs(const Kernel& kernel, std::vector<double> pivots, double cutoff_mass)
+      : m_x(std::move(pivots)), m_I(m_x.size()), m_cutoff(cutoff_mass) {
+    const size_t pairs = m_I * (m_I + 1) / 2;
+    m_c.resize(pairs);
+    m_b.resize(pairs);
+    m_t.resize(pairs);
+    m_escape.assign(m_I, m_I);
+    m_loss.assign(m_I, 0.0);
+    m_gain_lo.assign(m_I, 0.0);
+    m_gain_hi.assign(m_I, 0.0);
+    for (size_t j = 0; j < m_I; ++j) {
+      const size_t row = rowStart(j, m_I);
+      for (size_t k = j; k < m_I; ++k) {
+        const size_t idx = row + k;
+        // collision rate per N_j N_k: K for j < k, K/2 for j == k (each unordered pair once)
+        m_c[idx] = kernel(m_x[j], m_x[k]) * (j == k ? 0.5 : 1.0);
+        const double v = m_x[j] + m_x[k];
+        int t;
+        double b;
+        splitSize(m_x, v, t, b);
+        m_t[idx] = t;
+        m_b[idx] = t >= 0 ? b : v;  // escaped pairs keep their mass v in the b slot
+        if (t < 0 && m_escape[j] == m_I) m_escape[j] = k;  // x_j + x_k increases with k
+      }
+    }
+  }
+
+  size_t sections() const { return m_I; }
+  const std::vector<double>& pivots() const { return m_x; }
+
+  /// Range [lo, hi] of sections whose mass |N_i| x_i exceeds the cutoff (lo > hi when none).
+  void activeRange(const double* N, size_t& lo, size_t& hi) const {
+    lo = 0;
+    while (lo < m_I && !(std::fabs(N[lo]) * m_x[lo] > m_cutoff)) ++lo;
+    hi = m_I;
+    while (hi > lo && !(std::fabs(N[hi - 1]) * m_x[hi - 1] > m_cutoff)) --hi;
+    hi = hi == 0 ? 0 : hi - 1;
+    if (lo >= m_I) hi = 0;
+  }
+
+  /// y = (N_0..N_{I-1}, escaped mass); dydt likewise.
+  void operator()(const double* y, double* dydt) {
+    std::fill(dydt, dydt + m_I + 1, 0.0);
+    size_t lo, hi;
+    activeRange(y, lo, hi);
+    if (lo >= m_I) return;
+    // Loss and the two gain shares go to separate arrays: within a row every k, and almost every
+    // target t, is distinct, so successive iterations do not wait on each other's stores.
+    double* loss = m_loss.data();
+    double* gain_lo = m_gain_lo.data();
+    double* gain_hi = m_gain_hi.data();
+    // largest target of the pairs within [lo, hi]: that of (hi, hi), as x_j + x_k grows with j and k
+    const int32_t t_hh = m_t[rowStart(hi, m_I) + hi];
+    const size_t top = t_hh >= 0 ? static_cast<size_t>(t_hh) : m_I - 2;
+    std::fill(loss + lo, loss + hi + 1, 0.0);
+    std::fill(gain_lo, gain_lo + top + 1, 0.0);
+    std::fill(gain_hi, gain_hi + top + 1, 0.0);
+    const double* c = m_c.data();
+    const double* bw = m_b.data();
+    const int32_t* tg = m_t.data();
+    double escaped = 0.0;
+    for (size_t j = lo; j <= hi; ++j) {
+      const double Nj = y[j];
+      if (Nj == 0.0) continue;
+      const size_t row = rowStart(j, m_I);
+      double loss_j = 0.0;
+      // pairs that stay on the grid (k < m_escape[j]): no branch in the hot loop
+      const size_t k_stay = std::min(hi + 1, m_escape[j]);
+      for (size_t k = j; k < k_stay; ++k) {
+        const size_t idx = row + k;
+        const double R = c[idx] * Nj * y[k];  // collisions per unit time and volume
+        loss_j += R;
+        loss[k] += R;
+        const double bR = bw[idx] * R;
+        const int32_t t = tg[idx];
+        gain_lo[t] += R - bR;  // to pivot t
+        gain_hi[t] += bR;      // to pivot t + 1
+      }
+      for (size_t k = std::max(j, k_stay); k <= hi; ++k) {
+        const size_t idx = row + k;
+        const double R = c[idx] * Nj * y[k];
+        loss_j += R;
+        loss[k] += R;
+        escaped += bw[idx] * R;  // mass x_j + x_k leaves the grid
+      }
+      loss[j] += loss_j;  // with loss[k] += R at k == j, the j == k pair removes 2 R = K N_j^2
+    }
+    for (size_t i = lo; i <= hi; ++i) dydt[i] -= loss[i];
+    for (size_t t = 0; t <= top; ++t) {
+      dydt[t] += gain_lo[t];
+      dydt[t + 1] += gain_hi[t];
+    }
+    dydt[m_I] = escaped;
+  }
+
+ private:
+  std::vector<double> m_x;
+  size_t m_I;
+  double m_cutoff;
+  std::vector<double> m_c;    // (1 - delta_jk / 2) K(x_j, x_k)
+  std::vector<double> m_b;    // share to the upper target pivot (or v for escaped pairs)
+  std::vector<int32_t> m_t;   // lower target pivot, -1 if the aggregate leaves the grid
+  std::vector<size_t> m_escape;
+  std::vector<double> m_loss, m_gain_lo, m_gain_hi;  // scratch of operator()  // first k >= j whose pair (j, k) leaves the grid (I if none)
+};
+
+void validate(const SectionalOptions& o) {
+  using common::formatReal;
+  if (o.times.empty()) throw std::invalid_argument("sectional solver requires at least one output time (times is empty).");
+  for (size_t i = 0; i < o.times.size(); ++i) {
+    if (!(o.times[i] > 0.0) || !std::isfinite(o.times[i]))
+      throw std::invalid_argument("sectional times must be positive and finite (got " + formatReal(o.times[i]) + ").");
+    if (i > 0 && !(o.times[i] > o.times[i - 1]))
+      throw std::invalid_argument("sectional times must increase strictly (got " + formatReal(o.times[i - 1]) +
+                                  " then " + formatReal(o.times[i]) + ").");
+  }
+  if (!(o.rtol > 0.0) || !std::isfinite(o.rtol))
+    throw std::invalid_argument("sectional rtol must be positive and finite (got " + formatReal(o.rtol) + ").");
+  if (!(o.atol > 0.0) || !std::isfinite(o.atol))
+    throw std::invalid_argument("sectional atol must be positive and finite (got " + formatReal(o.atol) + ").");
+  if (!(o.s_end > 0.0))
+    throw std::invalid_argument("sectional s_end must be positive (got " + formatReal(o.s_end) + ").");
+  if (!(o.mass_loss_tolerance >= 0.0))
+    throw std::invalid_argument("sectional mass_loss_tolerance must not be negative (got " +
+                                formatReal(o.mass_loss_tolerance) + ").");
+  if (!(o.section_cutoff >= 0.0) || !(o.section_cutoff < 1e-6))
+    throw std::invalid_argument("sectional section_cutoff must lie in [0, 1e-6) (got " +
+                                formatReal(o.section_cutoff) + ").");
+  CvodeSolver::parseMethod(o.integrator);  // throws for an unknown name
+}
+
+}  // namespace
+
+SectionalGrid makeSectionalGrid(double ratio, double max_size) {
+  using common::formatReal;
+  if (!(ratio > 1.0) || !std::isfinite(ratio))
+    throw std::invalid_argument("sectional ratio must be a finite number > 1 (got " + formatReal(ratio) + ").");
+  if (!(max_size >= 2.0) || !std::isfinite(max_size))
+    throw std::invalid_argument("sectional max_size must be finite and >= 2 (got " + formatReal(max_size) + ").");
+  SectionalGrid g;
+  // integers 1..m with m the first integer whose geometric step m (r - 1) is at least one
+  const double m_real = std::ceil(1.0 / (ratio - 1.0) - 1e-12);
+  if (m_real > MAX_SECTIONS)
+    throw std::invalid_argument("sectional ratio " + formatReal(ratio) + " is too close to 1: more than " +
+                                std::to_string(MAX_SECTIONS) + " integer pivots.");
+  const int m = std::max(1, static_cast<int>(m_real));
+  for (int k = 1; k <= m; ++k) {
+    g.pivots.push_back(k);
+    if (k >= max_size) break;
+  }
+  g.integer_pivots = static_cast<int>(g.pivots.size());
+  while (g.pivots.back() < max_size) {
+    g.pivots.push_back(g.pivots.back() * ratio);
+    if (g.pivots.size() > static_cast<size_t>(MAX_SECTIONS))
+      throw std::invalid_argument("sectional grid with ratio " + formatReal(ratio) + " and max_size " +
+                                  formatReal(max_size) + " needs more than " + std::to_string(MAX_SECTIONS) +
+                                  " sections: raise ratio or lower max_size.");
+  }
+  return g;
+}
+
+SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options, const std::vector<double>* initial) {
+  using common::formatReal;
+  const auto wall_start = std::chrono::steady_clock::now();
+  validate(options);
+  const SectionalGrid grid = makeSectionalGrid(options.ratio, options.max_size);
+  const std::vector<double>& x = grid.pivots;
+  const size_t I = x.size();
+
+  // Initial state: n_k for k = 1..len onto the pivots (number- and mass-conserving split).
+  std::vector<double> y(I + 1, 0.0);
+  if (initial) {
+    if (initial->empty()) throw std::invalid_argument("sectional initial distribution is empty.");
+    for (size_t k = 0; k < initial->size(); ++k) {
+      const double n = (*initial)[k];
+      if (!(n >= 0.0) || !std::isfinite(n))
+        throw std::invalid_argument("sectional initial n_k must be finite and >= 0 (got " + formatReal(n) +
+                                    " at k = " + std::to_string(k + 1) + ").");
+      if (n == 0.0) continue;
+      int t;
+      double b;
+      splitSize(x, static_cast<double>(k + 1), t, b);
+      if (t < 0)
+        throw std::invalid_argument("sectional initial distribution reaches size " + std::to_string(k + 1) +
+                                    ", beyond max_size " + formatReal(options.max_size) + ".");
+      y[t] += (1.0 - b) * n;
+      y[t + 1] += b * n;
+    }
+  } else {
+    y[0] = 1.0;  // monodisperse n_1 = 1
+  }
+  double M1_0 = 0.0, M2_0 = 0.0;
+  for (size_t i = 0; i < I; ++i) {
+    M1_0 += x[i] * y[i];
+    M2_0 += x[i] * x[i] * y[i];
+  }
+  if (!(M1_0 > 0.0)) throw std::invalid_argument("sectional initial distribution has no mass.");
+
+  // Gelling kernels: the solution exists only before t_gel = 1 / (K0 M2(0)) (Ziff 1980 for K = K0 i j).
+  if (kernel.type() == KernelType::Multiplicative) {
+    const double t_gel = 1.0 / (kernel.K0() * M2_0);
+    if (options.times.back() >= t_gel)
+      throw std::invalid_argument("sectional times must stay before the gel time 1/(K0 M2(0)) = " +
+                                  formatReal(t_gel) + " of the multiplicative kernel (got " +
+                                  formatReal(options.times.back()) + ").");
+  } else if (kernel.gels()) {
+    throw std::invalid_argument("sectional solver: kernel '" + kernel.name() + "' gels; no gel time known.");
+  }
+
+  FixedPivotRhs rhs(kernel, x, options.section_cutoff * M1_0);
+
+  CvodeSolver::Options co;
+  co.method = CvodeSolver::parseMethod(options.integrator);
+  co.rtol = options.rtol;
+  co.atol_vector.resize(I + 1);
+  for (size_t i = 0; i < I; ++i) co.atol_vector[i] = options.atol * M1_0 / x[i];  // mass-weighted
+  co.atol_vector[I] = options.atol * M1_0;                                       // escaped mass
+  co.max_steps = 1000000;
+  const int n_unknowns = static_cast<int>(I + 1);
+  CvodeSolver cvode(n_unknowns, [&rhs](double, const double* yy, double* dd) { rhs(yy, dd); }, co, 0.0, y.data());
+  cvode.setStopTime(options.times.back());  // never step past the last output (gel time, blow-up)
+
+  SmolResult result;
+  result.method = "sectional";
+  std::vector<double> yout(I + 1);
+  for (double tout : options.times) {
+    cvode.advance(tout, yout.data());
+    MomentSample s;
+    s.t = tout;
+    for (size_t i = 0; i < I; ++i) {
+      const double N = yout[i];
+      s.M0 += N;
+      s.M1 += x[i] * N;
+      s.M2 += x[i] * x[i] * N;
+    }
+    s.S = s.M2 / s.M1;
+    s.mass_loss = (M1_0 - s.M1) / M1_0;
+    s.valid = std::fabs(s.mass_loss) <= options.mass_loss_tolerance;
+    size_t lo, hi;
+    rhs.activeRange(yout.data(), lo, hi);
+    s.max_size = lo < I ? x[hi] : 0.0;
+    result.samples.push_back(s);
+    if (options.snapshots) {
+      Snapshot snap;
+      snap.t = tout;
+      snap.size = x;
+      snap.n.assign(yout.begin(), yout.begin() + static_cast<long>(I));
+      result.snapshots.push_back(std::move(snap));
+    }
+    if (!s.valid && options.stop_on_truncation) {
+      result.stopped_early = "mass loss " + formatReal(s.mass_loss) + " at t = " + formatReal(tout) +
+                             " exceeds mass_loss_tolerance " + formatReal(options.mass_loss_tolerance) +
+                             " (aggregates beyond the last pivot " + formatReal(x.back()) +
+                             "; raise max_size)";
+      break;
+    }
+    if (s.S >= options.s_end) break;
+  }
+
+  const CvodeSolver::Stats cs = cvode.stats();
+  result.stats.steps = cs.steps;
+  result.stats.rhs_evaluations = cs.rhs_evaluations;
+  result.stats.linear_iterations = cs.linear_iterations;
+  result.stats.nonlinear_failures = cs.nonlinear_failures;
+  result.stats.error_test_failures = cs.error_test_failures;
+  result.stats.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return result;
+}
+
+}  // namespace granagg::meanfield

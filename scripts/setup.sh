@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs what granagg needs from Debian's packages (idempotent: quiet when all is there) and
+# configures + builds the CPU build in ./build. Used by scripts/test.sh and scripts/demo.sh.
+#   GRANAGG_BUILD_DIR   build folder (default: build)
+#   GRANAGG_JOBS        parallel compile jobs (default: nproc)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(build-essential cmake pkg-config git
+          libsundials-dev libeigen3-dev libboost-dev libgsl-dev libhdf5-dev catch2 libfftw3-dev
+          librandom123-dev libcli11-dev libtomlplusplus-dev libthrust-dev libomp-dev
+          python3-matplotlib python3-numpy python3-h5py)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "granagg setup: installing ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+BUILD_DIR=${GRANAGG_BUILD_DIR:-build}
+JOBS=${GRANAGG_JOBS:-$(nproc)}
+if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+fi
+cmake --build "$BUILD_DIR" -j "$JOBS"
