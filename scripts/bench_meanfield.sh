@@ -15,13 +15,13 @@ run() {  # label, then granagg arguments; prints "| label | wall s | last line o
   local t1=$(date +%s.%N)
   local S=$(grep -v '^#' "$TMP/out.csv" | tail -n 1 | cut -d, -f2)
   local z=$(grep -o 'z_inf = [0-9.]*' "$TMP/log" | head -n 1 || true)
-  local loss=$(grep -v '^#' "$TMP/out.csv" | tail -n +2 | cut -d, -f7 | sort -g | tail -n 1)
+  local loss=$(grep -v '^#' "$TMP/out.csv" | tail -n +2 | awk -F, '{a = $7 < 0 ? -$7 : $7; if (a > m) m = a} END {printf "%.1e", m}')
   printf '| %s | %.2f | %s | %s | %s |\n' "$label" "$(echo "$t1 - $t0" | bc)" "$S" "${z:-}" "$loss"
 }
 
 echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs); $("$G" --version)"
 echo
-echo "| run | wall [s] | final S | asymptotic z | largest mass loss |"
+echo "| run | wall [s] | final S | asymptotic z | largest abs. mass change |"
 echo "|---|---|---|---|---|"
 for beta in 2 2.5 3 4; do
   run "sectional beta=$beta, r=1.05, to S=1e8" smol --beta $beta --method sectional --s-end 1e8 --t-end 1e12

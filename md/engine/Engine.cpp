@@ -1,0 +1,407 @@
+#include "md/engine/Engine.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+#include <thrust/copy.h>
+#include <thrust/execution_policy.h>
+#include <thrust/functional.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/reduce.h>
+#include <thrust/transform_reduce.h>
+
+#if defined(__CUDACC__)
+#include <cuda_runtime.h>
+#else
+#include <omp.h>
+#endif
+
+#include "common/Box.h"
+#include "common/Csv.h"
+#include "md/compute/ContactForce.h"
+#include "md/engine/ParticleData.h"
+#include "md/integrate/VelocityVerlet.h"
+#include "md/neighbor/NeighborList.h"
+#include "md/potentials/HertzViscoelastic.h"
+#include "md/potentials/SpringDashpot.h"
+#include "md/rng/RngStreams.h"
+
+namespace granagg::md {
+
+namespace {
+constexpr double M_EFF = 0.5;  // reduced mass of two unit masses
+
+template <class T>
+std::vector<T> toHost(const DVec<T>& d) {
+  std::vector<T> h(d.size());
+  thrust::copy(d.begin(), d.end(), h.begin());
+  return h;
+}
+template <class T>
+void toDevice(const std::vector<T>& h, DVec<T>& d) {
+  d.assign(h.begin(), h.end());
+}
+
+struct Square {
+  HD double operator()(double v) const { return v * v; }
+};
+struct Abs3 {
+  const double *vx, *vy, *vz;
+  HD double operator()(int i) const { return sqrt(vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]); }
+};
+}  // namespace
+
+struct Engine::Impl {
+  MdConfig cfg;
+  common::Box box;
+  ParticleData p;
+  NeighborList nl;
+  ContactWork work;
+  double dt = 0.0;
+  std::int64_t step = 0;
+  double time = 0.0;
+  std::int64_t collisions = 0;
+  bool hertz = true;
+  HertzViscoelastic::Params hertz_params{};
+  SpringDashpot::Params sd_params{};
+
+  explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {}
+
+  /// Forces of the current positions into p.f; counts collisions; aborts on NaN / deep overlap.
+  void computeForces() {
+    nl.update(p, box);
+    const double h = 0.5 * dt;
+    if (hertz)
+      computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, h, cfg.run.max_overlap, work);
+    else
+      computeContactForces<SpringDashpot>(p, nl, box, sd_params, h, cfg.run.max_overlap, work);
+    const int worst = thrust::reduce(work.bad.begin(), work.bad.end(), 0, thrust::maximum<int>());
+    if (worst != 0) abort(worst);
+    p.fx.swap(work.fx);
+    p.fy.swap(work.fy);
+    p.fz.swap(work.fz);
+    collisions += thrust::reduce(work.new_contacts_upper.begin(), work.new_contacts_upper.end(), std::int64_t(0));
+  }
+
+  [[noreturn]] void abort(int worst) {
+    const auto bad = toHost(work.bad);
+    const auto mx = toHost(work.max_overlap);
+    std::ostringstream msg;
+    msg << "step " << step << " (t = " << time << "): ";
+    msg << (worst == 1 ? "non-finite force or position (NaN/inf)" : "overlap beyond run.max_overlap = ");
+    if (worst != 1) msg << cfg.run.max_overlap;
+    msg << " for particle(s)";
+    int shown = 0;
+    for (std::size_t i = 0; i < bad.size() && shown < 8; ++i)
+      if (bad[i]) {
+        msg << (shown ? ", " : " ") << i;
+        if (bad[i] == 2) msg << " (overlap " << mx[i] << ")";
+        ++shown;
+      }
+    msg << "; the time step dt = " << dt << " may be too large for these impacts";
+    throw RunAborted(msg.str());
+  }
+
+  void doStep() {
+    const double h = 0.5 * dt;
+    kick(p, h);
+    drift(p, dt, box);
+    ++step;
+    time = step * dt;  // no accumulated round-off in t
+    computeForces();
+    kick(p, h);
+  }
+};
+
+double Engine::chooseTimeStep(const MdConfig& c, std::string* reason) {
+  if (c.integrator.dt > 0.0) {
+    if (reason) *reason = "fixed by integrator.dt";
+    return c.integrator.dt;
+  }
+  std::ostringstream why;
+  double tc;
+  if (c.contact.model == "spring_dashpot") {
+    const auto sp = SpringDashpot::makeParams(c.contact.stiffness, c.contact.restitution, c.contact.clamp, M_EFF);
+    tc = SpringDashpot::contactTime(sp, M_EFF);
+    why << "spring-dashpot contact time " << tc;
+  } else {
+    // fastest expected impact: exceeded by a fraction 1e-6 of collisions in a Maxwellian gas at the
+    // initial temperature (collision-weighted P(g) = g/(2T) exp(-g^2/(4T)), tail exp(-g^2/(4T)))
+    const double v = c.integrator.impact_speed_max > 0.0 ? c.integrator.impact_speed_max
+                                                         : std::sqrt(4.0 * c.system.temperature * std::log(1e6));
+    tc = HertzViscoelastic::contactTime(v, {c.contact.E, c.contact.D, c.contact.clamp}, M_EFF);
+    why << "elastic Hertz contact time " << tc << " at impact speed " << v;
+  }
+  const double dt = tc / c.integrator.steps_per_contact;
+  why << " / " << c.integrator.steps_per_contact << " steps per contact";
+  if (reason) *reason = "auto: " + why.str();
+  return dt;
+}
+
+Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) : m_impl(std::make_unique<Impl>(config)) {
+  Impl& d = *m_impl;
+  const std::size_t N = init.size();
+  if (N < 2) throw std::invalid_argument("the initial state needs at least 2 particles (got " + std::to_string(N) + ").");
+  for (const auto* v : {&init.y, &init.z, &init.vx, &init.vy, &init.vz})
+    if (v->size() != N) throw std::invalid_argument("initial state: position and velocity arrays differ in length.");
+  if (!(init.box > 0.0) || !std::isfinite(init.box)) throw std::invalid_argument("initial state: box edge must be positive.");
+  d.box.L = init.box;
+  d.hertz = config.contact.model != "spring_dashpot";
+  d.hertz_params = {config.contact.E, config.contact.D, config.contact.clamp};
+  if (!d.hertz)
+    d.sd_params = SpringDashpot::makeParams(config.contact.stiffness, config.contact.restitution, config.contact.clamp, M_EFF);
+  d.dt = chooseTimeStep(config);
+
+  Frame f = init;
+  if (f.charge.size() != N) f.charge.assign(N, 0.0);
+  for (auto* v : {&f.ix, &f.iy, &f.iz})
+    if (v->size() != N) v->assign(N, 0);
+  for (std::size_t i = 0; i < N; ++i) {
+    for (double v : {f.x[i], f.y[i], f.z[i], f.vx[i], f.vy[i], f.vz[i], f.charge[i]})
+      if (!std::isfinite(v)) throw std::invalid_argument("initial state: non-finite value for particle " + std::to_string(i) + ".");
+    f.ix[i] += d.box.wrap(f.x[i]);
+    f.iy[i] += d.box.wrap(f.y[i]);
+    f.iz[i] += d.box.wrap(f.z[i]);
+  }
+  d.p.resize(N);
+  toDevice(f.x, d.p.x);
+  toDevice(f.y, d.p.y);
+  toDevice(f.z, d.p.z);
+  d.p.xp = d.p.x;
+  d.p.yp = d.p.y;
+  d.p.zp = d.p.z;
+  toDevice(f.vx, d.p.vx);
+  toDevice(f.vy, d.p.vy);
+  toDevice(f.vz, d.p.vz);
+  toDevice(f.charge, d.p.q);
+  toDevice(f.ix, d.p.ix);
+  toDevice(f.iy, d.p.iy);
+  toDevice(f.iz, d.p.iz);
+  d.step = init.step;
+  d.time = init.step * d.dt;
+
+  // overlapping initial states are refused (design.md section 2 / ground rules: bad input)
+  d.nl.build(d.p, d.box);
+  if (allow_contacts) {
+    d.computeForces();
+    return;
+  }
+  const auto rows = toHost(DVec<int>(d.nl.rows(), d.nl.rows() + N * static_cast<std::size_t>(d.nl.capacity())));
+  const auto counts = toHost(DVec<int>(d.nl.counts(), d.nl.counts() + N));
+  for (std::size_t i = 0; i < N; ++i)
+    for (int k = 0; k < counts[i]; ++k) {
+      const std::size_t j = rows[i * d.nl.capacity() + k];
+      if (j <= i) continue;
+      const double rx = d.box.minimumImage(f.x[i] - f.x[j]), ry = d.box.minimumImage(f.y[i] - f.y[j]),
+                   rz = d.box.minimumImage(f.z[i] - f.z[j]);
+      const double r = std::sqrt(rx * rx + ry * ry + rz * rz);
+      if (r < 1.0)
+        throw std::invalid_argument("initial state: particles " + std::to_string(i) + " and " + std::to_string(j) +
+                                    " overlap (distance " + common::formatReal(r) + " < diameter 1).");
+    }
+  d.computeForces();
+}
+
+Engine::~Engine() = default;
+
+void Engine::run(std::int64_t steps) {
+  for (std::int64_t s = 0; s < steps; ++s) m_impl->doStep();
+}
+
+Frame Engine::frame() const {
+  const Impl& d = *m_impl;
+  Frame f;
+  f.step = d.step;
+  f.time = d.time;
+  f.box = d.box.L;
+  f.x = toHost(d.p.x);
+  f.y = toHost(d.p.y);
+  f.z = toHost(d.p.z);
+  f.vx = toHost(d.p.vx);
+  f.vy = toHost(d.p.vy);
+  f.vz = toHost(d.p.vz);
+  f.charge = toHost(d.p.q);
+  f.ix = toHost(d.p.ix);
+  f.iy = toHost(d.p.iy);
+  f.iz = toHost(d.p.iz);
+  return f;
+}
+
+std::vector<double> Engine::forces() const {
+  const Impl& d = *m_impl;
+  std::vector<double> out = toHost(d.p.fx);
+  const auto fy = toHost(d.p.fy), fz = toHost(d.p.fz);
+  out.insert(out.end(), fy.begin(), fy.end());
+  out.insert(out.end(), fz.begin(), fz.end());
+  return out;
+}
+
+void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions) {
+  Impl& d = *m_impl;
+  const std::size_t N = d.p.size();
+  if (s.size() != N || forces.size() != 3 * N)
+    throw std::invalid_argument("checkpoint has " + std::to_string(s.size()) + " particles, the run " + std::to_string(N));
+  toDevice(s.x, d.p.x);
+  toDevice(s.y, d.p.y);
+  toDevice(s.z, d.p.z);
+  toDevice(s.vx, d.p.vx);
+  toDevice(s.vy, d.p.vy);
+  toDevice(s.vz, d.p.vz);
+  toDevice(s.charge, d.p.q);
+  toDevice(s.ix, d.p.ix);
+  toDevice(s.iy, d.p.iy);
+  toDevice(s.iz, d.p.iz);
+  d.p.fx.assign(forces.begin(), forces.begin() + N);
+  d.p.fy.assign(forces.begin() + N, forces.begin() + 2 * N);
+  d.p.fz.assign(forces.begin() + 2 * N, forces.end());
+  d.step = s.step;
+  d.time = s.step * d.dt;
+  d.collisions = collisions;
+  // Previous positions are overwritten by the next drift before they are used (collision test of
+  // the next step compares with the positions of this step), so x is the exact value to restore.
+  d.p.xp = d.p.x;
+  d.p.yp = d.p.y;
+  d.p.zp = d.p.z;
+  d.nl.build(d.p, d.box);
+}
+
+Observables Engine::observables() const {
+  const Impl& d = *m_impl;
+  const std::size_t N = d.p.size();
+  Observables o;
+  o.step = d.step;
+  o.time = d.time;
+  const DVec<double>* v[3] = {&d.p.vx, &d.p.vy, &d.p.vz};
+  double sum2 = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    o.momentum[c] = thrust::reduce(v[c]->begin(), v[c]->end(), 0.0);
+    sum2 += thrust::transform_reduce(v[c]->begin(), v[c]->end(), Square(), 0.0, thrust::plus<double>());
+  }
+  o.kinetic_energy = 0.5 * sum2;
+  const double p2 = o.momentum[0] * o.momentum[0] + o.momentum[1] * o.momentum[1] + o.momentum[2] * o.momentum[2];
+  o.temperature = (sum2 - p2 / N) / (3.0 * N);  // (1/3N) sum (v - <v>)^2, unit mass
+  o.momentum_abs_sum = thrust::transform_reduce(thrust::counting_iterator<int>(0),
+                                                thrust::counting_iterator<int>(static_cast<int>(N)),
+                                                Abs3{raw(d.p.vx), raw(d.p.vy), raw(d.p.vz)}, 0.0, thrust::plus<double>());
+  o.elastic_energy = thrust::reduce(d.work.energy.begin(), d.work.energy.end(), 0.0);
+  const long contacts = thrust::reduce(d.work.contacts.begin(), d.work.contacts.end(), 0L);
+  o.contacts_per_particle = static_cast<double>(contacts) / N;
+  o.collisions = d.collisions;
+  const double ov = thrust::reduce(d.work.overlap_upper.begin(), d.work.overlap_upper.end(), 0.0);
+  o.mean_overlap = contacts > 0 ? ov / (0.5 * contacts) : 0.0;
+  o.max_overlap = thrust::reduce(d.work.max_overlap.begin(), d.work.max_overlap.end(), 0.0, thrust::maximum<double>());
+  return o;
+}
+
+double Engine::dt() const { return m_impl->dt; }
+std::int64_t Engine::step() const { return m_impl->step; }
+double Engine::time() const { return m_impl->time; }
+double Engine::box() const { return m_impl->box.L; }
+std::size_t Engine::size() const { return m_impl->p.size(); }
+std::int64_t Engine::neighborBuilds() const { return m_impl->nl.builds(); }
+
+std::string Engine::backendDescription() {
+#if defined(__CUDACC__)
+  int dev = 0;
+  cudaDeviceProp prop;
+  if (cudaGetDevice(&dev) == cudaSuccess && cudaGetDeviceProperties(&prop, dev) == cudaSuccess)
+    return std::string("Thrust CUDA backend on ") + prop.name;
+  return "Thrust CUDA backend (no device found)";
+#else
+  return "Thrust OpenMP backend, " + std::to_string(omp_get_max_threads()) +
+         " thread(s) (set OMP_NUM_THREADS or --threads to change)";
+#endif
+}
+
+Frame Engine::randomInitialState(const MdConfig& c) {
+  const int N = c.system.N;
+  const double L = std::cbrt(N * M_PI / (6.0 * c.system.phi));
+  Frame f;
+  f.box = L;
+  f.x.resize(N);
+  f.y.resize(N);
+  f.z.resize(N);
+  // Random sequential insertion on a hash grid of cell >= 1 (a particle overlaps only particles in
+  // the 27 surrounding cells). Deterministic: attempt k of particle i draws Philox(seed, i, k).
+  const int nc = std::max(1, static_cast<int>(std::floor(L)));
+  const double cell = L / nc;
+  std::unordered_multimap<long, int> grid;
+  grid.reserve(2 * N);
+  common::Box box{L};
+  auto key = [nc](int a, int b, int cc) { return (static_cast<long>((a + nc) % nc) * nc + (b + nc) % nc) * nc + (cc + nc) % nc; };
+  const std::uint32_t max_attempts = 100000;
+  for (int i = 0; i < N; ++i) {
+    bool placed = false;
+    for (std::uint32_t k = 0; k < max_attempts && !placed; ++k) {
+      const auto r = philoxDraw(c.system.seed, RNG_INIT_POSITION, static_cast<std::uint32_t>(i), k, 0);
+      const double px = uniform01(r[0]) * L, py = uniform01(r[1]) * L, pz = uniform01(r[2]) * L;
+      const int cx = std::min(nc - 1, static_cast<int>(px / cell)), cy = std::min(nc - 1, static_cast<int>(py / cell)),
+                cz = std::min(nc - 1, static_cast<int>(pz / cell));
+      bool ok = true;
+      for (int a = -1; a <= 1 && ok; ++a)
+        for (int b = -1; b <= 1 && ok; ++b)
+          for (int e = -1; e <= 1 && ok; ++e) {
+            auto range = grid.equal_range(key(cx + a, cy + b, cz + e));
+            for (auto it = range.first; it != range.second && ok; ++it) {
+              const int j = it->second;
+              const double rx = box.minimumImage(px - f.x[j]), ry = box.minimumImage(py - f.y[j]),
+                           rz = box.minimumImage(pz - f.z[j]);
+              ok = rx * rx + ry * ry + rz * rz >= 1.0;
+            }
+          }
+      if (ok) {
+        f.x[i] = px >= L ? 0.0 : px;
+        f.y[i] = py >= L ? 0.0 : py;
+        f.z[i] = pz >= L ? 0.0 : pz;
+        grid.emplace(key(cx, cy, cz), i);
+        placed = true;
+      }
+    }
+    if (!placed)
+      throw std::invalid_argument("random insertion failed after " + std::to_string(max_attempts) + " attempts for particle " +
+                                  std::to_string(i) + ": system.phi = " + common::formatReal(c.system.phi) +
+                                  " is too dense for random sequential insertion (use phi < 0.3 or give an initial file).");
+  }
+  // Maxwell velocities (Box-Muller on Philox words), then zero momentum and T_g = temperature exactly
+  f.vx.resize(N);
+  f.vy.resize(N);
+  f.vz.resize(N);
+  for (int i = 0; i < N; ++i) {
+    const auto r = philoxDraw(c.system.seed, RNG_INIT_VELOCITY, static_cast<std::uint32_t>(i), 0, 0);
+    const double u1 = uniform01(r[0]), u2 = uniform01(r[1]), u3 = uniform01(r[2]), u4 = uniform01(r[3]);
+    const double a = std::sqrt(-2.0 * std::log(u1)), b = std::sqrt(-2.0 * std::log(u3));
+    f.vx[i] = a * std::cos(2.0 * M_PI * u2);
+    f.vy[i] = a * std::sin(2.0 * M_PI * u2);
+    f.vz[i] = b * std::cos(2.0 * M_PI * u4);
+  }
+  double m[3] = {0, 0, 0};
+  for (int i = 0; i < N; ++i) {
+    m[0] += f.vx[i];
+    m[1] += f.vy[i];
+    m[2] += f.vz[i];
+  }
+  double s2 = 0.0;
+  for (int i = 0; i < N; ++i) {
+    f.vx[i] -= m[0] / N;
+    f.vy[i] -= m[1] / N;
+    f.vz[i] -= m[2] / N;
+    s2 += f.vx[i] * f.vx[i] + f.vy[i] * f.vy[i] + f.vz[i] * f.vz[i];
+  }
+  const double scale = std::sqrt(c.system.temperature * 3.0 * N / s2);
+  for (int i = 0; i < N; ++i) {
+    f.vx[i] *= scale;
+    f.vy[i] *= scale;
+    f.vz[i] *= scale;
+  }
+  f.charge.assign(N, 0.0);
+  f.ix.assign(N, 0);
+  f.iy.assign(N, 0);
+  f.iz.assign(N, 0);
+  return f;
+}
+
+}  // namespace granagg::md

@@ -1,0 +1,92 @@
+#pragma once
+/// \file Engine.h
+/// The MD engine: N spheres of diameter 1 and mass 1 in a periodic cube, normal contact forces
+/// (Hertz viscoelastic or spring-dashpot), velocity Verlet (design.md section 2).
+///
+/// One source for both backends: Engine.cpp holds the state in Thrust device vectors (structure of
+/// arrays) and loops through Thrust algorithms whose functors call the HD physics of
+/// md/potentials/. This header has no Thrust in it (pimpl), so host-only code (CLI, I/O) can use it
+/// in a CUDA build too.
+///
+/// Determinism: forces are gathered per particle over a neighbour row sorted by particle index,
+/// so every sum runs in the same order whatever the thread count, the neighbour-list rebuild
+/// schedule, or a restart from a checkpoint: the same build gives bit-identical trajectories.
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "md/config/MdConfig.h"
+#include "md/io/Frame.h"
+
+namespace granagg::md {
+
+/// Observables at one step (design.md section 3, "Per frame"). Energies are totals (not per particle).
+struct Observables {
+  std::int64_t step = 0;
+  double time = 0.0;
+  double temperature = 0.0;          ///< T_g = (1/3N) sum (v - <v>)^2
+  double kinetic_energy = 0.0;       ///< (1/2) sum v^2
+  double elastic_energy = 0.0;       ///< sum over contacts of the elastic energy
+  double momentum[3] = {0, 0, 0};    ///< sum v
+  double momentum_abs_sum = 0.0;     ///< sum |v| (scale for momentum conservation)
+  double contacts_per_particle = 0.0;
+  std::int64_t collisions = 0;       ///< new contacts since the start of the run
+  double mean_overlap = 0.0;         ///< over pairs in contact (0 if none)
+  double max_overlap = 0.0;
+};
+
+/// Thrown when a run must stop (NaN, overlap beyond the bound): the state before the failing step
+/// is intact, and the message names the step and the particles.
+class RunAborted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Engine {
+ public:
+  /// Builds the engine from a validated configuration and an initial state (box L in initial.box).
+  /// Throws std::invalid_argument for overlapping particles (naming the pair; a fresh initial state
+  /// must have none -- pass allow_contacts = true to continue from a frame of a running gas, whose
+  /// contacts are legitimate), wrong sizes, non-finite values, or a box too small for the neighbour
+  /// cutoff.
+  Engine(const MdConfig& config, const Frame& initial, bool allow_contacts = false);
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  /// Random non-overlapping positions at the configured phi, Maxwell velocities rescaled to
+  /// T_g = temperature exactly with zero total momentum, zero charges (design.md section 2).
+  /// Deterministic in config.system.seed (Philox streams RNG_INIT_*).
+  static Frame randomInitialState(const MdConfig& config);
+
+  /// Advances `steps` velocity-Verlet steps. Throws RunAborted (state of the last good step kept).
+  void run(std::int64_t steps);
+
+  /// Host copy of the current state (wrapped positions, images, velocities, charges).
+  Frame frame() const;
+  /// Forces of the current state (needed for a bit-for-bit restart): fx, fy, fz concatenated.
+  std::vector<double> forces() const;
+  /// Restores a checkpointed state with its forces and collision counter (same N).
+  void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions);
+
+  Observables observables() const;
+  double dt() const;
+  std::int64_t step() const;
+  double time() const;
+  double box() const;
+  std::size_t size() const;
+  /// Number of neighbour-list builds so far (diagnostics).
+  std::int64_t neighborBuilds() const;
+  /// "OpenMP (2 threads)" or "CUDA (device name)": printed at start-up and stored in outputs.
+  static std::string backendDescription();
+  /// The time step chosen for a configuration (fixed, or auto from the contact time) and why.
+  static double chooseTimeStep(const MdConfig& config, std::string* reason = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace granagg::md

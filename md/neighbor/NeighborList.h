@@ -1,0 +1,45 @@
+#pragma once
+/// \file NeighborList.h
+/// Cell list + Verlet neighbour list with a skin (device source; Thrust).
+///
+/// Full lists (every pair appears in the rows of both partners), each row sorted by particle index
+/// so that per-particle force sums run in a fixed order (Engine.h, determinism). Rows have a fixed
+/// capacity; a row that would overflow is detected after the build, the capacity grows and the list
+/// is rebuilt -- never truncated (STYLE.md). The list is rebuilt when some particle has moved more
+/// than skin/2 since the last build (then no pair can have come within the contact distance 1
+/// unseen). Boxes with fewer than 3 cells per side use an all-pairs build (small systems).
+#include <cstdint>
+
+#include "common/Box.h"
+#include "md/engine/ParticleData.h"
+
+namespace granagg::md {
+
+class NeighborList {
+ public:
+  /// \param cutoff interaction range (1 for contacts); \param skin added to it for the list.
+  NeighborList(double cutoff, double skin);
+
+  /// Rebuilds if any particle moved more than skin/2 since the last build (or never built).
+  /// Returns true if it rebuilt.
+  bool update(const ParticleData& p, const common::Box& box);
+  /// Unconditional rebuild.
+  void build(const ParticleData& p, const common::Box& box);
+
+  const int* rows() const { return raw(m_list); }     ///< row i at rows()[i * capacity()]
+  const int* counts() const { return raw(m_count); }  ///< entries in row i
+  int capacity() const { return m_capacity; }
+  std::int64_t builds() const { return m_builds; }
+  double listRange() const { return m_cutoff + m_skin; }
+
+ private:
+  bool needsRebuild(const ParticleData& p, const common::Box& box);
+  double m_cutoff, m_skin;
+  int m_capacity = 32;
+  std::int64_t m_builds = 0;
+  DVec<int> m_list, m_count;
+  DVec<double> m_x0, m_y0, m_z0;  // positions at the last build
+  DVec<int> m_cell, m_order, m_cell_start, m_cell_end;
+};
+
+}  // namespace granagg::md

@@ -1,0 +1,163 @@
+// Contact physics: the HD potential functions against closed forms, and the neighbour-list
+// launcher against a brute-force O(N^2) host loop calling the same functions.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "common/Box.h"
+#include "md/compute/ContactForce.h"
+#include "md/neighbor/NeighborList.h"
+#include "md/potentials/HertzViscoelastic.h"
+#include "md/potentials/SpringDashpot.h"
+
+using namespace granagg;
+using namespace granagg::md;
+
+TEST_CASE("contact potentials: force is -dV/dxi, clamping, spring-dashpot restitution", "[md][potential]") {
+  const HertzViscoelastic::Params h{278.6, 0.0, true};
+  for (double xi : {1e-4, 1e-3, 0.01, 0.05}) {
+    const double dx = 1e-6 * xi;
+    const double dV = (HertzViscoelastic::elasticEnergy(xi + dx, h) - HertzViscoelastic::elasticEnergy(xi - dx, h)) / (2 * dx);
+    CHECK(HertzViscoelastic::normalForce(xi, 0.0, h) == Approx(dV).epsilon(1e-8));
+    CHECK(HertzViscoelastic::normalForce(xi, 0.0, h) == Approx(278.6 * std::pow(xi, 1.5)).epsilon(1e-14));
+  }
+  const HertzViscoelastic::Params hc{278.6, 27.7, true}, hu{278.6, 27.7, false};
+  // receding fast near the end of the contact: E xi^{3/2} + D xi^{1/2} xi' < 0
+  CHECK(HertzViscoelastic::normalForce(1e-4, -1.0, hc) == 0.0);
+  CHECK(HertzViscoelastic::normalForce(1e-4, -1.0, hu) == Approx(std::sqrt(1e-4) * (278.6e-4 - 27.7)).epsilon(1e-14));
+  // design.md: t_c = 0.23 for v = 1.6 at the defaults
+  CHECK(HertzViscoelastic::contactTime(1.6, hc) == Approx(0.233).margin(0.001));
+
+  const auto sd = SpringDashpot::makeParams(1e4, 0.9, false);
+  // closed form epsilon = exp(-pi zeta / omega) with zeta = gamma/(2 m_eff), omega^2 = k/m_eff - zeta^2
+  const double zeta = sd.gamma, omega = std::sqrt(2 * sd.k - zeta * zeta);
+  CHECK(std::exp(-M_PI * zeta / omega) == Approx(0.9).epsilon(1e-14));
+  CHECK(SpringDashpot::contactTime(sd) == Approx(M_PI / omega).epsilon(1e-14));
+  CHECK_THROWS_AS(SpringDashpot::makeParams(1e4, 1.5, false), std::invalid_argument);
+  CHECK_THROWS_AS(SpringDashpot::makeParams(-1, 0.5, false), std::invalid_argument);
+}
+
+namespace {
+ParticleData makeParticles(const std::vector<double>& pos, const std::vector<double>& vel) {
+  const std::size_t n = pos.size() / 3;
+  ParticleData p;
+  p.resize(n);
+  std::vector<double> h(n);
+  DVec<double>* P[3] = {&p.x, &p.y, &p.z};
+  DVec<double>* V[3] = {&p.vx, &p.vy, &p.vz};
+  for (int c = 0; c < 3; ++c) {
+    for (std::size_t i = 0; i < n; ++i) h[i] = pos[3 * i + c];
+    P[c]->assign(h.begin(), h.end());
+    for (std::size_t i = 0; i < n; ++i) h[i] = vel[3 * i + c];
+    V[c]->assign(h.begin(), h.end());
+  }
+  p.xp = p.x;
+  p.yp = p.y;
+  p.zp = p.z;
+  return p;
+}
+
+/// Brute-force reference: every pair, minimum image, the same HD function.
+void bruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L,
+                const HertzViscoelastic::Params& prm, std::vector<double>& f, int& pairs) {
+  const std::size_t n = pos.size() / 3;
+  common::Box box{L};
+  f.assign(3 * n, 0.0);
+  pairs = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) {
+      if (i == j) continue;
+      double r[3], g[3];
+      for (int c = 0; c < 3; ++c) {
+        r[c] = box.minimumImage(pos[3 * i + c] - pos[3 * j + c]);
+        g[c] = vel[3 * i + c] - vel[3 * j + c];
+      }
+      const double d = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+      if (d >= 1.0) continue;
+      pairs += (j > i);
+      const double xi_dot = -(g[0] * r[0] + g[1] * r[1] + g[2] * r[2]) / d;
+      const double F = HertzViscoelastic::normalForce(1.0 - d, xi_dot, prm);
+      for (int c = 0; c < 3; ++c) f[3 * i + c] += F * r[c] / d;
+    }
+}
+
+void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L) {
+  const HertzViscoelastic::Params prm{278.6, 27.7, true};
+  ParticleData p = makeParticles(pos, vel);
+  common::Box box{L};
+  NeighborList nl(1.0, 0.3);
+  nl.build(p, box);
+  ContactWork w;
+  // half_dt = 0 and zero old forces: predicted velocities equal v, as in the reference
+  computeContactForces<HertzViscoelastic>(p, nl, box, prm, 0.0, 0.5, w);
+  std::vector<double> ref;
+  int pairs;
+  bruteForce(pos, vel, L, prm, ref, pairs);
+  REQUIRE(pairs > 10);  // the configuration must actually test contacts
+  const std::size_t n = pos.size() / 3;
+  std::vector<double> fx(n), fy(n), fz(n);
+  thrust::copy(w.fx.begin(), w.fx.end(), fx.begin());
+  thrust::copy(w.fy.begin(), w.fy.end(), fy.begin());
+  thrust::copy(w.fz.begin(), w.fz.end(), fz.begin());
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a[3] = {fx[i], fy[i], fz[i]};
+    for (int c = 0; c < 3; ++c) {
+      worst = std::max(worst, std::fabs(a[c] - ref[3 * i + c]));
+      scale = std::max(scale, std::fabs(ref[3 * i + c]));
+    }
+  }
+  INFO("pairs in contact: " << pairs << ", max |F_nl - F_brute| / max |F| = " << worst / scale);
+  CHECK(worst <= 1e-12 * scale);
+  // Newton's third law: the total force vanishes
+  double tot[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < n; ++i) {
+    tot[0] += fx[i];
+    tot[1] += fy[i];
+    tot[2] += fz[i];
+  }
+  for (double t : tot) CHECK(std::fabs(t) <= 1e-12 * scale * n);
+}
+}  // namespace
+
+TEST_CASE("neighbour-list forces equal brute force on a random configuration", "[md][neighbor]") {
+  // 600 particles placed independently at random (phi ~ 0.1): many overlapping pairs, some across
+  // every periodic face; random velocities exercise the dissipative term.
+  std::mt19937_64 rng(11);
+  const double L = 14.5;
+  std::uniform_real_distribution<double> u(0.0, L), v(-2.0, 2.0);
+  std::vector<double> pos, vel;
+  for (int i = 0; i < 600; ++i)
+    for (int c = 0; c < 3; ++c) {
+      pos.push_back(u(rng));
+      vel.push_back(v(rng));
+    }
+  compareWithBruteForce(pos, vel, L);
+}
+
+TEST_CASE("neighbour-list forces equal brute force in dense clusters across the boundary", "[md][neighbor]") {
+  // Dense blobs (many neighbours per particle, exercising row-capacity growth) centred on a corner
+  // and on a face, so that contacts wrap across faces, edges and the corner.
+  std::mt19937_64 rng(5);
+  const double L = 12.0;
+  std::normal_distribution<double> g(0.0, 0.9);
+  std::uniform_real_distribution<double> v(-1.0, 1.0);
+  std::vector<double> pos, vel;
+  const double centres[2][3] = {{0.0, 0.0, 0.0}, {6.0, 6.0, L - 0.2}};
+  for (const auto& c : centres)
+    for (int i = 0; i < 250; ++i)
+      for (int k = 0; k < 3; ++k) {
+        double x = std::fmod(c[k] + g(rng) + 10 * L, L);
+        pos.push_back(x);
+        vel.push_back(v(rng));
+      }
+  compareWithBruteForce(pos, vel, L);
+}
+
+TEST_CASE("a box too small for the neighbour range is refused", "[md][neighbor]") {
+  ParticleData p = makeParticles({0.1, 0.1, 0.1, 1.5, 0.1, 0.1}, {0, 0, 0, 0, 0, 0});
+  NeighborList nl(1.0, 0.3);
+  CHECK_THROWS_WITH(nl.build(p, common::Box{2.4}), Catch::Contains("smaller than twice the neighbour range"));
+}
