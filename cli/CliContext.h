@@ -18,6 +18,8 @@ struct CliContext {
 
 /// Registers `granagg smol ...` (cli/SmolCommand.cpp).
 void registerSmolCommand(CLI::App& app, const CliContext& ctx);
+/// Registers `granagg md ...` (cli/MdCommand.cpp).
+void registerMdCommand(CLI::App& app, const CliContext& ctx);
 /// Registers `granagg kinetic ...` (cli/KineticCommand.cpp).
 void registerKineticCommand(CLI::App& app, const CliContext& ctx);
 

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.fallthrough(false);
 
+  cli::registerMdCommand(app, ctx);
   cli::registerSmolCommand(app, ctx);
   cli::registerKineticCommand(app, ctx);
 

@@ -133,6 +133,8 @@ double Engine::chooseTimeStep(const MdConfig& c, std::string* reason) {
     // initial temperature (collision-weighted P(g) = g/(2T) exp(-g^2/(4T)), tail exp(-g^2/(4T)))
     const double v = c.integrator.impact_speed_max > 0.0 ? c.integrator.impact_speed_max
                                                          : std::sqrt(4.0 * c.system.temperature * std::log(1e6));
+    if (!(c.contact.E > 0.0))
+      throw std::invalid_argument("integrator.dt = \"auto\" needs contact.E > 0 (the Hertz contact time is infinite for E = 0); give integrator.dt explicitly.");
     tc = HertzViscoelastic::contactTime(v, {c.contact.E, c.contact.D, c.contact.clamp}, M_EFF);
     why << "elastic Hertz contact time " << tc << " at impact speed " << v;
   }

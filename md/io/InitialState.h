@@ -1,0 +1,55 @@
+#pragma once
+/// \file InitialState.h
+/// User-given initial states (`[system] initial = "file"` in the run configuration) and the
+/// periodic wrapping shared by the readers and the H5MD writer. Reduced units: lengths in
+/// particle diameters d, velocities in sqrt(T0/m), charges in the engine's reduced charge unit.
+///
+/// CSV input (common::readCsv: '#' lines are comments, one header row, comma separated):
+///
+///     # my initial state
+///     x,y,z,vx,vy,vz,q
+///     0.5,1.25,3.0,0.1,-0.3,0.02,0.0
+///     ...
+///
+/// Columns x,y,z,vx,vy,vz are required, q (charge) is optional (zero otherwise), in any order;
+/// other columns are rejected. A CSV has no box: the caller passes L (from N and phi); positions
+/// outside [0, L) are wrapped and the crossings recorded as image counts.
+///
+/// H5MD input: any H5MD 1.1 file H5mdReader accepts (ours or another engine's); the last frame
+/// by default. Velocities are required; missing charges are zero; the box is the file's.
+#include <cstdint>
+#include <string>
+
+#include "md/io/Frame.h"
+
+namespace granagg::md {
+
+/// Reads an initial state from `path`, detected by content: an HDF5 file is read as H5MD (its
+/// last frame, its own box; `box_if_csv` is ignored), anything else as CSV in a cubic box of edge
+/// `box_if_csv` (> 0, reduced length units). The result has N >= 2 particles, finite values and
+/// positions wrapped into [0, L) with image counts. Step and time are 0 for CSV and the frame's
+/// for H5MD (the engine may reset them).
+/// Throws std::invalid_argument for bad values (naming the file, line or particle index) and for
+/// a missing file; std::runtime_error for unreadable or malformed H5MD files.
+Frame readInitialState(const std::string& path, double box_if_csv);
+
+/// CSV branch of readInitialState: columns as described above, box edge `box` > 0.
+/// Errors name the file and line ("init.csv:7: particle 4: vx = nan is not finite").
+Frame readInitialStateCsv(const std::string& path, double box);
+
+/// H5MD branch of readInitialState: frame `frame` (negative counts from the end, -1 = last) of
+/// the particle group `particle_group` ("" = the first group under /particles).
+Frame readInitialStateH5md(const std::string& path, long frame = -1, const std::string& particle_group = "");
+
+/// Wraps one coordinate into [0, box), adding the number of box lengths removed to `image` (so
+/// x + image * box is unchanged up to round-off). Values already in [0, box) are left bit for
+/// bit. Returns false, leaving both untouched, if x is not finite or the image count would
+/// overflow int32.
+bool wrapCoordinate(double& x, std::int32_t& image, double box);
+
+/// Wraps every position of `frame` into [0, frame.box) with wrapCoordinate; missing image arrays
+/// (empty) are created as zeros first. Throws std::invalid_argument naming the particle index if
+/// a position is not finite or the box is not positive.
+void wrapIntoBox(Frame& frame);
+
+}  // namespace granagg::md

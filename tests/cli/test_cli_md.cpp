@@ -1,0 +1,118 @@
+// `granagg md`: bad configurations, output folders, trajectory layout, restart bit for bit.
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "md/io/H5mdReader.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+struct Run {
+  int status;
+  std::string output;
+};
+Run sh(const std::string& cmd) {
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  REQUIRE(p != nullptr);
+  std::string out;
+  std::array<char, 4096> buf;
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+Run runGranagg(const std::string& args) { return sh(std::string(GRANAGG_BINARY) + " " + args); }
+
+fs::path tempDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("granagg_md_" + std::to_string(::getpid()) + "_" + name);
+  fs::remove_all(d);
+  return d;
+}
+std::string writeConfig(const fs::path& dir, const std::string& body) {
+  fs::create_directories(dir);
+  const fs::path p = dir / "run.toml";
+  std::ofstream(p) << body;
+  return p.string();
+}
+const char* SMALL = "[input]\nversion = 1\n[system]\nN = 300\nseed = 5\n[run]\nt_end = 1.0\n";
+}  // namespace
+
+TEST_CASE("md rejects bad configurations with a message naming the key, exit 2", "[cli][md]") {
+  const fs::path dir = tempDir("bad");
+  struct Case {
+    std::string toml, says;
+  };
+  for (const Case& c : {Case{"[system]\nNn = 5\n", "Nn"}, Case{"[system]\nphi = 0.7\n", "phi"},
+                        Case{"[system]\nN = 1\n", "N"}, Case{"[integrator]\ndt = -1\n", "dt"},
+                        Case{"[contact]\nE = -3\n", "E"}, Case{"[bogus]\nx = 1\n", "bogus"}}) {
+    INFO(c.toml);
+    const std::string cfg = writeConfig(dir, c.toml);
+    const Run r = runGranagg("md --config " + cfg + " --out " + (dir / "o").string() + " -q");
+    CHECK(r.status == 2);
+    CHECK_THAT(r.output, Catch::Contains(c.says));
+  }
+  const Run unknown = runGranagg("md --config " + writeConfig(dir, "[system]\nN = 100\nNn = 5\n") + " -q");
+  CHECK_THAT(unknown.output, Catch::Contains("run.toml:3"));
+  CHECK(runGranagg("md --preset nosuch -q").status == 2);
+  CHECK(runGranagg("md -q").status == 2);  // neither --config nor --preset
+  fs::remove_all(dir);
+}
+
+TEST_CASE("md writes a readable trajectory and refuses to overwrite it", "[cli][md]") {
+  const fs::path dir = tempDir("run");
+  const std::string cfg = writeConfig(dir, SMALL);
+  const fs::path out = dir / "out";
+  const Run r = runGranagg("md --config " + cfg + " --out " + out.string());
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK_THAT(r.output, Catch::Contains("backend"));
+  CHECK_THAT(r.output, Catch::Contains("dt = "));
+  REQUIRE(fs::exists(out / "traj.h5"));
+  REQUIRE(fs::exists(out / "checkpoint.h5"));
+  granagg::md::H5mdReader reader((out / "traj.h5").string());
+  CHECK(reader.size() == 300);
+  CHECK(reader.frames() >= 3);
+  const auto last = reader.readFrame(reader.frames() - 1);
+  CHECK(last.time == Approx(1.0).margin(0.01));
+
+  const Run again = runGranagg("md --config " + cfg + " --out " + out.string() + " -q");
+  CHECK(again.status == 2);
+  CHECK_THAT(again.output, Catch::Contains("--force"));
+  if (fs::exists("/usr/bin/python3") && sh("/usr/bin/python3 -c 'import h5py'").status == 0) {
+    const Run check = sh("/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) + "/scripts/check_h5md.py " +
+                         (out / "traj.h5").string());
+    INFO(check.output);
+    CHECK(check.status == 0);
+  } else {
+    WARN("h5py not available: scripts/check_h5md.py not run");
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
+  const fs::path dir = tempDir("restart");
+  const std::string cfg = writeConfig(dir, SMALL);
+  // uninterrupted to t = 1
+  REQUIRE(runGranagg("md --config " + cfg + " --out " + (dir / "a").string() + " -q").status == 0);
+  // interrupted at t = 0.5, then continued to t = 1
+  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.5 --out " + (dir / "b").string() + " -q").status == 0);
+  const Run r = runGranagg("md --restart " + (dir / "b").string() + " --set run.t_end=1.0 -q");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()), rb((dir / "b" / "traj.h5").string());
+  const auto fa = ra.readFrame(ra.frames() - 1), fb = rb.readFrame(rb.frames() - 1);
+  CHECK(fa.step == fb.step);
+  CHECK(fa.x == fb.x);
+  CHECK(fa.y == fb.y);
+  CHECK(fa.vz == fb.vz);
+  CHECK(fa.ix == fb.ix);
+  CHECK(runGranagg("md --restart " + (dir / "b").string() + " --set system.N=5 -q").status == 2);
+  fs::remove_all(dir);
+}

@@ -1,0 +1,195 @@
+// Checkpoints: bit-exact round trip, atomic replacement (a failed write keeps the previous
+// checkpoint), and clear errors for truncated, corrupted and foreign files.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <random>
+#include <string>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "md/io/Checkpoint.h"
+#include "md/io/H5mdWriter.h"
+
+using namespace granagg::md;
+
+namespace {
+
+std::string tempPath(const std::string& name) {
+  return "/tmp/granagg_test_ckpt_" + std::to_string(::getpid()) + "_" + name;
+}
+
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+/// A state with awkward doubles (signed zero, subnormal, huge) so that any rounding shows.
+Checkpoint makeCheckpoint(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 12.0), v(-5.0, 5.0);
+  std::uniform_int_distribution<std::int32_t> im(-50, 50);
+  Checkpoint c;
+  Frame& s = c.state;
+  s.step = 123456789012LL;
+  s.time = 98.76543210987654;
+  s.box = 12.0;
+  CheckpointExtra& e = c.extra;
+  for (std::size_t i = 0; i < n; ++i) {
+    s.x.push_back(u(rng));
+    s.y.push_back(u(rng));
+    s.z.push_back(u(rng));
+    s.vx.push_back(v(rng));
+    s.vy.push_back(v(rng));
+    s.vz.push_back(v(rng));
+    s.charge.push_back(v(rng) * 1e-3);
+    s.ix.push_back(im(rng));
+    s.iy.push_back(im(rng));
+    s.iz.push_back(im(rng));
+    e.fx.push_back(v(rng) * 1e4);
+    e.fy.push_back(v(rng) * 1e4);
+    e.fz.push_back(v(rng) * 1e4);
+  }
+  s.vx[0] = -0.0;
+  s.vy[0] = std::numeric_limits<double>::denorm_min();
+  e.fz[0] = 1.7976931348623157e308;
+  e.dt = 1.0 / 3000.0;
+  e.config_toml = "[input]\nversion = 1\n[system]\nN = " + std::to_string(n) + "\n";
+  e.seed = 0xFFFFFFFFFFFFFFF1ULL;  // needs all 64 unsigned bits
+  e.frames_written = 17;
+  e.next_frame_index = 19;
+  e.int_scalars = {{"neighbor_rebuilds", 4242}, {"min_step", -7}};
+  e.real_scalars = {{"wall_seconds", 1234.5}, {"max_displacement", 0.1 + 0.2}};
+  return c;
+}
+
+bool sameCheckpoint(const Checkpoint& a, const Checkpoint& b) {
+  const Frame &s = a.state, &t = b.state;
+  const CheckpointExtra &e = a.extra, &f = b.extra;
+  return s.step == t.step && sameBits(s.time, t.time) && sameBits(s.box, t.box) && sameBits(s.x, t.x) &&
+         sameBits(s.y, t.y) && sameBits(s.z, t.z) && sameBits(s.vx, t.vx) && sameBits(s.vy, t.vy) &&
+         sameBits(s.vz, t.vz) && sameBits(s.charge, t.charge) && sameBits(s.ix, t.ix) && sameBits(s.iy, t.iy) &&
+         sameBits(s.iz, t.iz) && sameBits(e.fx, f.fx) && sameBits(e.fy, f.fy) && sameBits(e.fz, f.fz) &&
+         sameBits(e.dt, f.dt) && e.config_toml == f.config_toml && e.seed == f.seed &&
+         e.frames_written == f.frames_written && e.next_frame_index == f.next_frame_index &&
+         e.int_scalars == f.int_scalars && e.real_scalars.size() == f.real_scalars.size() &&
+         std::equal(e.real_scalars.begin(), e.real_scalars.end(), f.real_scalars.begin(),
+                    [](const auto& p, const auto& q) { return p.first == q.first && sameBits(p.second, q.second); });
+}
+
+bool fileExists(const std::string& p) {
+  struct stat st;
+  return ::stat(p.c_str(), &st) == 0;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void spit(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+}  // namespace
+
+TEST_CASE("checkpoint round trip is bit-exact", "[md][io]") {
+  const std::string path = tempPath("rt.h5");
+  const Checkpoint c = makeCheckpoint(1000, 7);
+  writeCheckpoint(path, c.state, c.extra);
+  CHECK_FALSE(fileExists(path + ".tmp"));  // renamed into place
+  const Checkpoint r = readCheckpoint(path);
+  CHECK(sameCheckpoint(c, r));
+  CHECK(r.extra.seed == 0xFFFFFFFFFFFFFFF1ULL);
+  CHECK(r.extra.int_scalars.at("min_step") == -7);
+
+  // replacing it with a newer checkpoint
+  const Checkpoint c2 = makeCheckpoint(1000, 8);
+  writeCheckpoint(path, c2.state, c2.extra);
+  CHECK(sameCheckpoint(readCheckpoint(path), c2));
+  std::remove(path.c_str());
+}
+
+TEST_CASE("a failed checkpoint write keeps the previous checkpoint", "[md][io]") {
+  const std::string path = tempPath("atomic.h5");
+  const Checkpoint good = makeCheckpoint(50, 1);
+  writeCheckpoint(path, good.state, good.extra);
+  // Simulate a failure while writing: the temporary file cannot be created because a directory
+  // of that name is in the way.
+  const std::string tmp = path + ".tmp";
+  REQUIRE(::mkdir(tmp.c_str(), 0700) == 0);
+  const Checkpoint next = makeCheckpoint(50, 2);
+  CHECK_THROWS_AS(writeCheckpoint(path, next.state, next.extra), std::runtime_error);
+  CHECK_THROWS_WITH(writeCheckpoint(path, next.state, next.extra), Catch::Contains(tmp));
+  CHECK(sameCheckpoint(readCheckpoint(path), good));  // the old one survives intact
+  ::rmdir(tmp.c_str());
+  // and once the obstacle is gone, writing works again
+  writeCheckpoint(path, next.state, next.extra);
+  CHECK(sameCheckpoint(readCheckpoint(path), next));
+  std::remove(path.c_str());
+}
+
+TEST_CASE("checkpoint arguments are validated", "[md][io]") {
+  const std::string path = tempPath("invalid.h5");
+  Checkpoint c = makeCheckpoint(10, 3);
+  Checkpoint bad = c;
+  bad.extra.fy.pop_back();
+  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra), Catch::Contains("fy has 9 entries, expected N = 10"));
+  bad = c;
+  bad.extra.dt = 0.0;
+  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra), Catch::Contains("dt must be positive"));
+  bad = c;
+  bad.state.charge.clear();
+  CHECK_THROWS_AS(writeCheckpoint(path, bad.state, bad.extra), std::invalid_argument);
+  CHECK_FALSE(fileExists(path));
+}
+
+TEST_CASE("corrupt or foreign checkpoints give clear errors", "[md][io]") {
+  const std::string path = tempPath("corrupt.h5");
+  Checkpoint c = makeCheckpoint(4096, 4);
+  // a recognisable pattern in x to locate its bytes in the file
+  for (std::size_t i = 0; i < c.state.x.size(); ++i) c.state.x[i] = 1.0 + 1e-9 * static_cast<double>(i);
+  writeCheckpoint(path, c.state, c.extra);
+  const std::string bytes = slurp(path);
+
+  SECTION("truncated") {
+    const std::string half = tempPath("half.h5");
+    spit(half, bytes.substr(0, bytes.size() / 2));
+    CHECK_THROWS_AS(readCheckpoint(half), std::runtime_error);
+    CHECK_THROWS_WITH(readCheckpoint(half), Catch::Contains(half));
+    std::remove(half.c_str());
+  }
+  SECTION("a flipped byte in the particle data fails the checksum") {
+    double probe = c.state.x[100];
+    const std::string needle(reinterpret_cast<const char*>(&probe), sizeof probe);
+    const std::size_t at = bytes.find(needle);
+    REQUIRE(at != std::string::npos);
+    std::string broken = bytes;
+    broken[at + 3] = static_cast<char>(broken[at + 3] ^ 0x10);
+    const std::string bad = tempPath("flipped.h5");
+    spit(bad, broken);
+    CHECK_THROWS_WITH(readCheckpoint(bad), Catch::Contains(bad) && Catch::Contains("/state/x"));
+    std::remove(bad.c_str());
+  }
+  SECTION("not HDF5, missing, not a checkpoint") {
+    const std::string text = tempPath("text.h5");
+    spit(text, "not a checkpoint\n");
+    CHECK_THROWS_WITH(readCheckpoint(text), Catch::Contains(text) && Catch::Contains("not an HDF5 file"));
+    std::remove(text.c_str());
+    CHECK_THROWS_WITH(readCheckpoint(tempPath("missing.h5")), Catch::Contains("does not exist"));
+    const std::string traj = tempPath("traj.h5");
+    { H5mdWriter w(traj, 3, {}, "", true); }
+    CHECK_THROWS_WITH(readCheckpoint(traj), Catch::Contains("not a granagg checkpoint"));
+    std::remove(traj.c_str());
+    std::remove(H5mdWriter::xdmfPathFor(traj).c_str());
+  }
+  std::remove(path.c_str());
+}
