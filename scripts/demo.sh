@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job (README): installs what is missing, builds, and runs the mean-field demo --
 # the z(beta) table from the full Smoluchowski equation and S(t) for beta = 2 and 3 with the
-# three solvers -- then draws the figures. About a minute on 2 cores after the build.
+# three solvers -- plus a small MD run of the viscoelastic gas (the quick preset) compared with
+# kinetic theory, then draws the figures. About a minute on 2 cores after the build.
 # (Issue 6 replaces this with the paired MD / mean-field demo.)
 #   usage: bash scripts/demo.sh [OUTDIR]     (default: results/demo-<date>-<time>; never reused)
 set -euo pipefail
@@ -28,6 +29,9 @@ done
 echo "-- kinetic theory: restitution and cooling of the viscoelastic gas"
 "$G" kinetic restitution --v 0.01,0.05,0.1,0.5,1,2 --out "$OUT/restitution.csv"
 "$G" kinetic cooling --t-end 1000 --out "$OUT/cooling.csv"
+
+echo "-- MD: the quick preset (N = 2000 viscoelastic gas to t = 50)"
+"$G" md --preset quick --out "$OUT/md-quick"
 
 /usr/bin/python3 scripts/plot_meanfield.py "$OUT"
 echo "== done: tables (CSV with provenance headers) and figures in $OUT"

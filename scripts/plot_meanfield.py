@@ -105,6 +105,34 @@ def plot_kinetic(out):
     plt.close(fig)
 
 
+def plot_md(out):
+    """T_g(t) of the MD run in OUT/md-quick beside the kinetic-theory cooling (cooling.csv)."""
+    traj = os.path.join(out, "md-quick", "traj.h5")
+    if not os.path.exists(traj):
+        return
+    import h5py
+
+    with h5py.File(traj, "r") as f:
+        g = f["granagg/observables/temperature"]
+        t, T = g["time"][:], g["value"][:]
+        c = f["granagg/observables/contacts_per_particle/value"][:]
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    ok = t > 0
+    ax.loglog(t[ok], T[ok], "-", label="MD, quick preset (N = 2000)")
+    theory = read(os.path.join(out, "cooling.csv"))
+    if theory is not None:
+        names = theory.dtype.names
+        ax.loglog(theory[names[0]], theory["T"], "--", label="kinetic theory, exact e(v), Enskog rate")
+    ax.set_xlabel("t  [sqrt(m d^2/T0)]")
+    ax.set_ylabel("T_g / T0")
+    ax.set_xlim(left=0.05)
+    ax.legend(fontsize=8)
+    ax.set_title(f"viscoelastic gas (mean contacts per particle {c.mean():.2f})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "md_cooling.png"), dpi=120)
+    plt.close(fig)
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
@@ -112,6 +140,7 @@ def main():
     plot_S(out)
     plot_zbeta(out)
     plot_kinetic(out)
+    plot_md(out)
     print("figures:", ", ".join(f for f in sorted(os.listdir(out)) if f.endswith(".png")))
 
 

@@ -116,3 +116,20 @@ TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   CHECK(runGranagg("md --restart " + (dir / "b").string() + " --set system.N=5 -q").status == 2);
   fs::remove_all(dir);
 }
+
+TEST_CASE("md stops at a deep overlap naming step and particles and keeps the last checkpoint", "[cli][md]") {
+  const fs::path dir = tempDir("abort");
+  // max_overlap = 0.03 is reached by any impact faster than ~0.5 (xi_max ~ (5 v^2/(8E))^{2/5}):
+  // the guard must fire within t = 1, after at least one step-based checkpoint
+  const std::string cfg = writeConfig(
+      dir, std::string(SMALL) + "max_overlap = 0.03\n[output]\ncheckpoint_interval = 5\ncheckpoint_wall_seconds = 0.0\n");
+  const Run r = runGranagg("md --config " + cfg + " --out " + (dir / "o").string() + " -q");
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK_THAT(r.output, Catch::Contains("overlap beyond run.max_overlap"));
+  CHECK_THAT(r.output, Catch::Contains("step "));
+  CHECK_THAT(r.output, Catch::Contains("particle"));
+  CHECK_THAT(r.output, Catch::Contains("last good checkpoint"));
+  CHECK(fs::exists(dir / "o" / "checkpoint.h5"));
+  fs::remove_all(dir);
+}

@@ -28,7 +28,7 @@ std::string writeText(const std::string& name, const std::string& text) {
 
 }  // namespace
 
-TEST_CASE("wrapCoordinate maps into [0, L) and counts the crossings", "[md][io]") {
+TEST_CASE("wrapCoordinate maps into the box and counts the crossings", "[md][io]") {
   const double L = 10.0;
   double x = 3.25;
   std::int32_t im = 4;

@@ -1,0 +1,277 @@
+#!/usr/bin/env bash
+# MD throughput of granagg against LAMMPS (issue 3; design.md section 7): the same neutral
+# viscoelastic-Hertz gas (phi = 0.076, E = 278.6, D = 27.7, clamped, d = m = 1, T = 1), the same
+# initial state, the same fixed time step and the same Verlet skin, run in one go on this machine.
+# Prints Markdown tables for docs/benchmarks.md: the two-body mapping check, then N, code, cores
+# (granagg OpenMP threads, LAMMPS MPI ranks), particle-steps/s and the ratio granagg/LAMMPS on the
+# same number of cores.
+#
+#   usage: bash scripts/bench_md_lammps.sh [GRANAGG_BINARY]      (default build/bin/granagg)
+#   environment: SIZES="10000 100000"  STEPS_10000="200 2000"  STEPS_100000="100 500"
+#                DT=0.002  REPEATS=3  THREADS="1 2"  LMP_RANKS="1 2"  SKIP_TWO_BODY=1 (skip the mapping check)
+#
+# Installs Debian's `lammps` (29 Sep 2021 stable, binary lmp) if it is missing; builds nothing.
+#
+# Timing: every run is done at two lengths n1 < n2 from the same initial state; the rate is
+# N (n2 - n1) / (t(n2) - t(n1)). For granagg t is the wall time of the whole process, so start-up,
+# initial-state reading, the first neighbour build and output cancel; for LAMMPS the input does
+# `run n1` then `run n2-n1` and t(n2) - t(n1) is the second run's "Loop time" (same steps n1..n2 of
+# the same cooling gas, so both codes do the same physical work). Each time is the smallest of
+# REPEATS runs (the machine may be shared: load only slows a run down); the range of the
+# per-repeat rates is printed as a measure of the noise.
+#
+# LAMMPS mapping (src/GRANULAR/pair_gran_hertz_history.cpp): the normal force on each partner is
+#     F = sqrt(delta R_i R_j/(R_i+R_j)) [kn delta + m_eff gamma_n xi'],
+# so with R = 1/2 (factor 1/2) and m = 1 (m_eff = 1/2): kn = 2E = 557.2, gamma_n = 4D = 110.8;
+# kt = gamma_t = xmu = 0, dampflag 0; `limit_damping` = granagg's contact.clamp = true. Density
+# 6/pi gives mass 1 at diameter 1. scripts/lammps/two_body.in checks this mapping against
+# `granagg kinetic restitution`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+G=$(realpath "${1:-build/bin/granagg}")
+[ -x "$G" ] || { echo "bench_md_lammps: no granagg binary at $G (build it first)" >&2; exit 1; }
+SIZES=${SIZES-"10000 100000"}   # SIZES="" runs only the two-body check
+DT=${DT:-0.002}
+REPEATS=${REPEATS:-3}
+THREADS=${THREADS:-"1 2"}        # granagg OpenMP threads
+LMP_RANKS=${LMP_RANKS:-"1 2"}    # LAMMPS MPI ranks (1 = serial, no mpirun)
+E=278.6; D=27.7; PHI=0.076; SKIN=0.3
+calc() { awk "BEGIN {printf \"%.10g\", $1}"; }
+KN=$(calc "2 * $E"); GN=$(calc "4 * $D")
+
+if ! command -v lmp >/dev/null 2>&1; then
+  echo "bench_md_lammps: installing Debian's lammps" >&2
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO=sudo
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get install -y lammps >/dev/null || { $SUDO apt-get update >/dev/null && $SUDO apt-get install -y lammps >/dev/null; }
+fi
+LMP=$(command -v lmp)
+if ! command -v mpirun >/dev/null 2>&1; then  # Debian's lammps pulls in Open MPI; without it, serial only
+  LMP_RANKS=1
+fi
+
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+
+steps_for() {  # N -> "n1 n2": STEPS_<N> if set, else 200 2000 up to N = 2e4 and 100 500 above
+  local var="STEPS_$1"
+  if [ -n "${!var:-}" ]; then echo "${!var}"; elif [ "$1" -le 20000 ]; then echo "200 2000"; else echo "100 500"; fi
+}
+now() { date +%s.%N; }
+
+# ---------------------------------------------------------------------------------------------
+# Machine
+echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(free -g | awk '/Mem:/ {print $2}') GiB"
+echo "granagg: $("$G" --version 2>&1 | head -n 1); $G"
+echo "LAMMPS:  $("$LMP" -h | grep -m1 'Large-scale' | sed 's/.*Simulator - //') (Debian $(dpkg-query -W -f='${Version}' lammps 2>/dev/null || echo '?')); $LMP"
+echo "Load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo
+
+# ---------------------------------------------------------------------------------------------
+# Two-body mapping check: restitution of a head-on collision in LAMMPS against granagg's
+if [ -z "${SKIP_TWO_BODY:-}" ]; then
+  VS="0.05 0.5 1 2"
+  declare -A EG
+  for c in clamped unclamped; do
+    flag=""; [ $c = unclamped ] && flag=--unclamped
+    while IFS=, read -r v e _; do EG[$c,$v]=$e; done < <("$G" kinetic restitution --v "$(echo "$VS" | tr ' ' ,)" $flag 2>/dev/null | grep -v '^#' | tail -n +2)
+  done
+  lmp_e() {  # v clamp dt -> e
+    (cd "$TMP" && "$LMP" -in "$ROOT/scripts/lammps/two_body.in" -var v "$1" -var clamp "$2" -var dt "$3" -log none -nocite -echo none) \
+      | sed -n 's/^TWO_BODY .* e=\([-0-9.e]*\) .*/\1/p'
+  }
+  echo "Two-body head-on collision, restitution e(v): LAMMPS pair gran/hertz/history (kn = 2E, gamma_n = 4D) against \`granagg kinetic restitution\`"
+  echo
+  echo "| v | granagg clamped | LAMMPS limit_damping, dt=1e-5 | LAMMPS limit_damping, dt=$DT | granagg unclamped (\`--unclamped\`) | LAMMPS without limit_damping, dt=1e-5 |"
+  echo "|---|---|---|---|---|---|"
+  for v in $VS; do
+    printf '| %s | %.6f | %s | %s | %.6f | %s |\n' "$v" "${EG[clamped,$v]:-nan}" \
+      "$(lmp_e "$v" 1 1e-5)" "$(lmp_e "$v" 1 "$DT")" "${EG[unclamped,$v]:-nan}" "$(lmp_e "$v" 0 1e-5)"
+  done
+  echo
+fi
+
+# ---------------------------------------------------------------------------------------------
+# Throughput
+gen_state() {  # N -> $TMP/state_N.csv (granagg) and $TMP/state_N.data (LAMMPS): random non-overlapping
+  # positions (random sequential addition, cell list) and Gaussian velocities with zero momentum
+  # rescaled to T_g = (1/3N) sum v^2 = 1 exactly, like granagg's own random state.
+  /usr/bin/python3 - "$1" "$PHI" "$TMP" <<'EOF'
+import math, random, sys
+N, phi, tmp = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
+L = (N * math.pi / (6 * phi)) ** (1 / 3)
+rng = random.Random(12345)
+nc = int(L)            # cells of edge >= 1 (= diameter)
+cl = L / nc
+cells = {}
+pos = []
+while len(pos) < N:
+    p = (rng.random() * L, rng.random() * L, rng.random() * L)
+    c = [int(p[k] / cl) % nc for k in range(3)]
+    ok = True
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dz in (-1, 0, 1):
+                for j in cells.get(((c[0] + dx) % nc, (c[1] + dy) % nc, (c[2] + dz) % nc), ()):
+                    q = pos[j]
+                    r2 = 0.0
+                    for k in range(3):
+                        d = p[k] - q[k]
+                        d -= L * round(d / L)
+                        r2 += d * d
+                    if r2 < 1.0:
+                        ok = False; break
+                if not ok: break
+            if not ok: break
+        if not ok: break
+    if ok:
+        cells.setdefault(tuple(c), []).append(len(pos))
+        pos.append(p)
+vel = [[rng.gauss(0, 1) for _ in range(3)] for _ in range(N)]
+mean = [sum(v[k] for v in vel) / N for k in range(3)]
+vel = [[v[k] - mean[k] for k in range(3)] for v in vel]
+s = math.sqrt(1.0 / (sum(v[0]**2 + v[1]**2 + v[2]**2 for v in vel) / (3 * N)))
+vel = [[x * s for x in v] for v in vel]
+with open(f"{tmp}/state_{N}.csv", "w") as f:
+    f.write("x,y,z,vx,vy,vz\n")
+    for p, v in zip(pos, vel):
+        f.write(",".join(repr(x) for x in (*p, *v)) + "\n")
+with open(f"{tmp}/state_{N}.data", "w") as f:
+    f.write(f"granagg benchmark state, N = {N}, phi = {phi}\n\n{N} atoms\n1 atom types\n\n")
+    for a in "xyz":
+        f.write(f"0.0 {L!r} {a}lo {a}hi\n")
+    f.write("\nAtoms # sphere\n\n")
+    for i, p in enumerate(pos):
+        f.write(f"{i + 1} 1 1.0 {6 / math.pi!r} {p[0]!r} {p[1]!r} {p[2]!r}\n")
+    f.write("\nVelocities\n\n")
+    for i, v in enumerate(vel):
+        f.write(f"{i + 1} {v[0]!r} {v[1]!r} {v[2]!r} 0 0 0\n")
+EOF
+}
+
+granagg_time() {  # N steps threads -> wall seconds of the whole process
+  local N=$1 n=$2 th=$3
+  cat > "$TMP/g.toml" <<EOF
+[system]
+N = $N
+phi = $PHI
+initial = "$TMP/state_$N.csv"
+[contact]
+model = "hertz"
+E = $E
+D = $D
+clamp = true
+[integrator]
+dt = $DT
+[neighbor]
+skin = $SKIN
+[run]
+t_end = $(calc "$n * $DT")
+[output]
+frames_per_decade = 0
+frame_interval = 0.0
+observable_interval = 1000000
+checkpoint_interval = 0
+checkpoint_wall_seconds = 0.0
+write_velocities = false
+EOF
+  local t0 t1
+  t0=$(now)
+  OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" > "$TMP/g.log" 2>&1 \
+    || { cat "$TMP/g.log" >&2; exit 1; }
+  t1=$(now)
+  grep -q "$n steps to t_end" "$TMP/g.log" || { echo "granagg did not run $n steps:" >&2; cat "$TMP/g.log" >&2; exit 1; }
+  calc "$t1 - $t0"
+}
+
+lammps_time() {  # N n1 n2 ranks -> loop seconds of steps n1..n2
+  local N=$1 n1=$2 n2=$3 np=$4
+  cat > "$TMP/bench.in" <<EOF
+units           lj
+atom_style      sphere
+boundary        p p p
+comm_modify     vel yes
+read_data       $TMP/state_$N.data
+pair_style      gran/hertz/history $KN 0.0 $GN 0.0 0.0 0 limit_damping
+pair_coeff      * *
+neighbor        $SKIN bin
+neigh_modify    delay 0 every 1 check yes
+fix             1 all nve/sphere
+timestep        $DT
+thermo          1000000
+run             $n1
+run             $((n2 - n1))
+EOF
+  local launch=()
+  if [ "$np" -gt 1 ]; then
+    launch=(mpirun -np "$np" --bind-to core)
+    [ "$(id -u)" -ne 0 ] || launch+=(--allow-run-as-root)
+  fi
+  (cd "$TMP" && OMP_NUM_THREADS=1 "${launch[@]}" "$LMP" -in bench.in -log none -nocite -echo none > lmp.log 2>&1) || { cat "$TMP/lmp.log" >&2; exit 1; }
+  cp "$TMP/lmp.log" "$TMP/lmp_$np.log"
+  grep '^Loop time' "$TMP/lmp.log" | tail -n 1 | awk '{print $4}'
+}
+
+mins() {  # numbers... -> the smallest
+  printf '%s\n' "$@" | sort -g | head -n 1
+}
+range() {  # rates... -> "min-max"
+  printf '%s\n' "$@" | sort -g | awk '{a[NR] = $1} END {printf "%.3g-%.3g", a[1], a[NR]}'
+}
+
+ROWS=()
+NOTES=()
+for N in $SIZES; do
+  read -r n1 n2 <<< "$(steps_for "$N")"
+  echo "N = $N: generating the initial state, timing steps $n1..$n2 ($REPEATS repeats; load $(cut -d' ' -f1 /proc/loadavg))" >&2
+  gen_state "$N"
+  declare -A T=() R=()
+  for rep in $(seq "$REPEATS"); do
+    for np in $LMP_RANKS; do
+      t=$(lammps_time "$N" "$n1" "$n2" "$np")
+      T[l$np]+="$t "; R[l$np]+="$(calc "$N * ($n2 - $n1) / $t") "
+    done
+    for th in $THREADS; do
+      ta=$(granagg_time "$N" "$n1" "$th"); tb=$(granagg_time "$N" "$n2" "$th")
+      T[a$th]+="$ta "; T[b$th]+="$tb "; R[g$th]+="$(calc "$N * ($n2 - $n1) / ($tb - $ta)") "
+    done
+    echo "  repeat $rep: load $(cut -d' ' -f1 /proc/loadavg); rates so far: LAMMPS $(for np in $LMP_RANKS; do printf '%s ranks: %s; ' "$np" "${R[l$np]}"; done)granagg $(for th in $THREADS; do printf '%s threads: %s; ' "$th" "${R[g$th]}"; done)" >&2
+  done
+  # rate from the fastest run of each kind (load only ever slows a run down)
+  declare -A LR=()
+  for np in $LMP_RANKS; do
+    # shellcheck disable=SC2086
+    LR[$np]=$(calc "$N * ($n2 - $n1) / $(mins ${T[l$np]})")
+    # shellcheck disable=SC2086
+    ROWS+=("| $N | LAMMPS gran/hertz/history, $([ "$np" -eq 1 ] && echo serial || echo "MPI") | $np | $(printf '%.3g' "${LR[$np]}") | | $(range ${R[l$np]}) |")
+  done
+  for th in $THREADS; do
+    # shellcheck disable=SC2086
+    rate=$(calc "$N * ($n2 - $n1) / ($(mins ${T[b$th]}) - $(mins ${T[a$th]}))")
+    ratio=""
+    [ -z "${LR[$th]:-}" ] || ratio=$(calc "$rate / ${LR[$th]}" | xargs printf '%.2f')
+    # shellcheck disable=SC2086
+    ROWS+=("| $N | granagg, OpenMP | $th | $(printf '%.3g' "$rate") | $ratio | $(range ${R[g$th]}) |")
+  done
+  # what the window looks like (temperature at n1 and n2, rebuilds, time split), from the log of
+  # the last LAMMPS run on the fewest ranks
+  # shellcheck disable=SC2086
+  log="$TMP/lmp_$(printf '%s\n' $LMP_RANKS | sort -n | head -n 1).log"
+  last=$(awk '/^Loop time/ {buf = ""} {buf = buf $0 "\n"} END {printf "%s", buf}' "$log")  # from the last "Loop time"
+  temps=$(awk '/^ *Step/ {getline; t = $2} END {print t}' "$log")
+  temp2=$(awk '/^Loop time/ {t = prev} {prev = $2} END {print t}' "$log")
+  builds=$(grep 'Neighbor list builds' <<< "$last" | awk '{print $NF}')
+  brk=$(awk '/^Section/ {s = 1; next} s && /^---/ {next} s && /\|/ {gsub(/ /, ""); split($0, a, "|"); printf "%s %s%%, ", a[1], a[6]; next} {s = 0}' <<< "$last" | sed 's/, $//')
+  NOTES+=("- N = $N, steps $n1..$n2: LAMMPS temperature $temps -> $temp2, $builds neighbour-list builds; LAMMPS time split (last run on $(basename "$log" .log | sed "s/lmp_//") rank(s)): $brk")
+done
+
+echo "Throughput: phi = $PHI, dt = $DT, skin $SKIN, clamped Hertz (E = $E, D = $D), T(0) = 1; rates over steps n1..n2 from the fastest of $REPEATS runs of each kind"
+echo
+echo "| N | code | cores (threads or ranks) | particle-steps/s | granagg / LAMMPS on as many cores | range over repeats |"
+echo "|---|---|---|---|---|---|"
+printf '%s\n' "${ROWS[@]}"
+echo
+printf '%s\n' "${NOTES[@]}"
+echo
+echo "Load at end: $(cut -d' ' -f1-3 /proc/loadavg)"
