@@ -71,6 +71,24 @@ struct Engine::Impl {
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {}
 
+  /// Copies a host state (same N, wrapped, with images and charges) into the device arrays.
+  void upload(const Frame& f) {
+    toDevice(f.x, p.x);
+    toDevice(f.y, p.y);
+    toDevice(f.z, p.z);
+    toDevice(f.vx, p.vx);
+    toDevice(f.vy, p.vy);
+    toDevice(f.vz, p.vz);
+    toDevice(f.charge, p.q);
+    toDevice(f.ix, p.ix);
+    toDevice(f.iy, p.iy);
+    toDevice(f.iz, p.iz);
+    // previous positions are overwritten by the next drift before the collision test reads them
+    p.xp = p.x;
+    p.yp = p.y;
+    p.zp = p.z;
+  }
+
   /// Forces of the current positions into p.f; counts collisions; aborts on NaN / deep overlap.
   void computeForces() {
     nl.update(p, box);
@@ -170,19 +188,7 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
     f.iz[i] += d.box.wrap(f.z[i]);
   }
   d.p.resize(N);
-  toDevice(f.x, d.p.x);
-  toDevice(f.y, d.p.y);
-  toDevice(f.z, d.p.z);
-  d.p.xp = d.p.x;
-  d.p.yp = d.p.y;
-  d.p.zp = d.p.z;
-  toDevice(f.vx, d.p.vx);
-  toDevice(f.vy, d.p.vy);
-  toDevice(f.vz, d.p.vz);
-  toDevice(f.charge, d.p.q);
-  toDevice(f.ix, d.p.ix);
-  toDevice(f.iy, d.p.iy);
-  toDevice(f.iz, d.p.iz);
+  d.upload(f);
   d.step = init.step;
   d.time = init.step * d.dt;
 
@@ -245,29 +251,15 @@ std::vector<double> Engine::forces() const {
 void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions) {
   Impl& d = *m_impl;
   const std::size_t N = d.p.size();
-  if (s.size() != N || forces.size() != 3 * N)
+  if (s.size() != N || forces.size() != 3 * N || s.charge.size() != N || s.ix.size() != N)
     throw std::invalid_argument("checkpoint has " + std::to_string(s.size()) + " particles, the run " + std::to_string(N));
-  toDevice(s.x, d.p.x);
-  toDevice(s.y, d.p.y);
-  toDevice(s.z, d.p.z);
-  toDevice(s.vx, d.p.vx);
-  toDevice(s.vy, d.p.vy);
-  toDevice(s.vz, d.p.vz);
-  toDevice(s.charge, d.p.q);
-  toDevice(s.ix, d.p.ix);
-  toDevice(s.iy, d.p.iy);
-  toDevice(s.iz, d.p.iz);
+  d.upload(s);
   d.p.fx.assign(forces.begin(), forces.begin() + N);
   d.p.fy.assign(forces.begin() + N, forces.begin() + 2 * N);
   d.p.fz.assign(forces.begin() + 2 * N, forces.end());
   d.step = s.step;
   d.time = s.step * d.dt;
   d.collisions = collisions;
-  // Previous positions are overwritten by the next drift before they are used (collision test of
-  // the next step compares with the positions of this step), so x is the exact value to restore.
-  d.p.xp = d.p.x;
-  d.p.yp = d.p.y;
-  d.p.zp = d.p.z;
   d.nl.build(d.p, d.box);
 }
 

@@ -2,6 +2,8 @@
 // refusal to overwrite. Runs the real binary (GRANAGG_BINARY, set by CMake).
 #include <catch2/catch.hpp>
 
+#include "RunCommand.h"
+
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -11,23 +13,6 @@
 #include <unistd.h>
 
 namespace {
-struct Run {
-  int status;
-  std::string output;  // stdout and stderr together
-};
-
-Run granagg(const std::string& args) {
-  const std::string cmd = std::string(GRANAGG_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  std::string out;
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
-
 std::string tempPath(const std::string& name) {
   return "/tmp/granagg_cli_" + std::to_string(::getpid()) + "_" + name;
 }
@@ -40,12 +25,12 @@ int countLines(const std::string& s) {
 }  // namespace
 
 TEST_CASE("version and help work on every level", "[cli]") {
-  const Run v = granagg("--version");
+  const Run v = runGranagg("--version");
   CHECK(v.status == 0);
   CHECK_THAT(v.output, Catch::StartsWith("granagg 0."));
   for (const char* cmd : {"--help", "smol --help", "smol zbeta --help", "kinetic --help"}) {
     INFO(cmd);
-    const Run h = granagg(cmd);
+    const Run h = runGranagg(cmd);
     CHECK(h.status == 0);
     CHECK_THAT(h.output, Catch::Contains("Usage") || Catch::Contains("usage"));
   }
@@ -64,7 +49,7 @@ TEST_CASE("bad input gives one line naming the option and exit status 2", "[cli]
                         Case{"smol zbeta --count 0", "--count"}, Case{"smol zbeta --beta-min -2", "--beta-min"},
                         Case{"smol --no-such-option", "no-such-option"}, Case{"frobnicate", "frobnicate"}}) {
     INFO(c.args);
-    const Run r = granagg(c.args);
+    const Run r = runGranagg(c.args);
     CHECK(r.status == 2);
     CHECK_THAT(r.output, Catch::Contains(c.says));
     CHECK(countLines(r.output) == 1);
@@ -74,7 +59,7 @@ TEST_CASE("bad input gives one line naming the option and exit status 2", "[cli]
 TEST_CASE("smol writes a table with provenance and refuses to overwrite it", "[cli]") {
   const std::string out = tempPath("mono.csv");
   std::remove(out.c_str());
-  const Run r = granagg("smol --beta 3 --method mono --t-end 100 --out " + out);
+  const Run r = runGranagg("smol --beta 3 --method mono --t-end 100 --out " + out);
   REQUIRE(r.status == 0);
   CHECK_THAT(r.output, Catch::Contains("scaling prediction z = 1/(1 - lambda) = 1.5"));
   std::ifstream f(out);
@@ -86,9 +71,9 @@ TEST_CASE("smol writes a table with provenance and refuses to overwrite it", "[c
   CHECK_THAT(text, Catch::Contains("# beta = 3"));
   CHECK_THAT(text, Catch::Contains("\nt,S,M0,M1,M2,z_local,mass_loss,valid,max_size\n"));
 
-  const Run again = granagg("smol --beta 3 --method mono --t-end 100 --out " + out);
+  const Run again = runGranagg("smol --beta 3 --method mono --t-end 100 --out " + out);
   CHECK(again.status == 2);
   CHECK_THAT(again.output, Catch::Contains("already exists"));
-  CHECK(granagg("smol --beta 3 --method mono --t-end 100 --force --out " + out).status == 0);
+  CHECK(runGranagg("smol --beta 3 --method mono --t-end 100 --force --out " + out).status == 0);
   std::remove(out.c_str());
 }

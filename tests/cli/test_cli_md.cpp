@@ -1,6 +1,8 @@
 // `granagg md`: bad configurations, output folders, trajectory layout, restart bit for bit.
 #include <catch2/catch.hpp>
 
+#include "RunCommand.h"
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -14,22 +16,6 @@
 namespace fs = std::filesystem;
 
 namespace {
-struct Run {
-  int status;
-  std::string output;
-};
-Run sh(const std::string& cmd) {
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  REQUIRE(p != nullptr);
-  std::string out;
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
-Run runGranagg(const std::string& args) { return sh(std::string(GRANAGG_BINARY) + " " + args); }
-
 fs::path tempDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("granagg_md_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(d);

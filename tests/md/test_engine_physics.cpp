@@ -153,7 +153,7 @@ TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart"
   CHECK_FALSE(other.frame().x == one.frame().x);
 }
 
-TEST_CASE("initial state: T = 1 exactly, zero momentum, no overlaps; overlapping input refused", "[md][init]") {
+TEST_CASE("random initial state has T = 1 exactly and zero momentum and no overlaps and overlapping input is refused", "[md][init]") {
   MdConfig c = gasConfig(3000, 27.7, 1);
   const Frame f = Engine::randomInitialState(c);
   double p[3] = {0, 0, 0}, s2 = 0;
