@@ -8,7 +8,16 @@ bash scripts/setup.sh
 BUILD_DIR=${GRANAGG_BUILD_DIR:-build}
 JOBS=${GRANAGG_JOBS:-$(nproc)}
 
-ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
+LOG=$(mktemp)
+trap 'rm -f "$LOG"' EXIT
+set +e
+ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" | tee "$LOG"
+CTEST_RC=${PIPESTATUS[0]}
+set -e
+# "N tests passed, M failed out of T" -> the plain summary printed last (after the CUDA build)
+TOTAL=$(sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' "$LOG" | tail -n 1)
+FAILED=$(sed -n 's/.*tests passed, \([0-9]*\) tests failed out of.*/\1/p' "$LOG" | tail -n 1)
+[ -n "$TOTAL" ] || { echo "scripts/test.sh: ctest printed no summary" >&2; exit 1; }
 
 NVCC=${NVCC:-$(command -v nvcc || echo /usr/local/cuda/bin/nvcc)}
 if [ -x "$NVCC" ]; then
@@ -24,3 +33,6 @@ if [ -x "$NVCC" ]; then
 else
   echo "== nvcc not found: CUDA build skipped"
 fi
+
+echo "tests: $((TOTAL - FAILED)) passed, $FAILED failed"
+exit "$CTEST_RC"
