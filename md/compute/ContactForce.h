@@ -26,6 +26,7 @@ struct ContactWork {
   DVec<int> contacts;             ///< partners in contact with i
   DVec<int> new_contacts_upper;   ///< partners j > i whose contact started this step (collisions)
   DVec<int> bad;                  ///< 1: non-finite force, 2: overlap beyond the bound
+  DVec<double> vpx, vpy, vpz;     ///< predicted velocities v + (dt/2) f, once per particle per step
   void resize(std::size_t n);
 };
 

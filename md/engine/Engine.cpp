@@ -10,6 +10,9 @@
 #include <thrust/copy.h>
 #include <thrust/execution_policy.h>
 #include <thrust/functional.h>
+#include <thrust/gather.h>
+#include <thrust/scatter.h>
+#include <thrust/sequence.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/reduce.h>
 #include <thrust/transform_reduce.h>
@@ -44,6 +47,20 @@ std::vector<T> toHost(const DVec<T>& d) {
 template <class T>
 void toDevice(const std::vector<T>& h, DVec<T>& d) {
   d.assign(h.begin(), h.end());
+}
+/// Host copy in particle-id order: out[id[slot]] = d[slot].
+template <class T>
+std::vector<T> toHostById(const DVec<T>& d, const DVec<int>& id) {
+  DVec<T> tmp(d.size());
+  thrust::scatter(d.begin(), d.end(), id.begin(), tmp.begin());
+  return toHost(tmp);
+}
+/// d = d[order] (storage permutation).
+template <class T>
+void permute(DVec<T>& d, const DVec<int>& order, DVec<T>& scratch) {
+  scratch.resize(d.size());
+  thrust::gather(order.begin(), order.end(), d.begin(), scratch.begin());
+  d.swap(scratch);
 }
 
 struct Square {
@@ -83,15 +100,35 @@ struct Engine::Impl {
     toDevice(f.ix, p.ix);
     toDevice(f.iy, p.iy);
     toDevice(f.iz, p.iz);
+    p.id.resize(f.size());
+    thrust::sequence(p.id.begin(), p.id.end());
     // previous positions are overwritten by the next drift before the collision test reads them
     p.xp = p.x;
     p.yp = p.y;
     p.zp = p.z;
   }
 
+  /// Stores particles in the cell order of the neighbour list just built (memory locality for
+  /// the gathers), then rebuilds the list for the new slots. Rows are sorted by particle id, so
+  /// forces, and hence trajectories, do not depend on the storage order.
+  void sortByCell() {
+    const DVec<int>& order = nl.cellOrder();
+    if (order.size() != p.size()) return;  // all-pairs build: nothing to sort
+    const DVec<int> ord = order;             // the rebuild below overwrites the list's copy
+    DVec<double> sd;
+    DVec<int> si;
+    for (auto* v : {&p.x, &p.y, &p.z, &p.xp, &p.yp, &p.zp, &p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz, &p.q})
+      permute(*v, ord, sd);
+    for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, ord, si);
+    nl.build(p, box);
+  }
+
   /// Forces of the current positions into p.f; counts collisions; aborts on NaN / deep overlap.
   void computeForces() {
-    nl.update(p, box);
+    // re-sort storage every SORT_EVERY list builds (the order decays as particles move)
+    constexpr std::int64_t SORT_EVERY = 10;
+    if (nl.update(p, box) && nl.builds() % SORT_EVERY == 2) sortByCell();  // builds 2, 12, 22, ...
+
     const double h = 0.5 * dt;
     if (hertz)
       computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, h, cfg.run.max_overlap, work);
@@ -106,8 +143,8 @@ struct Engine::Impl {
   }
 
   [[noreturn]] void abort(int worst) {
-    const auto bad = toHost(work.bad);
-    const auto mx = toHost(work.max_overlap);
+    const auto bad = toHostById(work.bad, p.id);
+    const auto mx = toHostById(work.max_overlap, p.id);
     std::ostringstream msg;
     msg << "step " << step << " (t = " << time << "): ";
     msg << (worst == 1 ? "non-finite force or position (NaN/inf)" : "overlap beyond run.max_overlap = ");
@@ -222,27 +259,28 @@ void Engine::run(std::int64_t steps) {
 
 Frame Engine::frame() const {
   const Impl& d = *m_impl;
+  const DVec<int>& id = d.p.id;
   Frame f;
   f.step = d.step;
   f.time = d.time;
   f.box = d.box.L;
-  f.x = toHost(d.p.x);
-  f.y = toHost(d.p.y);
-  f.z = toHost(d.p.z);
-  f.vx = toHost(d.p.vx);
-  f.vy = toHost(d.p.vy);
-  f.vz = toHost(d.p.vz);
-  f.charge = toHost(d.p.q);
-  f.ix = toHost(d.p.ix);
-  f.iy = toHost(d.p.iy);
-  f.iz = toHost(d.p.iz);
+  f.x = toHostById(d.p.x, id);
+  f.y = toHostById(d.p.y, id);
+  f.z = toHostById(d.p.z, id);
+  f.vx = toHostById(d.p.vx, id);
+  f.vy = toHostById(d.p.vy, id);
+  f.vz = toHostById(d.p.vz, id);
+  f.charge = toHostById(d.p.q, id);
+  f.ix = toHostById(d.p.ix, id);
+  f.iy = toHostById(d.p.iy, id);
+  f.iz = toHostById(d.p.iz, id);
   return f;
 }
 
 std::vector<double> Engine::forces() const {
   const Impl& d = *m_impl;
-  std::vector<double> out = toHost(d.p.fx);
-  const auto fy = toHost(d.p.fy), fz = toHost(d.p.fz);
+  std::vector<double> out = toHostById(d.p.fx, d.p.id);
+  const auto fy = toHostById(d.p.fy, d.p.id), fz = toHostById(d.p.fz, d.p.id);
   out.insert(out.end(), fy.begin(), fy.end());
   out.insert(out.end(), fz.begin(), fz.end());
   return out;
@@ -253,7 +291,7 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
   const std::size_t N = d.p.size();
   if (s.size() != N || forces.size() != 3 * N || s.charge.size() != N || s.ix.size() != N)
     throw std::invalid_argument("checkpoint has " + std::to_string(s.size()) + " particles, the run " + std::to_string(N));
-  d.upload(s);
+  d.upload(s);  // storage in id order again
   d.p.fx.assign(forces.begin(), forces.begin() + N);
   d.p.fy.assign(forces.begin() + N, forces.begin() + 2 * N);
   d.p.fz.assign(forces.begin() + 2 * N, forces.end());

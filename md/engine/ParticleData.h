@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include <thrust/device_vector.h>
+#include <thrust/sequence.h>
 
 namespace granagg::md {
 
@@ -27,9 +28,14 @@ struct ParticleData {
   DVec<double> fx, fy, fz;     ///< forces of the current positions
   DVec<double> q;              ///< charges
   DVec<int> ix, iy, iz;        ///< image counts
+  /// Particle id (index in the user's order) of each slot: the engine stores particles sorted by
+  /// cell for memory locality and maps back to ids for output.
+  DVec<int> id;
   void resize(std::size_t n) {
     for (auto* v : {&x, &y, &z, &xp, &yp, &zp, &vx, &vy, &vz, &fx, &fy, &fz, &q}) v->assign(n, 0.0);
     for (auto* v : {&ix, &iy, &iz}) v->assign(n, 0);
+    id.resize(n);
+    thrust::sequence(id.begin(), id.end());
   }
   std::size_t size() const { return x.size(); }
 };

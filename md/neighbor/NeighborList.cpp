@@ -33,11 +33,13 @@ struct CellIndex {
   }
 };
 
-/// Inserts j into the sorted row (insertion sort; rows are short) if there is room; counts always.
-HD inline void insertSorted(int* row, int& n, int cap, int j) {
+/// Inserts slot j into the row kept sorted by particle id (insertion sort; rows are short) if there
+/// is room; counts always.
+HD inline void insertSorted(int* row, int& n, int cap, int j, const int* id) {
   if (n < cap) {
     int k = n;
-    while (k > 0 && row[k - 1] > j) {
+    const int key = id[j];
+    while (k > 0 && id[row[k - 1]] > key) {
       row[k] = row[k - 1];
       --k;
     }
@@ -48,7 +50,7 @@ HD inline void insertSorted(int* row, int& n, int cap, int j) {
 
 struct BuildCells {
   const double *x, *y, *z;
-  const int *order, *cell_start, *cell_end;
+  const int *order, *cell_start, *cell_end, *id;
   int *list, *count;
   common::Box box;
   double inv_cell, r2;
@@ -70,7 +72,7 @@ struct BuildCells {
             if (j == i) continue;
             const double rx = box.minimumImage(xi - x[j]), ry = box.minimumImage(yi - y[j]),
                          rz = box.minimumImage(zi - z[j]);
-            if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j);
+            if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
           }
         }
     count[i] = n;
@@ -79,6 +81,7 @@ struct BuildCells {
 
 struct BuildAllPairs {
   const double *x, *y, *z;
+  const int* id;
   int *list, *count;
   common::Box box;
   double r2;
@@ -90,7 +93,7 @@ struct BuildAllPairs {
       if (j == i) continue;
       const double rx = box.minimumImage(x[i] - x[j]), ry = box.minimumImage(y[i] - y[j]),
                    rz = box.minimumImage(z[i] - z[j]);
-      if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j);  // j increasing: stays sorted
+      if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
     }
     count[i] = n;
   }
@@ -154,10 +157,11 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
                           thrust::counting_iterator<int>(ncell), m_cell_end.begin());
       thrust::for_each(first, last,
                        BuildCells{raw(p.x), raw(p.y), raw(p.z), raw(m_order), raw(m_cell_start), raw(m_cell_end),
-                                  raw(m_list), raw(m_count), box, inv_cell, range * range, nc, m_capacity});
+                                  raw(p.id), raw(m_list), raw(m_count), box, inv_cell, range * range, nc, m_capacity});
     } else {
+      m_order.clear();
       thrust::for_each(first, last,
-                       BuildAllPairs{raw(p.x), raw(p.y), raw(p.z), raw(m_list), raw(m_count), box, range * range, N,
+                       BuildAllPairs{raw(p.x), raw(p.y), raw(p.z), raw(p.id), raw(m_list), raw(m_count), box, range * range, N,
                                      m_capacity});
     }
     const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;

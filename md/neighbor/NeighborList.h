@@ -2,8 +2,9 @@
 /// \file NeighborList.h
 /// Cell list + Verlet neighbour list with a skin (device source; Thrust).
 ///
-/// Full lists (every pair appears in the rows of both partners), each row sorted by particle index
-/// so that per-particle force sums run in a fixed order (Engine.h, determinism). Rows have a fixed
+/// Full lists (every pair appears in the rows of both partners), each row sorted by particle id
+/// (ParticleData::id, not the storage slot) so that per-particle force sums run in a fixed order
+/// whatever the storage order (Engine.h, determinism). Rows have a fixed
 /// capacity; a row that would overflow is detected after the build, the capacity grows and the list
 /// is rebuilt -- never truncated (STYLE.md). The list is rebuilt when some particle has moved more
 /// than skin/2 since the last build (then no pair can have come within the contact distance 1
@@ -29,6 +30,8 @@ class NeighborList {
   const int* rows() const { return raw(m_list); }     ///< row i at rows()[i * capacity()]
   const int* counts() const { return raw(m_count); }  ///< entries in row i
   int capacity() const { return m_capacity; }
+  /// Slots sorted by cell at the last build (empty for all-pairs builds): a locality order.
+  const DVec<int>& cellOrder() const { return m_order; }
   std::int64_t builds() const { return m_builds; }
   double listRange() const { return m_cutoff + m_skin; }
 
