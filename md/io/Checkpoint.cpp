@@ -245,14 +245,7 @@ Checkpoint readCheckpoint(const std::string& path) {
       if (h5::objectType(gs.get(), sub) != H5I_GROUP)
         throw std::runtime_error(c + " is missing group '/scalars/" + std::string(sub) + "'");
       h5::Handle g = h5::check(H5Gopen2(gs.get(), sub, H5P_DEFAULT), c);
-      std::vector<std::string> names;
-      auto cb = [](hid_t, const char* name, const H5A_info_t*, void* data) -> herr_t {
-        static_cast<std::vector<std::string>*>(data)->emplace_back(name);
-        return 0;
-      };
-      hsize_t idx = 0;
-      if (H5Aiterate2(g.get(), H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0)
-        h5::fail(c + ": cannot list /scalars/" + sub);
+      const std::vector<std::string> names = h5::attributeNames(g.get(), c + ": /scalars/" + sub);
       const std::string gname = std::string("/scalars/") + sub;
       for (const auto& name : names) {
         if (integer) {

@@ -335,14 +335,7 @@ std::vector<std::pair<std::string, std::string>> H5mdReader::parameters() const 
   std::vector<std::pair<std::string, std::string>> out;
   if (h5::objectType(m.file.get(), "/parameters") != H5I_GROUP) return out;
   h5::Handle g = h5::check(H5Gopen2(m.file.get(), "/parameters", H5P_DEFAULT), m.ctx() + ": /parameters");
-  std::vector<std::string> names;
-  auto cb = [](hid_t, const char* name, const H5A_info_t*, void* data) -> herr_t {
-    static_cast<std::vector<std::string>*>(data)->emplace_back(name);
-    return 0;
-  };
-  hsize_t idx = 0;
-  if (H5Aiterate2(g.get(), H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0)
-    h5::fail(m.ctx() + ": cannot list the attributes of /parameters");
+  const std::vector<std::string> names = h5::attributeNames(g.get(), m.ctx() + ": /parameters");
   for (const auto& name : names) {
     const std::string c = m.ctx() + ": /parameters attribute '" + name + "'";
     h5::Handle a = h5::check(H5Aopen(g.get(), name.c_str(), H5P_DEFAULT), c);

@@ -367,6 +367,30 @@ inline Handle createExtendible(hid_t loc, const std::string& name, hid_t file_ty
                ctx + ": cannot create dataset '" + name + "'");
 }
 
+/// File and memory dataspaces selecting rows [row, row + count) of a dataset whose current
+/// dimensions are `dims` (first dimension = time index); shared by writeRows and readRows.
+inline void selectRows(hid_t dset, const std::vector<hsize_t>& dims, hsize_t row, hsize_t count, Handle& fspace,
+                       Handle& mspace, const std::string& ctx) {
+  fspace = check(H5Dget_space(dset), ctx);
+  std::vector<hsize_t> start(dims.size(), 0), cnt = dims;
+  start[0] = row;
+  cnt[0] = count;
+  checkStatus(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr), ctx);
+  mspace = Handle(H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr));
+}
+
+/// Names of all attributes of an object, in name order.
+inline std::vector<std::string> attributeNames(hid_t obj, const std::string& ctx) {
+  std::vector<std::string> names;
+  auto cb = [](hid_t, const char* name, const H5A_info_t*, void* data) -> herr_t {
+    static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+    return 0;
+  };
+  hsize_t idx = 0;
+  if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0) fail(ctx + ": cannot list the attributes");
+  return names;
+}
+
 /// Writes rows [row, row + count) of a dataset whose first dimension is the time index, growing
 /// it to at least row + count rows first. `data` holds count * (product of inner dims) values of
 /// `mem_type`.
@@ -378,12 +402,8 @@ inline void writeRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, co
     dims[0] = row + count;
     checkStatus(H5Dset_extent(dset, dims.data()), ctx + ": cannot extend");
   }
-  Handle fspace = check(H5Dget_space(dset), ctx);
-  std::vector<hsize_t> start(dims.size(), 0), cnt = dims;
-  start[0] = row;
-  cnt[0] = count;
-  checkStatus(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr), ctx);
-  Handle mspace(H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr));
+  Handle fspace, mspace;
+  selectRows(dset, dims, row, count, fspace, mspace, ctx);
   checkStatus(H5Dwrite(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data), ctx + ": cannot write");
 }
 
@@ -395,12 +415,8 @@ inline void readRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, voi
   if (dims.empty() || dims[0] < row + count)
     throw std::runtime_error(ctx + ": rows " + std::to_string(row) + ".." + std::to_string(row + count) +
                              " requested, dataset has " + std::to_string(dims.empty() ? 0 : dims[0]));
-  Handle fspace = check(H5Dget_space(dset), ctx);
-  std::vector<hsize_t> start(dims.size(), 0), cnt = dims;
-  start[0] = row;
-  cnt[0] = count;
-  checkStatus(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr), ctx);
-  Handle mspace(H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr));
+  Handle fspace, mspace;
+  selectRows(dset, dims, row, count, fspace, mspace, ctx);
   checkStatus(H5Dread(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, out), ctx + ": cannot read");
 }
 
