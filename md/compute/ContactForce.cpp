@@ -4,6 +4,8 @@
 
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform.h>
+#include <thrust/transform_reduce.h>
 
 #include "md/potentials/HertzViscoelastic.h"
 #include "md/potentials/SpringDashpot.h"
@@ -11,77 +13,63 @@
 namespace granagg::md {
 
 void ContactWork::resize(std::size_t n) {
-  for (auto* v : {&fx, &fy, &fz, &energy, &overlap_upper, &max_overlap, &vpx, &vpy, &vpz}) v->assign(n, 0.0);
-  for (auto* v : {&contacts, &new_contacts_upper, &bad}) v->assign(n, 0);
+  for (auto* v : {&vpx, &vpy, &vpz}) v->resize(n);
+  for (auto* v : {&new_contacts_upper, &bad}) v->assign(n, 0);
 }
 
 namespace {
 
-/// Predicted full-step velocity of every particle, computed once per step (a neighbour's is then
-/// one load per component instead of two loads and a multiply-add per pair; same values).
-struct PredictVelocity {
-  const double *vx, *vy, *vz, *fx, *fy, *fz;
-  double *px, *py, *pz;
-  double half_dt;
-  HD void operator()(int i) const {
-    px[i] = vx[i] + half_dt * fx[i];
-    py[i] = vy[i] + half_dt * fy[i];
-    pz[i] = vz[i] + half_dt * fz[i];
-  }
-};
-
 template <class Potential>
 struct ContactForceFunctor {
-  const double *x, *y, *z, *xp, *yp, *zp, *vx, *vy, *vz;  // vx..: predicted velocities
+  const double *x, *y, *z, *xp, *yp, *zp, *vpx, *vpy, *vpz;  // vp*: predicted velocities
   const int *rows, *counts;
   int cap;
   common::Box box;
   typename Potential::Params params;
-  double max_overlap;
-  double *ofx, *ofy, *ofz, *energy, *overlap_upper, *omax;
-  int *contacts, *new_upper, *bad;
+  double max_overlap, close_h;
+  double *fx, *fy, *fz, *vx, *vy, *vz;
+  int *new_upper, *bad;
 
   HD void operator()(int i) const {
     const double xi_ = x[i], yi_ = y[i], zi_ = z[i];
-    // predicted full-step velocity of i (see header)
-    const double vix = vx[i], viy = vy[i], viz = vz[i];
-    double f0 = 0.0, f1 = 0.0, f2 = 0.0, e = 0.0, ov = 0.0, mx = 0.0;
-    int nc = 0, nnew = 0;
+    const double vix = vpx[i], viy = vpy[i], viz = vpz[i];
+    double f0 = 0.0, f1 = 0.0, f2 = 0.0, mx = 0.0;
+    int nnew = 0;
     const int* row = rows + static_cast<long>(i) * cap;
     const int n = counts[i];
     for (int k = 0; k < n; ++k) {
       const int j = row[k];
-      const double rx = box.minimumImage(xi_ - x[j]), ry = box.minimumImage(yi_ - y[j]), rz = box.minimumImage(zi_ - z[j]);
+      // positions are wrapped into [0, L): one conditional shift is the minimum image
+      const double rx = box.minimumImageWrapped(xi_ - x[j]), ry = box.minimumImageWrapped(yi_ - y[j]),
+                   rz = box.minimumImageWrapped(zi_ - z[j]);
       const double r2 = rx * rx + ry * ry + rz * rz;
       if (r2 >= 1.0) continue;
       const double r = sqrt(r2);
       const double inv_r = 1.0 / r;
       const double nx = rx * inv_r, ny = ry * inv_r, nz = rz * inv_r;  // unit vector from j to i
       const double xi = 1.0 - r;                                        // overlap
-      const double gx = vix - vx[j], gy = viy - vy[j], gz = viz - vz[j];
+      const double gx = vix - vpx[j], gy = viy - vpy[j], gz = viz - vpz[j];
       const double xi_dot = -(gx * nx + gy * ny + gz * nz);  // > 0 while approaching
       const double F = Potential::normalForce(xi, xi_dot, params);
       f0 += F * nx;
       f1 += F * ny;
       f2 += F * nz;
-      e += 0.5 * Potential::elasticEnergy(xi, params);
-      ++nc;
       mx = xi > mx ? xi : mx;
       if (j > i) {
-        ov += xi;
         // a collision is the first step at which the pair overlaps after not overlapping
-        const double px = box.minimumImage(xp[i] - xp[j]), py = box.minimumImage(yp[i] - yp[j]),
-                     pz = box.minimumImage(zp[i] - zp[j]);
+        const double px = box.minimumImageWrapped(xp[i] - xp[j]), py = box.minimumImageWrapped(yp[i] - yp[j]),
+                     pz = box.minimumImageWrapped(zp[i] - zp[j]);
         if (px * px + py * py + pz * pz >= 1.0) ++nnew;
       }
     }
-    ofx[i] = f0;
-    ofy[i] = f1;
-    ofz[i] = f2;
-    energy[i] = e;
-    overlap_upper[i] = ov;
-    omax[i] = mx;
-    contacts[i] = nc;
+    fx[i] = f0;
+    fy[i] = f1;
+    fz[i] = f2;
+    if (close_h != 0.0) {  // closing kick of velocity Verlet: v(t+dt) = v(t+dt/2) + (dt/2) f(t+dt)
+      vx[i] += close_h * f0;
+      vy[i] += close_h * f1;
+      vz[i] += close_h * f2;
+    }
     new_upper[i] = nnew;
     // v - v == 0 exactly for finite v and is NaN for NaN or inf: a finiteness test that needs no
     // math library in device code
@@ -91,29 +79,115 @@ struct ContactForceFunctor {
   }
 };
 
+struct StepFlags {
+  const int *new_upper, *bad;
+  HD ContactStepResult operator()(int i) const {
+    ContactStepResult r;
+    r.collisions = new_upper[i];
+    r.worst = bad[i];
+    return r;
+  }
+};
+struct CombineStepFlags {
+  HD ContactStepResult operator()(const ContactStepResult& a, const ContactStepResult& b) const {
+    ContactStepResult r;
+    r.collisions = a.collisions + b.collisions;
+    r.worst = a.worst > b.worst ? a.worst : b.worst;
+    return r;
+  }
+};
+
+/// Contact statistics of particle i (the same pair test as the force pass).
+template <class Potential>
+struct SummaryFunctor {
+  const double *x, *y, *z;
+  const int *rows, *counts;
+  int cap;
+  common::Box box;
+  typename Potential::Params params;
+  HD ContactSummary operator()(int i) const {
+    ContactSummary s;
+    const int* row = rows + static_cast<long>(i) * cap;
+    for (int k = 0; k < counts[i]; ++k) {
+      const int j = row[k];
+      const double rx = box.minimumImageWrapped(x[i] - x[j]), ry = box.minimumImageWrapped(y[i] - y[j]),
+                   rz = box.minimumImageWrapped(z[i] - z[j]);
+      const double r2 = rx * rx + ry * ry + rz * rz;
+      if (r2 >= 1.0) continue;
+      const double xi = 1.0 - sqrt(r2);
+      s.elastic_energy += 0.5 * Potential::elasticEnergy(xi, params);  // half per partner
+      ++s.contacts;
+      if (j > i) s.overlap_sum += xi;
+      s.max_overlap = xi > s.max_overlap ? xi : s.max_overlap;
+    }
+    return s;
+  }
+};
+struct CombineSummary {
+  HD ContactSummary operator()(const ContactSummary& a, const ContactSummary& b) const {
+    ContactSummary r;
+    r.elastic_energy = a.elastic_energy + b.elastic_energy;
+    r.overlap_sum = a.overlap_sum + b.overlap_sum;
+    r.max_overlap = a.max_overlap > b.max_overlap ? a.max_overlap : b.max_overlap;
+    r.contacts = a.contacts + b.contacts;
+    return r;
+  }
+};
+template <class Potential>
+struct MaxOverlapOf {
+  SummaryFunctor<Potential> s;
+  HD double operator()(int i) const { return s(i).max_overlap; }
+};
+
 }  // namespace
 
 template <class Potential>
-void computeContactForces(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                          const typename Potential::Params& params, double half_dt, double max_overlap,
-                          ContactWork& w) {
+ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
+                                       const typename Potential::Params& params, double max_overlap,
+                                       double close_half_dt, ContactWork& w) {
   const int N = static_cast<int>(p.size());
-  if (w.fx.size() != p.size()) w.resize(p.size());
-  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
-                   PredictVelocity{raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(w.vpx),
-                                   raw(w.vpy), raw(w.vpz), half_dt});
+  if (w.bad.size() != p.size()) w.resize(p.size());
+  const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
   ContactForceFunctor<Potential> f{raw(p.x), raw(p.y), raw(p.z), raw(p.xp), raw(p.yp), raw(p.zp),
                                    raw(w.vpx), raw(w.vpy), raw(w.vpz),
-                                   nl.rows(), nl.counts(), nl.capacity(), box, params, max_overlap,
-                                   raw(w.fx), raw(w.fy), raw(w.fz), raw(w.energy), raw(w.overlap_upper),
-                                   raw(w.max_overlap), raw(w.contacts), raw(w.new_contacts_upper), raw(w.bad)};
-  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), f);
+                                   nl.rows(), nl.counts(), nl.capacity(), box, params, max_overlap, close_half_dt,
+                                   raw(p.fx), raw(p.fy), raw(p.fz), raw(p.vx), raw(p.vy), raw(p.vz),
+                                   raw(w.new_contacts_upper), raw(w.bad)};
+  thrust::for_each(first, last, f);
+  // one reduction for both: collisions (sum) and the worst flag (max)
+  return thrust::transform_reduce(first, last, StepFlags{raw(w.new_contacts_upper), raw(w.bad)}, ContactStepResult{},
+                                  CombineStepFlags{});
 }
 
-// the contact models: adding one = one header + one line here
-template void computeContactForces<HertzViscoelastic>(const ParticleData&, const NeighborList&, const common::Box&,
-                                                      const HertzViscoelastic::Params&, double, double, ContactWork&);
-template void computeContactForces<SpringDashpot>(const ParticleData&, const NeighborList&, const common::Box&,
-                                                  const SpringDashpot::Params&, double, double, ContactWork&);
+template <class Potential>
+ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                              const typename Potential::Params& params) {
+  const int N = static_cast<int>(p.size());
+  SummaryFunctor<Potential> s{raw(p.x), raw(p.y), raw(p.z), nl.rows(), nl.counts(), nl.capacity(), box, params};
+  return thrust::transform_reduce(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), s, ContactSummary{},
+                                  CombineSummary{});
+}
+
+template <class Potential>
+void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                           const typename Potential::Params& params, DVec<double>& out) {
+  const int N = static_cast<int>(p.size());
+  out.resize(p.size());
+  SummaryFunctor<Potential> s{raw(p.x), raw(p.y), raw(p.z), nl.rows(), nl.counts(), nl.capacity(), box, params};
+  thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), out.begin(),
+                    MaxOverlapOf<Potential>{s});
+}
+
+// the contact models: adding one = one header + one line per function here
+#define GRANAGG_CONTACT_MODEL(P)                                                                                  \
+  template ContactStepResult computeContactForces<P>(ParticleData&, const NeighborList&, const common::Box&,      \
+                                                     const P::Params&, double, double, ContactWork&);            \
+  template ContactSummary contactSummary<P>(const ParticleData&, const NeighborList&, const common::Box&,          \
+                                            const P::Params&);                                                    \
+  template void maxOverlapPerParticle<P>(const ParticleData&, const NeighborList&, const common::Box&,             \
+                                         const P::Params&, DVec<double>&);
+GRANAGG_CONTACT_MODEL(HertzViscoelastic)
+GRANAGG_CONTACT_MODEL(SpringDashpot)
+#undef GRANAGG_CONTACT_MODEL
 
 }  // namespace granagg::md

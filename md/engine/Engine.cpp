@@ -9,6 +9,7 @@
 
 #include <thrust/copy.h>
 #include <thrust/execution_policy.h>
+#include <thrust/fill.h>
 #include <thrust/functional.h>
 #include <thrust/gather.h>
 #include <thrust/scatter.h>
@@ -117,34 +118,48 @@ struct Engine::Impl {
     const DVec<int> ord = order;             // the rebuild below overwrites the list's copy
     DVec<double> sd;
     DVec<int> si;
-    for (auto* v : {&p.x, &p.y, &p.z, &p.xp, &p.yp, &p.zp, &p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz, &p.q})
+    for (auto* v : {&p.x, &p.y, &p.z, &p.xp, &p.yp, &p.zp, &p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz, &p.q,
+                    &work.vpx, &work.vpy, &work.vpz})
       permute(*v, ord, sd);
     for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, ord, si);
     nl.build(p, box);
   }
 
-  /// Forces of the current positions into p.f; counts collisions; aborts on NaN / deep overlap.
-  void computeForces() {
+  /// Forces of the current positions into p.f, then the closing kick v += close_half_dt f; counts
+  /// collisions; aborts on NaN / deep overlap. work.vp* must hold the predicted velocities.
+  void computeForces(double close_half_dt) {
     // re-sort storage every SORT_EVERY list builds (the order decays as particles move)
     constexpr std::int64_t SORT_EVERY = 10;
     if (nl.update(p, box) && nl.builds() % SORT_EVERY == 2) sortByCell();  // builds 2, 12, 22, ...
 
-    const double h = 0.5 * dt;
-    if (hertz)
-      computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, h, cfg.run.max_overlap, work);
-    else
-      computeContactForces<SpringDashpot>(p, nl, box, sd_params, h, cfg.run.max_overlap, work);
-    const int worst = thrust::reduce(work.bad.begin(), work.bad.end(), 0, thrust::maximum<int>());
-    if (worst != 0) abort(worst);
-    p.fx.swap(work.fx);
-    p.fy.swap(work.fy);
-    p.fz.swap(work.fz);
-    collisions += thrust::reduce(work.new_contacts_upper.begin(), work.new_contacts_upper.end(), std::int64_t(0));
+    const ContactStepResult r =
+        hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, cfg.run.max_overlap, close_half_dt, work)
+              : computeContactForces<SpringDashpot>(p, nl, box, sd_params, cfg.run.max_overlap, close_half_dt, work);
+    if (r.worst != 0) abort(r.worst);
+    collisions += r.collisions;
+  }
+
+  /// Forces of a state given at full step (initial state): predicted velocities are v itself
+  /// (f = 0 until the first evaluation) and v is left alone.
+  void computeInitialForces() {
+    for (auto* f : {&p.fx, &p.fy, &p.fz}) thrust::fill(f->begin(), f->end(), 0.0);
+    predictVelocities(p, 0.0, work.vpx, work.vpy, work.vpz);
+    computeForces(0.0);
+  }
+
+  ContactSummary summary() const {
+    return hertz ? contactSummary<HertzViscoelastic>(p, nl, box, hertz_params)
+                 : contactSummary<SpringDashpot>(p, nl, box, sd_params);
   }
 
   [[noreturn]] void abort(int worst) {
     const auto bad = toHostById(work.bad, p.id);
-    const auto mx = toHostById(work.max_overlap, p.id);
+    DVec<double> mx_slots;
+    if (hertz)
+      maxOverlapPerParticle<HertzViscoelastic>(p, nl, box, hertz_params, mx_slots);
+    else
+      maxOverlapPerParticle<SpringDashpot>(p, nl, box, sd_params, mx_slots);
+    const auto mx = toHostById(mx_slots, p.id);
     std::ostringstream msg;
     msg << "step " << step << " (t = " << time << "): ";
     msg << (worst == 1 ? "non-finite force or position (NaN/inf)" : "overlap beyond run.max_overlap = ");
@@ -161,14 +176,14 @@ struct Engine::Impl {
     throw RunAborted(msg.str());
   }
 
+  /// One velocity-Verlet step in two passes (VelocityVerlet.h): kick + drift (+ predicted
+  /// velocities), then forces + closing kick.
   void doStep() {
     const double h = 0.5 * dt;
-    kick(p, h);
-    drift(p, dt, box);
+    kickDrift(p, h, dt, box, work.vpx, work.vpy, work.vpz);
     ++step;
     time = step * dt;  // no accumulated round-off in t
-    computeForces();
-    kick(p, h);
+    computeForces(h);
   }
 };
 
@@ -232,7 +247,7 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
   // overlapping initial states are refused (design.md section 2 / ground rules: bad input)
   d.nl.build(d.p, d.box);
   if (allow_contacts) {
-    d.computeForces();
+    d.computeInitialForces();
     return;
   }
   const auto rows = toHost(DVec<int>(d.nl.rows(), d.nl.rows() + N * static_cast<std::size_t>(d.nl.capacity())));
@@ -248,7 +263,7 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
         throw std::invalid_argument("initial state: particles " + std::to_string(i) + " and " + std::to_string(j) +
                                     " overlap (distance " + common::formatReal(r) + " < diameter 1).");
     }
-  d.computeForces();
+  d.computeInitialForces();
 }
 
 Engine::~Engine() = default;
@@ -319,13 +334,12 @@ Observables Engine::observables() const {
   o.momentum_abs_sum = thrust::transform_reduce(thrust::counting_iterator<int>(0),
                                                 thrust::counting_iterator<int>(static_cast<int>(N)),
                                                 Abs3{raw(d.p.vx), raw(d.p.vy), raw(d.p.vz)}, 0.0, thrust::plus<double>());
-  o.elastic_energy = thrust::reduce(d.work.energy.begin(), d.work.energy.end(), 0.0);
-  const long contacts = thrust::reduce(d.work.contacts.begin(), d.work.contacts.end(), 0L);
-  o.contacts_per_particle = static_cast<double>(contacts) / N;
+  const ContactSummary c = d.summary();
+  o.elastic_energy = c.elastic_energy;
+  o.contacts_per_particle = static_cast<double>(c.contacts) / N;
   o.collisions = d.collisions;
-  const double ov = thrust::reduce(d.work.overlap_upper.begin(), d.work.overlap_upper.end(), 0.0);
-  o.mean_overlap = contacts > 0 ? ov / (0.5 * contacts) : 0.0;
-  o.max_overlap = thrust::reduce(d.work.max_overlap.begin(), d.work.max_overlap.end(), 0.0, thrust::maximum<double>());
+  o.mean_overlap = c.contacts > 0 ? c.overlap_sum / (0.5 * c.contacts) : 0.0;
+  o.max_overlap = c.max_overlap;
   return o;
 }
 

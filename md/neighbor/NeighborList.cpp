@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <thrust/binary_search.h>
+#include <thrust/fill.h>
 #include <thrust/execution_policy.h>
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
@@ -48,6 +48,19 @@ HD inline void insertSorted(int* row, int& n, int cap, int j, const int* id) {
   ++n;
 }
 
+/// Marks where each cell's run starts and ends in the cell-sorted slot list: O(N), one pass
+/// (empty cells keep start = end = 0 from the fill).
+struct CellBounds {
+  const int* cell;  // sorted cell index of each position in the order
+  int *start, *end;
+  int n;
+  HD void operator()(int s) const {
+    const int c = cell[s];
+    if (s == 0 || cell[s - 1] != c) start[c] = s;
+    if (s == n - 1 || cell[s + 1] != c) end[c] = s + 1;
+  }
+};
+
 struct BuildCells {
   const double *x, *y, *z;
   const int *order, *cell_start, *cell_end, *id;
@@ -61,20 +74,26 @@ struct BuildCells {
     cx = cx < 0 ? 0 : (cx >= nc ? nc - 1 : cx);
     cy = cy < 0 ? 0 : (cy >= nc ? nc - 1 : cy);
     cz = cz < 0 ? 0 : (cz >= nc ? nc - 1 : cz);
+    // periodic neighbour cells along each axis (nc >= 3, so the three are distinct); no modulo
+    const int xs[3] = {cx == 0 ? nc - 1 : cx - 1, cx, cx == nc - 1 ? 0 : cx + 1};
+    const int ys[3] = {cy == 0 ? nc - 1 : cy - 1, cy, cy == nc - 1 ? 0 : cy + 1};
+    const int zs[3] = {cz == 0 ? nc - 1 : cz - 1, cz, cz == nc - 1 ? 0 : cz + 1};
     int* row = list + static_cast<long>(i) * cap;
     int n = 0;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const int c = (((cx + dx + nc) % nc) * nc + (cy + dy + nc) % nc) * nc + (cz + dz + nc) % nc;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        const int cxy = (xs[a] * nc + ys[b]) * nc;
+        for (int e = 0; e < 3; ++e) {
+          const int c = cxy + zs[e];
           for (int s = cell_start[c]; s < cell_end[c]; ++s) {
             const int j = order[s];
             if (j == i) continue;
-            const double rx = box.minimumImage(xi - x[j]), ry = box.minimumImage(yi - y[j]),
-                         rz = box.minimumImage(zi - z[j]);
+            const double rx = box.minimumImageWrapped(xi - x[j]), ry = box.minimumImageWrapped(yi - y[j]),
+                         rz = box.minimumImageWrapped(zi - z[j]);
             if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
           }
         }
+      }
     count[i] = n;
   }
 };
@@ -103,8 +122,8 @@ struct Displacement2 {
   const double *x, *y, *z, *x0, *y0, *z0;
   common::Box box;
   HD double operator()(int i) const {
-    const double dx = box.minimumImage(x[i] - x0[i]), dy = box.minimumImage(y[i] - y0[i]),
-                 dz = box.minimumImage(z[i] - z0[i]);
+    const double dx = box.minimumImageWrapped(x[i] - x0[i]), dy = box.minimumImageWrapped(y[i] - y0[i]),
+                 dz = box.minimumImageWrapped(z[i] - z0[i]);
     return dx * dx + dy * dy + dz * dz;
   }
 };
@@ -149,12 +168,9 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
       thrust::for_each(first, last, CellIndex{raw(p.x), raw(p.y), raw(p.z), raw(m_cell), inv_cell, nc});
       thrust::sequence(m_order.begin(), m_order.end());
       thrust::stable_sort_by_key(m_cell.begin(), m_cell.end(), m_order.begin());
-      m_cell_start.resize(ncell);
-      m_cell_end.resize(ncell);
-      thrust::lower_bound(m_cell.begin(), m_cell.end(), thrust::counting_iterator<int>(0),
-                          thrust::counting_iterator<int>(ncell), m_cell_start.begin());
-      thrust::upper_bound(m_cell.begin(), m_cell.end(), thrust::counting_iterator<int>(0),
-                          thrust::counting_iterator<int>(ncell), m_cell_end.begin());
+      m_cell_start.assign(ncell, 0);
+      m_cell_end.assign(ncell, 0);
+      thrust::for_each(first, last, CellBounds{raw(m_cell), raw(m_cell_start), raw(m_cell_end), N});
       thrust::for_each(first, last,
                        BuildCells{raw(p.x), raw(p.y), raw(p.z), raw(m_order), raw(m_cell_start), raw(m_cell_end),
                                   raw(p.id), raw(m_list), raw(m_count), box, inv_cell, range * range, nc, m_capacity});
