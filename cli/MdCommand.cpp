@@ -220,6 +220,8 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   Progress progress(!quiet, cfg.run.t_end);
   const std::int64_t obs_every = cfg.output.observable_interval;
   const std::int64_t first_step = engine.step();
+  const std::int64_t first_builds = engine.neighborBuilds();
+  const auto loop_start = std::chrono::steady_clock::now();
   try {
     while (engine.step() < last) {
       std::int64_t target = std::min(last, (engine.step() / obs_every + 1) * obs_every);
@@ -253,10 +255,16 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                                                 : "; no checkpoint was written before the failure"));
   }
   progress.done();
+  const double loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   checkpoint();
   writer->close();
   if (!quiet) {
     const auto o = engine.observables();
+    const std::int64_t steps = engine.step() - first_step, builds = engine.neighborBuilds() - first_builds;
+    std::printf("md: %lld steps in %.3g s (%.3g particle-steps/s incl. output); neighbour list rebuilt %lld times (every %.3g steps)\n",
+                static_cast<long long>(steps), loop_seconds,
+                loop_seconds > 0 ? static_cast<double>(steps) * engine.size() / loop_seconds : 0.0,
+                static_cast<long long>(builds), builds > 0 ? static_cast<double>(steps) / builds : 0.0);
     std::printf("md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max overlap %.3g\n", o.time,
                 o.temperature, static_cast<long long>(o.collisions), o.contacts_per_particle, o.max_overlap);
     std::printf("md: wrote %s (%zu frames), %s\n", traj.c_str(), writer->frames(), cpath.c_str());

@@ -7,32 +7,37 @@
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
+#include <thrust/reduce.h>
+
+#include "md/engine/Launch.h"
 #include "md/potentials/HertzViscoelastic.h"
 #include "md/potentials/SpringDashpot.h"
 
 namespace granagg::md {
 
 void ContactWork::resize(std::size_t n) {
-  for (auto* v : {&vpx, &vpy, &vpz}) v->resize(n);
-  for (auto* v : {&new_contacts_upper, &bad}) v->assign(n, 0);
+  vp.resize(n);
+  bad.assign(n, 0);
 }
 
 namespace {
 
 template <class Potential>
 struct ContactForceFunctor {
-  const double *x, *y, *z, *xp, *yp, *zp, *vpx, *vpy, *vpz;  // vp*: predicted velocities
+  const Scalar4 *pos, *pos_prev, *vp;  // vp: predicted velocities
   const int *rows, *counts;
   int cap;
   common::Box box;
   typename Potential::Params params;
   double max_overlap, close_h;
   double *fx, *fy, *fz, *vx, *vy, *vz;
-  int *new_upper, *bad;
+  int* bad;
 
-  HD void operator()(int i) const {
-    const double xi_ = x[i], yi_ = y[i], zi_ = z[i];
-    const double vix = vpx[i], viy = vpy[i], viz = vpz[i];
+  /// returns the collisions of pairs (i, j > i) that started this step and the check flag of i
+  HD ContactStepResult operator()(int i) const {
+    const Scalar4 ri = pos[i];
+    const double xi_ = ri.x, yi_ = ri.y, zi_ = ri.z;
+    const Scalar4 vi = vp[i];
     double f0 = 0.0, f1 = 0.0, f2 = 0.0, mx = 0.0;
     int nnew = 0;
     const int* row = rows + static_cast<long>(i) * cap;
@@ -40,15 +45,17 @@ struct ContactForceFunctor {
     for (int k = 0; k < n; ++k) {
       const int j = row[k];
       // positions are wrapped into [0, L): one conditional shift is the minimum image
-      const double rx = box.minimumImageWrapped(xi_ - x[j]), ry = box.minimumImageWrapped(yi_ - y[j]),
-                   rz = box.minimumImageWrapped(zi_ - z[j]);
+      const Scalar4 rj = pos[j];
+      const double rx = box.minimumImageWrapped(xi_ - rj.x), ry = box.minimumImageWrapped(yi_ - rj.y),
+                   rz = box.minimumImageWrapped(zi_ - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
       if (r2 >= 1.0) continue;
       const double r = sqrt(r2);
       const double inv_r = 1.0 / r;
       const double nx = rx * inv_r, ny = ry * inv_r, nz = rz * inv_r;  // unit vector from j to i
       const double xi = 1.0 - r;                                        // overlap
-      const double gx = vix - vpx[j], gy = viy - vpy[j], gz = viz - vpz[j];
+      const Scalar4 vj = vp[j];
+      const double gx = vi.x - vj.x, gy = vi.y - vj.y, gz = vi.z - vj.z;
       const double xi_dot = -(gx * nx + gy * ny + gz * nz);  // > 0 while approaching
       const double F = Potential::normalForce(xi, xi_dot, params);
       f0 += F * nx;
@@ -57,8 +64,9 @@ struct ContactForceFunctor {
       mx = xi > mx ? xi : mx;
       if (j > i) {
         // a collision is the first step at which the pair overlaps after not overlapping
-        const double px = box.minimumImageWrapped(xp[i] - xp[j]), py = box.minimumImageWrapped(yp[i] - yp[j]),
-                     pz = box.minimumImageWrapped(zp[i] - zp[j]);
+        const Scalar4 pi = pos_prev[i], pj = pos_prev[j];
+        const double px = box.minimumImageWrapped(pi.x - pj.x), py = box.minimumImageWrapped(pi.y - pj.y),
+                     pz = box.minimumImageWrapped(pi.z - pj.z);
         if (px * px + py * py + pz * pz >= 1.0) ++nnew;
       }
     }
@@ -70,25 +78,21 @@ struct ContactForceFunctor {
       vy[i] += close_h * f1;
       vz[i] += close_h * f2;
     }
-    new_upper[i] = nnew;
     // v - v == 0 exactly for finite v and is NaN for NaN or inf: a finiteness test that needs no
     // math library in device code
     const double probe = f0 + f1 + f2 + xi_ + yi_ + zi_;
     const bool finite = probe - probe == 0.0;
-    bad[i] = !finite ? 1 : (mx > max_overlap ? 2 : 0);
+    ContactStepResult res;
+    res.collisions = nnew;
+    res.worst = !finite ? 1 : (mx > max_overlap ? 2 : 0);
+    bad[i] = res.worst;
+    return res;
   }
 };
 
-struct StepFlags {
-  const int *new_upper, *bad;
-  HD ContactStepResult operator()(int i) const {
-    ContactStepResult r;
-    r.collisions = new_upper[i];
-    r.worst = bad[i];
-    return r;
-  }
-};
 struct CombineStepFlags {
+  using value_type = ContactStepResult;
+  HD static ContactStepResult identity() { return ContactStepResult{}; }
   HD ContactStepResult operator()(const ContactStepResult& a, const ContactStepResult& b) const {
     ContactStepResult r;
     r.collisions = a.collisions + b.collisions;
@@ -100,7 +104,7 @@ struct CombineStepFlags {
 /// Contact statistics of particle i (the same pair test as the force pass).
 template <class Potential>
 struct SummaryFunctor {
-  const double *x, *y, *z;
+  const Scalar4* pos;
   const int *rows, *counts;
   int cap;
   common::Box box;
@@ -110,8 +114,9 @@ struct SummaryFunctor {
     const int* row = rows + static_cast<long>(i) * cap;
     for (int k = 0; k < counts[i]; ++k) {
       const int j = row[k];
-      const double rx = box.minimumImageWrapped(x[i] - x[j]), ry = box.minimumImageWrapped(y[i] - y[j]),
-                   rz = box.minimumImageWrapped(z[i] - z[j]);
+      const Scalar4 ri = pos[i], rj = pos[j];
+      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+                   rz = box.minimumImageWrapped(ri.z - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
       if (r2 >= 1.0) continue;
       const double xi = 1.0 - sqrt(r2);
@@ -147,23 +152,22 @@ ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, 
                                        double close_half_dt, ContactWork& w) {
   const int N = static_cast<int>(p.size());
   if (w.bad.size() != p.size()) w.resize(p.size());
-  const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
-  ContactForceFunctor<Potential> f{raw(p.x), raw(p.y), raw(p.z), raw(p.xp), raw(p.yp), raw(p.zp),
-                                   raw(w.vpx), raw(w.vpy), raw(w.vpz),
+  ContactForceFunctor<Potential> f{raw(p.pos), raw(p.pos_prev), raw(w.vp),
                                    nl.rows(), nl.counts(), nl.capacity(), box, params, max_overlap, close_half_dt,
                                    raw(p.fx), raw(p.fy), raw(p.fz), raw(p.vx), raw(p.vy), raw(p.vz),
-                                   raw(w.new_contacts_upper), raw(w.bad)};
-  thrust::for_each(first, last, f);
-  // one reduction for both: collisions (sum) and the worst flag (max)
-  return thrust::transform_reduce(first, last, StepFlags{raw(w.new_contacts_upper), raw(w.bad)}, ContactStepResult{},
-                                  CombineStepFlags{});
+                                   raw(w.bad)};
+  // forces and, per block, collisions (sum) and the worst flag (max); then one reduction over blocks
+  const int block = blockSizeFor(N);
+  w.block_flags.resize(blockCount(N, block));
+  forEachBlocked(N, block, f, CombineStepFlags{}, raw(w.block_flags));
+  return thrust::reduce(w.block_flags.begin(), w.block_flags.end(), ContactStepResult{}, CombineStepFlags{});
 }
 
 template <class Potential>
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
                               const typename Potential::Params& params) {
   const int N = static_cast<int>(p.size());
-  SummaryFunctor<Potential> s{raw(p.x), raw(p.y), raw(p.z), nl.rows(), nl.counts(), nl.capacity(), box, params};
+  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
   return thrust::transform_reduce(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), s, ContactSummary{},
                                   CombineSummary{});
 }
@@ -173,7 +177,7 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
                            const typename Potential::Params& params, DVec<double>& out) {
   const int N = static_cast<int>(p.size());
   out.resize(p.size());
-  SummaryFunctor<Potential> s{raw(p.x), raw(p.y), raw(p.z), nl.rows(), nl.counts(), nl.capacity(), box, params};
+  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
   thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), out.begin(),
                     MaxOverlapOf<Potential>{s});
 }

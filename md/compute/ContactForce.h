@@ -22,21 +22,21 @@
 
 namespace granagg::md {
 
-/// Per-particle scratch of the force pass.
-struct ContactWork {
-  DVec<double> vpx, vpy, vpz;     ///< predicted velocities v(t+dt) (input, see above)
-  DVec<int> new_contacts_upper;   ///< partners j > i whose contact started this step (collisions)
-  DVec<int> bad;                  ///< 1: non-finite force or position, 2: overlap beyond the bound
-  void resize(std::size_t n);
-};
-
 /// What one force pass found.
 struct ContactStepResult {
   std::int64_t collisions = 0;  ///< pairs whose contact started at this step
   int worst = 0;                ///< max of ContactWork::bad (0: all good)
 };
 
-/// Contact forces of the current positions into p.fx, p.fy, p.fz (approach rates from work.vp*),
+/// Per-particle scratch of the force pass.
+struct ContactWork {
+  DVec<Scalar4> vp;               ///< predicted velocities v(t+dt) (input, see above; w unused)
+  DVec<int> bad;                  ///< 1: non-finite force or position, 2: overlap beyond the bound
+  DVec<ContactStepResult> block_flags;  ///< per-block partial results (md/engine/Launch.h)
+  void resize(std::size_t n);
+};
+
+/// Contact forces of the current positions into p.fx, p.fy, p.fz (approach rates from work.vp),
 /// then the closing kick v += close_half_dt * f (pass 0 to leave v alone, e.g. for the forces of an
 /// initial state). \param max_overlap bound that flags a particle in work.bad.
 template <class Potential>

@@ -79,6 +79,10 @@ struct Engine::Impl {
   ParticleData p;
   NeighborList nl;
   ContactWork work;
+  DVec<double> block_max;  // kickDrift's per-block maximum displacements
+  DVec<double> scratch_d;  // for permutations
+  DVec<int> scratch_i;
+  DVec<Scalar4> scratch4;
   double dt = 0.0;
   std::int64_t step = 0;
   double time = 0.0;
@@ -91,46 +95,39 @@ struct Engine::Impl {
 
   /// Copies a host state (same N, wrapped, with images and charges) into the device arrays.
   void upload(const Frame& f) {
-    toDevice(f.x, p.x);
-    toDevice(f.y, p.y);
-    toDevice(f.z, p.z);
+    p.setPositions(f.x, f.y, f.z, f.charge);  // previous positions: overwritten by the next drift
     toDevice(f.vx, p.vx);
     toDevice(f.vy, p.vy);
     toDevice(f.vz, p.vz);
-    toDevice(f.charge, p.q);
     toDevice(f.ix, p.ix);
     toDevice(f.iy, p.iy);
     toDevice(f.iz, p.iz);
     p.id.resize(f.size());
     thrust::sequence(p.id.begin(), p.id.end());
-    // previous positions are overwritten by the next drift before the collision test reads them
-    p.xp = p.x;
-    p.yp = p.y;
-    p.zp = p.z;
   }
 
-  /// Stores particles in the cell order of the neighbour list just built (memory locality for
-  /// the gathers), then rebuilds the list for the new slots. Rows are sorted by particle id, so
-  /// forces, and hence trajectories, do not depend on the storage order.
+  /// Stores particles in cell order (memory locality for the neighbour gathers: a particle's
+  /// neighbours then sit within a few hundred slots of it). Rows are sorted by particle id, so
+  /// forces, and hence trajectories, do not depend on the storage order. The caller rebuilds the list.
   void sortByCell() {
-    const DVec<int>& order = nl.cellOrder();
-    if (order.size() != p.size()) return;  // all-pairs build: nothing to sort
-    const DVec<int> ord = order;             // the rebuild below overwrites the list's copy
-    DVec<double> sd;
-    DVec<int> si;
-    for (auto* v : {&p.x, &p.y, &p.z, &p.xp, &p.yp, &p.zp, &p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz, &p.q,
-                    &work.vpx, &work.vpy, &work.vpz})
-      permute(*v, ord, sd);
-    for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, ord, si);
-    nl.build(p, box);
+    const DVec<int>& order = nl.computeCellOrder(p, box);
+    if (order.size() != p.size()) return;  // all-pairs builds: nothing to sort
+    for (auto* v : {&p.pos, &p.pos_prev, &work.vp}) permute(*v, order, scratch4);
+    for (auto* v : {&p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz}) permute(*v, order, scratch_d);
+    for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
   }
 
   /// Forces of the current positions into p.f, then the closing kick v += close_half_dt f; counts
   /// collisions; aborts on NaN / deep overlap. work.vp* must hold the predicted velocities.
-  void computeForces(double close_half_dt) {
-    // re-sort storage every SORT_EVERY list builds (the order decays as particles move)
-    constexpr std::int64_t SORT_EVERY = 10;
-    if (nl.update(p, box) && nl.builds() % SORT_EVERY == 2) sortByCell();  // builds 2, 12, 22, ...
+  /// \param max_displacement2 largest squared displacement since the last list build (from
+  /// kickDrift), or a negative value to have the list measure it.
+  void computeForces(double close_half_dt, double max_displacement2) {
+    if (max_displacement2 < 0.0 ? nl.needsRebuild(p, box) : nl.needsRebuild(p, max_displacement2)) {
+      // storage re-sorted at every build: the cost is a gather per array, far less than the
+      // cache misses of neighbours scattered in memory
+      sortByCell();
+      nl.build(p, box);
+    }
 
     const ContactStepResult r =
         hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, cfg.run.max_overlap, close_half_dt, work)
@@ -143,8 +140,8 @@ struct Engine::Impl {
   /// (f = 0 until the first evaluation) and v is left alone.
   void computeInitialForces() {
     for (auto* f : {&p.fx, &p.fy, &p.fz}) thrust::fill(f->begin(), f->end(), 0.0);
-    predictVelocities(p, 0.0, work.vpx, work.vpy, work.vpz);
-    computeForces(0.0);
+    predictVelocities(p, 0.0, work.vp);
+    computeForces(0.0, -1.0);
   }
 
   ContactSummary summary() const {
@@ -180,10 +177,10 @@ struct Engine::Impl {
   /// velocities), then forces + closing kick.
   void doStep() {
     const double h = 0.5 * dt;
-    kickDrift(p, h, dt, box, work.vpx, work.vpy, work.vpz);
+    const double moved2 = kickDrift(p, h, dt, box, work.vp, nl.referencePositions(p.size()), block_max);
     ++step;
     time = step * dt;  // no accumulated round-off in t
-    computeForces(h);
+    computeForces(h, moved2);
   }
 };
 
@@ -279,13 +276,21 @@ Frame Engine::frame() const {
   f.step = d.step;
   f.time = d.time;
   f.box = d.box.L;
-  f.x = toHostById(d.p.x, id);
-  f.y = toHostById(d.p.y, id);
-  f.z = toHostById(d.p.z, id);
+  const auto pos = toHostById(d.p.pos, id);
+  const std::size_t N = pos.size();
+  f.x.resize(N);
+  f.y.resize(N);
+  f.z.resize(N);
+  f.charge.resize(N);
+  for (std::size_t i = 0; i < N; ++i) {
+    f.x[i] = pos[i].x;
+    f.y[i] = pos[i].y;
+    f.z[i] = pos[i].z;
+    f.charge[i] = pos[i].w;
+  }
   f.vx = toHostById(d.p.vx, id);
   f.vy = toHostById(d.p.vy, id);
   f.vz = toHostById(d.p.vz, id);
-  f.charge = toHostById(d.p.q, id);
   f.ix = toHostById(d.p.ix, id);
   f.iy = toHostById(d.p.iy, id);
   f.iz = toHostById(d.p.iz, id);

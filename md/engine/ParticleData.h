@@ -1,11 +1,19 @@
 #pragma once
 /// \file ParticleData.h
-/// Particle state as structure-of-arrays Thrust device vectors (host memory on the OpenMP backend,
-/// GPU memory on CUDA). Only device sources (neighbor/, compute/, integrate/, engine/) include it.
+/// Particle state as Thrust device vectors (host memory on the OpenMP backend, GPU memory on
+/// CUDA). Only device sources (neighbor/, compute/, integrate/, engine/, coulomb/) include it.
+///
+/// Layout: what the neighbour gathers read for a partner j -- its position, and its charge for the
+/// Coulomb real-space term -- is packed into one 32-byte record (Scalar4, HOOMD-blue's layout), so
+/// a neighbour costs one cache line instead of four; everything only read or written for the
+/// particle itself (velocities, forces, images) stays structure-of-arrays.
 #include <cstdint>
+#include <vector>
 
 #include <thrust/device_vector.h>
 #include <thrust/sequence.h>
+
+#include "common/HostDevice.h"
 
 namespace granagg::md {
 
@@ -21,23 +29,37 @@ const T* raw(const DVec<T>& v) {
   return thrust::raw_pointer_cast(v.data());
 }
 
+/// Four doubles in one aligned record: a position and one scalar (charge or unused).
+struct alignas(32) Scalar4 {
+  double x, y, z, w;
+};
+
 struct ParticleData {
-  DVec<double> x, y, z;        ///< wrapped positions in [0, L)
-  DVec<double> xp, yp, zp;     ///< positions one step earlier (collision = first overlapping step)
+  DVec<Scalar4> pos;       ///< wrapped positions in [0, L) (x, y, z) and charge (w)
+  DVec<Scalar4> pos_prev;  ///< positions one step earlier (collision = first overlapping step)
   DVec<double> vx, vy, vz;
-  DVec<double> fx, fy, fz;     ///< forces of the current positions
-  DVec<double> q;              ///< charges
-  DVec<int> ix, iy, iz;        ///< image counts
+  DVec<double> fx, fy, fz;  ///< forces of the current positions
+  DVec<int> ix, iy, iz;     ///< image counts
   /// Particle id (index in the user's order) of each slot: the engine stores particles sorted by
   /// cell for memory locality and maps back to ids for output.
   DVec<int> id;
   void resize(std::size_t n) {
-    for (auto* v : {&x, &y, &z, &xp, &yp, &zp, &vx, &vy, &vz, &fx, &fy, &fz, &q}) v->assign(n, 0.0);
+    pos.assign(n, Scalar4{0, 0, 0, 0});
+    pos_prev.assign(n, Scalar4{0, 0, 0, 0});
+    for (auto* v : {&vx, &vy, &vz, &fx, &fy, &fz}) v->assign(n, 0.0);
     for (auto* v : {&ix, &iy, &iz}) v->assign(n, 0);
     id.resize(n);
     thrust::sequence(id.begin(), id.end());
   }
-  std::size_t size() const { return x.size(); }
+  std::size_t size() const { return pos.size(); }
+  /// Sets positions and charges from host arrays (slot order); pos_prev = pos.
+  void setPositions(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z,
+                    const std::vector<double>& q) {
+    std::vector<Scalar4> h(x.size());
+    for (std::size_t i = 0; i < h.size(); ++i) h[i] = Scalar4{x[i], y[i], z[i], q.empty() ? 0.0 : q[i]};
+    pos.assign(h.begin(), h.end());
+    pos_prev = pos;
+  }
 };
 
 }  // namespace granagg::md

@@ -15,12 +15,15 @@
 
 namespace granagg::md {
 
-/// Predicted full-step velocities vp = v + half_dt f, written to (vpx, vpy, vpz).
-void predictVelocities(const ParticleData& p, double half_dt, DVec<double>& vpx, DVec<double>& vpy, DVec<double>& vpz);
+/// Predicted full-step velocities vp = v + half_dt f (packed; w unused).
+void predictVelocities(const ParticleData& p, double half_dt, DVec<Scalar4>& vp);
 
 /// Opening half of a step: v += half_dt f; vp = v + half_dt f (prediction of v(t + dt));
-/// xp = x; x += dt v; wrap into [0, L) and update the image counts.
-void kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, DVec<double>& vpx,
-               DVec<double>& vpy, DVec<double>& vpz);
+/// pos_prev = pos; x += dt v; wrap into [0, L) and update the image counts.
+/// Returns the largest squared displacement from `reference` (the neighbour list's positions at its
+/// last build, NeighborList::referencePositions(); 0 if null), computed in the same pass.
+/// \param block_max scratch for the per-block maxima.
+double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, DVec<Scalar4>& vp,
+                 const Scalar4* reference, DVec<double>& block_max);
 
 }  // namespace granagg::md

@@ -4,7 +4,6 @@
 #include <stdexcept>
 #include <string>
 
-#include <thrust/fill.h>
 #include <thrust/execution_policy.h>
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
@@ -19,13 +18,13 @@ namespace granagg::md {
 namespace {
 
 struct CellIndex {
-  const double *x, *y, *z;
+  const Scalar4* pos;
   int* cell;
   double inv_cell;  // cells per unit length
   int nc;
   HD void operator()(int i) const {
-    int cx = static_cast<int>(x[i] * inv_cell), cy = static_cast<int>(y[i] * inv_cell),
-        cz = static_cast<int>(z[i] * inv_cell);
+    const Scalar4 r = pos[i];
+    int cx = static_cast<int>(r.x * inv_cell), cy = static_cast<int>(r.y * inv_cell), cz = static_cast<int>(r.z * inv_cell);
     cx = cx < 0 ? 0 : (cx >= nc ? nc - 1 : cx);
     cy = cy < 0 ? 0 : (cy >= nc ? nc - 1 : cy);
     cz = cz < 0 ? 0 : (cz >= nc ? nc - 1 : cz);
@@ -48,50 +47,67 @@ HD inline void insertSorted(int* row, int& n, int cap, int j, const int* id) {
   ++n;
 }
 
-/// Marks where each cell's run starts and ends in the cell-sorted slot list: O(N), one pass
-/// (empty cells keep start = end = 0 from the fill).
-struct CellBounds {
+/// First slot (in the cell-sorted order) of every cell, as lower bounds: start[c] = first s with
+/// cell[s] >= c, and start[ncell] = N. Empty cells get start[c] = start[c + 1], so the slots of
+/// consecutive cells c0..c1 are the one range [start[c0], start[c1 + 1]). O(N + ncell): slot s
+/// writes the cells after its predecessor's, up to its own.
+struct CellStarts {
   const int* cell;  // sorted cell index of each position in the order
-  int *start, *end;
-  int n;
+  int* start;
+  int n, ncell;
   HD void operator()(int s) const {
-    const int c = cell[s];
-    if (s == 0 || cell[s - 1] != c) start[c] = s;
-    if (s == n - 1 || cell[s + 1] != c) end[c] = s + 1;
+    const int lo = s == 0 ? 0 : cell[s - 1] + 1;
+    for (int c = lo; c <= cell[s]; ++c) start[c] = s;
+    if (s == n - 1)
+      for (int c = cell[s] + 1; c <= ncell; ++c) start[c] = n;
   }
 };
 
 struct BuildCells {
-  const double *x, *y, *z;
-  const int *order, *cell_start, *cell_end, *id;
+  const Scalar4* pos;
+  const int *order, *cell_start, *id;
   int *list, *count;
   common::Box box;
   double inv_cell, r2;
   int nc, cap;
+
+  /// Candidates in the slot range [s0, s1) of the cell order.
+  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n) const {
+    for (int s = s0; s < s1; ++s) {
+      const int j = order[s];
+      if (j == i) continue;
+      const Scalar4 rj = pos[j];
+      const double rx = box.minimumImageWrapped(xi - rj.x), ry = box.minimumImageWrapped(yi - rj.y),
+                   rz = box.minimumImageWrapped(zi - rj.z);
+      if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
+    }
+  }
+
   HD void operator()(int i) const {
-    const double xi = x[i], yi = y[i], zi = z[i];
+    const Scalar4 ri = pos[i];
+    const double xi = ri.x, yi = ri.y, zi = ri.z;
     int cx = static_cast<int>(xi * inv_cell), cy = static_cast<int>(yi * inv_cell), cz = static_cast<int>(zi * inv_cell);
     cx = cx < 0 ? 0 : (cx >= nc ? nc - 1 : cx);
     cy = cy < 0 ? 0 : (cy >= nc ? nc - 1 : cy);
     cz = cz < 0 ? 0 : (cz >= nc ? nc - 1 : cz);
-    // periodic neighbour cells along each axis (nc >= 3, so the three are distinct); no modulo
+    // periodic neighbour cells along x and y (nc >= 3, so the three are distinct); no modulo
     const int xs[3] = {cx == 0 ? nc - 1 : cx - 1, cx, cx == nc - 1 ? 0 : cx + 1};
     const int ys[3] = {cy == 0 ? nc - 1 : cy - 1, cy, cy == nc - 1 ? 0 : cy + 1};
-    const int zs[3] = {cz == 0 ? nc - 1 : cz - 1, cz, cz == nc - 1 ? 0 : cz + 1};
     int* row = list + static_cast<long>(i) * cap;
     int n = 0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
-        const int cxy = (xs[a] * nc + ys[b]) * nc;
-        for (int e = 0; e < 3; ++e) {
-          const int c = cxy + zs[e];
-          for (int s = cell_start[c]; s < cell_end[c]; ++s) {
-            const int j = order[s];
-            if (j == i) continue;
-            const double rx = box.minimumImageWrapped(xi - x[j]), ry = box.minimumImageWrapped(yi - y[j]),
-                         rz = box.minimumImageWrapped(zi - z[j]);
-            if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
-          }
+        // the three cells cz-1, cz, cz+1 of a column are consecutive in the cell order (one slot
+        // range) unless the column wraps through the z faces (two ranges)
+        const int base = (xs[a] * nc + ys[b]) * nc;
+        if (cz > 0 && cz < nc - 1) {
+          scan(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n);
+        } else if (cz == 0) {
+          scan(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n);
+          scan(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n);
+        } else {
+          scan(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n);
+          scan(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n);
         }
       }
     count[i] = n;
@@ -99,7 +115,7 @@ struct BuildCells {
 };
 
 struct BuildAllPairs {
-  const double *x, *y, *z;
+  const Scalar4* pos;
   const int* id;
   int *list, *count;
   common::Box box;
@@ -110,8 +126,9 @@ struct BuildAllPairs {
     int n = 0;
     for (int j = 0; j < N; ++j) {
       if (j == i) continue;
-      const double rx = box.minimumImage(x[i] - x[j]), ry = box.minimumImage(y[i] - y[j]),
-                   rz = box.minimumImage(z[i] - z[j]);
+      const Scalar4 ri = pos[i], rj = pos[j];
+      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+                   rz = box.minimumImageWrapped(ri.z - rj.z);
       if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
     }
     count[i] = n;
@@ -119,11 +136,12 @@ struct BuildAllPairs {
 };
 
 struct Displacement2 {
-  const double *x, *y, *z, *x0, *y0, *z0;
+  const Scalar4 *pos, *pos0;
   common::Box box;
   HD double operator()(int i) const {
-    const double dx = box.minimumImageWrapped(x[i] - x0[i]), dy = box.minimumImageWrapped(y[i] - y0[i]),
-                 dz = box.minimumImageWrapped(z[i] - z0[i]);
+    const Scalar4 a = pos[i], b = pos0[i];
+    const double dx = box.minimumImageWrapped(a.x - b.x), dy = box.minimumImageWrapped(a.y - b.y),
+                 dz = box.minimumImageWrapped(a.z - b.z);
     return dx * dx + dy * dy + dz * dz;
   }
 };
@@ -136,11 +154,15 @@ NeighborList::NeighborList(double cutoff, double skin) : m_cutoff(cutoff), m_ski
 
 bool NeighborList::needsRebuild(const ParticleData& p, const common::Box& box) {
   const int N = static_cast<int>(p.size());
-  if (m_builds == 0 || static_cast<int>(m_x0.size()) != N) return true;
+  if (m_builds == 0 || static_cast<int>(m_pos0.size()) != N) return true;
   const double max2 = thrust::transform_reduce(
       thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
-      Displacement2{raw(p.x), raw(p.y), raw(p.z), raw(m_x0), raw(m_y0), raw(m_z0), box}, 0.0, thrust::maximum<double>());
-  return max2 > 0.25 * m_skin * m_skin;
+      Displacement2{raw(p.pos), raw(m_pos0), box}, 0.0, thrust::maximum<double>());
+  return needsRebuild(p, max2);
+}
+
+bool NeighborList::needsRebuild(const ParticleData& p, double max_displacement2) const {
+  return m_builds == 0 || m_pos0.size() != p.size() || !(max_displacement2 <= 0.25 * m_skin * m_skin);  // NaN: rebuild
 }
 
 bool NeighborList::update(const ParticleData& p, const common::Box& box) {
@@ -149,44 +171,62 @@ bool NeighborList::update(const ParticleData& p, const common::Box& box) {
   return true;
 }
 
-void NeighborList::build(const ParticleData& p, const common::Box& box) {
-  const int N = static_cast<int>(p.size());
+int NeighborList::cellsPerSide(const common::Box& box) const {
   const double range = m_cutoff + m_skin;
   if (2.0 * range > box.L)
     throw std::invalid_argument("box edge L = " + std::to_string(box.L) + " is smaller than twice the neighbour range " +
                                 std::to_string(range) + " (contact distance 1 + skin): use more particles or a smaller skin.");
-  const int nc = static_cast<int>(std::floor(box.L / range));
+  return static_cast<int>(std::floor(box.L / range));
+}
+
+const DVec<int>& NeighborList::computeCellOrder(const ParticleData& p, const common::Box& box) {
+  const int N = static_cast<int>(p.size());
+  const int nc = cellsPerSide(box);
+  if (nc < 3) {
+    m_order.clear();
+    return m_order;
+  }
+  m_cell.resize(N);
+  m_order.resize(N);
+  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+                   CellIndex{raw(p.pos), raw(m_cell), nc / box.L, nc});
+  thrust::sequence(m_order.begin(), m_order.end());
+  thrust::stable_sort_by_key(m_cell.begin(), m_cell.end(), m_order.begin());
+  return m_order;
+}
+
+void NeighborList::build(const ParticleData& p, const common::Box& box) {
+  const int N = static_cast<int>(p.size());
+  const double range = m_cutoff + m_skin;
+  const int nc = cellsPerSide(box);
   const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
   m_count.resize(N);
+  if (nc >= 3) computeCellOrder(p, box);
   for (;;) {
     m_list.resize(static_cast<std::size_t>(N) * m_capacity);
     if (nc >= 3) {
       const int ncell = nc * nc * nc;
       const double inv_cell = nc / box.L;
-      m_cell.resize(N);
-      m_order.resize(N);
-      thrust::for_each(first, last, CellIndex{raw(p.x), raw(p.y), raw(p.z), raw(m_cell), inv_cell, nc});
-      thrust::sequence(m_order.begin(), m_order.end());
-      thrust::stable_sort_by_key(m_cell.begin(), m_cell.end(), m_order.begin());
-      m_cell_start.assign(ncell, 0);
-      m_cell_end.assign(ncell, 0);
-      thrust::for_each(first, last, CellBounds{raw(m_cell), raw(m_cell_start), raw(m_cell_end), N});
+      m_cell_start.resize(ncell + 1);
+      thrust::for_each(first, last, CellStarts{raw(m_cell), raw(m_cell_start), N, ncell});
       thrust::for_each(first, last,
-                       BuildCells{raw(p.x), raw(p.y), raw(p.z), raw(m_order), raw(m_cell_start), raw(m_cell_end),
-                                  raw(p.id), raw(m_list), raw(m_count), box, inv_cell, range * range, nc, m_capacity});
+                       BuildCells{raw(p.pos), raw(m_order), raw(m_cell_start), raw(p.id), raw(m_list), raw(m_count), box, inv_cell, range * range, nc, m_capacity});
     } else {
       m_order.clear();
       thrust::for_each(first, last,
-                       BuildAllPairs{raw(p.x), raw(p.y), raw(p.z), raw(p.id), raw(m_list), raw(m_count), box, range * range, N,
+                       BuildAllPairs{raw(p.pos), raw(p.id), raw(m_list), raw(m_count), box, range * range, N,
                                      m_capacity});
     }
     const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
-    if (most <= m_capacity) break;
+    if (most <= m_capacity) {
+      // rows much wider than needed cost a cache line per particle per step for nothing: the next
+      // build uses a tighter capacity (a later overflow is caught above)
+      if (2 * (most + most / 4 + 4) < m_capacity) m_capacity = most + most / 4 + 4;
+      break;
+    }
     m_capacity = most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
   }
-  m_x0 = p.x;
-  m_y0 = p.y;
-  m_z0 = p.z;
+  m_pos0 = p.pos;
   ++m_builds;
 }
 

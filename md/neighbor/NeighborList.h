@@ -24,25 +24,33 @@ class NeighborList {
   /// Rebuilds if any particle moved more than skin/2 since the last build (or never built).
   /// Returns true if it rebuilt.
   bool update(const ParticleData& p, const common::Box& box);
+  /// True if some particle moved more than skin/2 since the last build (measured here), or never built.
+  bool needsRebuild(const ParticleData& p, const common::Box& box);
+  /// The same test given max_displacement2, the largest squared displacement since the last build
+  /// (e.g. from kickDrift, which measures it in its own pass).
+  bool needsRebuild(const ParticleData& p, double max_displacement2) const;
+  /// Slots sorted by cell for the current positions (stable), without building the list; empty if
+  /// the box is too small for cells (all-pairs builds). For sorting the particle storage.
+  const DVec<int>& computeCellOrder(const ParticleData& p, const common::Box& box);
+  /// Positions at the last build (slot order), or null before the first build / after N changed.
+  const Scalar4* referencePositions(std::size_t n) const { return m_builds > 0 && m_pos0.size() == n ? raw(m_pos0) : nullptr; }
   /// Unconditional rebuild.
   void build(const ParticleData& p, const common::Box& box);
 
   const int* rows() const { return raw(m_list); }     ///< row i at rows()[i * capacity()]
   const int* counts() const { return raw(m_count); }  ///< entries in row i
   int capacity() const { return m_capacity; }
-  /// Slots sorted by cell at the last build (empty for all-pairs builds): a locality order.
-  const DVec<int>& cellOrder() const { return m_order; }
   std::int64_t builds() const { return m_builds; }
   double listRange() const { return m_cutoff + m_skin; }
 
  private:
-  bool needsRebuild(const ParticleData& p, const common::Box& box);
+  int cellsPerSide(const common::Box& box) const;
   double m_cutoff, m_skin;
-  int m_capacity = 32;
+  int m_capacity = 16;  // grows on overflow, shrinks when rows are mostly empty
   std::int64_t m_builds = 0;
   DVec<int> m_list, m_count;
-  DVec<double> m_x0, m_y0, m_z0;  // positions at the last build
-  DVec<int> m_cell, m_order, m_cell_start, m_cell_end;
+  DVec<Scalar4> m_pos0;  // positions at the last build
+  DVec<int> m_cell, m_order, m_cell_start;
 };
 
 }  // namespace granagg::md

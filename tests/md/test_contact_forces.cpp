@@ -45,18 +45,14 @@ ParticleData makeParticles(const std::vector<double>& pos, const std::vector<dou
   const std::size_t n = pos.size() / 3;
   ParticleData p;
   p.resize(n);
-  std::vector<double> h(n);
-  DVec<double>* P[3] = {&p.x, &p.y, &p.z};
+  std::vector<double> h(n), P[3];
   DVec<double>* V[3] = {&p.vx, &p.vy, &p.vz};
   for (int c = 0; c < 3; ++c) {
-    for (std::size_t i = 0; i < n; ++i) h[i] = pos[3 * i + c];
-    P[c]->assign(h.begin(), h.end());
+    for (std::size_t i = 0; i < n; ++i) P[c].push_back(pos[3 * i + c]);
     for (std::size_t i = 0; i < n; ++i) h[i] = vel[3 * i + c];
     V[c]->assign(h.begin(), h.end());
   }
-  p.xp = p.x;
-  p.yp = p.y;
-  p.zp = p.z;
+  p.setPositions(P[0], P[1], P[2], {});
   return p;
 }
 
@@ -93,7 +89,7 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   ContactWork w;
   // half_dt = 0: predicted velocities equal v, as in the reference; no closing kick. Overlap bound
   // 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite force.
-  predictVelocities(p, 0.0, w.vpx, w.vpy, w.vpz);
+  predictVelocities(p, 0.0, w.vp);
   const auto flags = computeContactForces<HertzViscoelastic>(p, nl, box, prm, 1.0, 0.0, w);
   CHECK(flags.worst == 0);
   std::vector<double> ref;

@@ -1,0 +1,70 @@
+#pragma once
+/// \file Launch.h
+/// Launch plumbing for per-particle loops (device source; Thrust).
+///
+/// forEachBlocked(n, body) runs body(i) for every i in [0, n) through thrust::for_each over blocks
+/// of consecutive indices. On the OpenMP backend a block is a plain loop over many particles with
+/// the functor copied into locals: its pointers stay in registers (a functor called once per
+/// element through thrust reloads them after every store, since stores through double* may alias
+/// it) and a block can reduce what it computed before writing one value. On the CUDA backend a
+/// block is one particle, i.e. one thread per particle as usual.
+///
+/// Per-block results (block maxima, counts) go to an array reduced afterwards over the blocks;
+/// sums of integers and maxima are exact, so results do not depend on the blocking or the thread
+/// count.
+#include <thrust/for_each.h>
+#include <thrust/iterator/counting_iterator.h>
+
+#if !defined(__CUDACC__)
+#include <omp.h>
+#endif
+
+#include "common/HostDevice.h"
+
+namespace granagg::md {
+
+/// Indices per block: one on CUDA; on the OpenMP backend 16 blocks per thread (load balance
+/// between threads whose blocks cost differently, e.g. dense clusters), at least 256.
+inline int blockSizeFor(int n) {
+#if defined(__CUDACC__)
+  (void)n;
+  return 1;
+#else
+  const int blocks = 16 * omp_get_max_threads();
+  const int b = (n + blocks - 1) / blocks;
+  return b < 256 ? 256 : b;
+#endif
+}
+inline int blockCount(int n, int block) { return (n + block - 1) / block; }
+
+/// body(i, acc) for i in block b; acc (a Reduction::value_type) is combined over the block and
+/// stored in out[b].
+template <class Body, class Reduction>
+struct BlockedLoop {
+  Body body;
+  Reduction reduce;
+  typename Reduction::value_type* out;  // one per block (may be null without a reduction)
+  int n, block;
+  HD void operator()(int b) const {
+    const Body f = body;  // a local copy: its members are not aliased by f's stores
+    typename Reduction::value_type acc = Reduction::identity();
+    const int first = b * block, last = first + block < n ? first + block : n;
+    for (int i = first; i < last; ++i) acc = reduce(acc, f(i));
+    if (out) out[b] = acc;
+  }
+};
+
+/// No reduction: body(i) returns nothing useful (NoReduction::value_type is int).
+struct NoReduction {
+  using value_type = int;
+  HD static int identity() { return 0; }
+  HD int operator()(int a, int) const { return a; }
+};
+
+template <class Body, class Reduction>
+void forEachBlocked(int n, int block, const Body& body, const Reduction& reduce, typename Reduction::value_type* out) {
+  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(blockCount(n, block)),
+                   BlockedLoop<Body, Reduction>{body, reduce, out, n, block});
+}
+
+}  // namespace granagg::md
