@@ -16,28 +16,34 @@
 namespace granagg::md {
 
 void ContactWork::resize(std::size_t n) {
-  vp.resize(n);
-  bad.assign(n, 0);
+  for (auto* v : {&fx, &fy, &fz}) v->resize(n);
 }
 
 namespace {
 
 template <class Potential>
 struct ContactForceFunctor {
-  const Scalar4 *pos, *pos_prev, *vp;  // vp: predicted velocities
+  const Scalar4* pos;
+  const double *vx, *vy, *vz;        // drift velocities u = v(t - dt/2) of the step just taken
+  const double *fx_old, *fy_old, *fz_old;  // f(t - dt), which kicked u
   const int *rows, *counts;
   int cap;
   common::Box box;
   typename Potential::Params params;
-  double max_overlap, close_h;
-  double *fx, *fy, *fz, *vx, *vy, *vz;
-  int* bad;
+  double max_overlap, h_pred, dt_prev;
+  double *fx, *fy, *fz;  // f(t), written
+
+  /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old
+  HD void predicted(int k, double& a, double& b, double& c) const {
+    a = vx[k] + h_pred * fx_old[k];
+    b = vy[k] + h_pred * fy_old[k];
+    c = vz[k] + h_pred * fz_old[k];
+  }
 
   /// returns the collisions of pairs (i, j > i) that started this step and the check flag of i
   HD ContactStepResult operator()(int i) const {
     const Scalar4 ri = pos[i];
     const double xi_ = ri.x, yi_ = ri.y, zi_ = ri.z;
-    const Scalar4 vi = vp[i];
     double f0 = 0.0, f1 = 0.0, f2 = 0.0, mx = 0.0;
     int nnew = 0;
     const int* row = rows + static_cast<long>(i) * cap;
@@ -54,8 +60,10 @@ struct ContactForceFunctor {
       const double inv_r = 1.0 / r;
       const double nx = rx * inv_r, ny = ry * inv_r, nz = rz * inv_r;  // unit vector from j to i
       const double xi = 1.0 - r;                                        // overlap
-      const Scalar4 vj = vp[j];
-      const double gx = vi.x - vj.x, gy = vi.y - vj.y, gz = vi.z - vj.z;
+      double vi0, vi1, vi2, vj0, vj1, vj2;  // contacts are rare: predicted velocities on demand
+      predicted(i, vi0, vi1, vi2);
+      predicted(j, vj0, vj1, vj2);
+      const double gx = vi0 - vj0, gy = vi1 - vj1, gz = vi2 - vj2;
       const double xi_dot = -(gx * nx + gy * ny + gz * nz);  // > 0 while approaching
       const double F = Potential::normalForce(xi, xi_dot, params);
       f0 += F * nx;
@@ -63,21 +71,17 @@ struct ContactForceFunctor {
       f2 += F * nz;
       mx = xi > mx ? xi : mx;
       if (j > i) {
-        // a collision is the first step at which the pair overlaps after not overlapping
-        const Scalar4 pi = pos_prev[i], pj = pos_prev[j];
-        const double px = box.minimumImageWrapped(pi.x - pj.x), py = box.minimumImageWrapped(pi.y - pj.y),
-                     pz = box.minimumImageWrapped(pi.z - pj.z);
+        // a collision is the first step at which the pair overlaps after not overlapping; the
+        // separation one step earlier is r - dt (u_i - u_j), the drift undone (antisymmetric in
+        // i and j to the last bit, so both partners agree)
+        const double px = rx - dt_prev * (vx[i] - vx[j]), py = ry - dt_prev * (vy[i] - vy[j]),
+                     pz = rz - dt_prev * (vz[i] - vz[j]);
         if (px * px + py * py + pz * pz >= 1.0) ++nnew;
       }
     }
     fx[i] = f0;
     fy[i] = f1;
     fz[i] = f2;
-    if (close_h != 0.0) {  // closing kick of velocity Verlet: v(t+dt) = v(t+dt/2) + (dt/2) f(t+dt)
-      vx[i] += close_h * f0;
-      vy[i] += close_h * f1;
-      vz[i] += close_h * f2;
-    }
     // v - v == 0 exactly for finite v and is NaN for NaN or inf: a finiteness test that needs no
     // math library in device code
     const double probe = f0 + f1 + f2 + xi_ + yi_ + zi_;
@@ -85,7 +89,6 @@ struct ContactForceFunctor {
     ContactStepResult res;
     res.collisions = nnew;
     res.worst = !finite ? 1 : (mx > max_overlap ? 2 : 0);
-    bad[i] = res.worst;
     return res;
   }
 };
@@ -148,18 +151,21 @@ struct MaxOverlapOf {
 
 template <class Potential>
 ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                                       const typename Potential::Params& params, double max_overlap,
-                                       double close_half_dt, ContactWork& w) {
+                                       const typename Potential::Params& params, double max_overlap, double dt,
+                                       ContactWork& w) {
   const int N = static_cast<int>(p.size());
-  if (w.bad.size() != p.size()) w.resize(p.size());
-  ContactForceFunctor<Potential> f{raw(p.pos), raw(p.pos_prev), raw(w.vp),
-                                   nl.rows(), nl.counts(), nl.capacity(), box, params, max_overlap, close_half_dt,
-                                   raw(p.fx), raw(p.fy), raw(p.fz), raw(p.vx), raw(p.vy), raw(p.vz),
-                                   raw(w.bad)};
+  const double half_dt = 0.5 * dt;
+  if (w.fx.size() != p.size()) w.resize(p.size());
+  ContactForceFunctor<Potential> f{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz),
+                                   nl.rows(), nl.counts(), nl.capacity(), box, params, max_overlap, half_dt, dt,
+                                   raw(w.fx), raw(w.fy), raw(w.fz)};
   // forces and, per block, collisions (sum) and the worst flag (max); then one reduction over blocks
   const int block = blockSizeFor(N);
   w.block_flags.resize(blockCount(N, block));
   forEachBlocked(N, block, f, CombineStepFlags{}, raw(w.block_flags));
+  p.fx.swap(w.fx);  // p.f = f(t); the old forces stay in w until the next pass overwrites them
+  p.fy.swap(w.fy);
+  p.fz.swap(w.fz);
   return thrust::reduce(w.block_flags.begin(), w.block_flags.end(), ContactStepResult{}, CombineStepFlags{});
 }
 

@@ -5,15 +5,19 @@
 /// Potential::normalForce -- the same HD function the unit tests call. Each thread writes only its
 /// own particle: no atomics, and sums in the sorted neighbour order (deterministic).
 ///
-/// Velocities in the dissipative term: velocity Verlet evaluates forces after the drift, when
-/// only the half-step velocity v(t+dt/2) is known. The approach rate uses the predicted
-/// v(t+dt) = v(t+dt/2) + (dt/2) f(t) / m (computed by kickDrift or predictVelocities), second
-/// order in dt like the rest of the scheme (using v(t+dt/2) directly, as LAMMPS' fix nve does, is
-/// first order in the damping force).
+/// State when the pass runs (velocity Verlet with the closing kick deferred, VelocityVerlet.h):
+/// positions x(t), velocities u = v(t - dt/2) (the drift velocities of the step just taken), forces
+/// f(t - dt). The pass writes f(t) and leaves v alone, so every partner's u is stable while others
+/// read it:
+/// - Dissipative term: it needs the normal velocity at t, when only u is known. The approach rate
+///   uses the predicted v(t) = u + (dt/2) f(t - dt) / m, second order in dt like the rest of the
+///   scheme (using u directly, as LAMMPS' fix nve does, is first order in the damping force).
+/// - Collisions: a pair in contact at t whose separation one step earlier, r - dt (u_i - u_j), was
+///   at least 1 has just collided.
 ///
-/// The per-step pass computes only what every step needs (forces, collisions, the NaN / overlap
-/// check) and closes the velocity-Verlet step; energies, overlaps and contact counts are a separate
-/// pass over the same list, run only when observables are sampled (contactSummary).
+/// The pass computes only what every step needs (forces, collisions, the NaN / overlap check);
+/// energies, overlaps and contact counts are a separate pass over the same list, run only when
+/// observables are sampled (contactSummary).
 #include <cstdint>
 
 #include "common/Box.h"
@@ -25,24 +29,24 @@ namespace granagg::md {
 /// What one force pass found.
 struct ContactStepResult {
   std::int64_t collisions = 0;  ///< pairs whose contact started at this step
-  int worst = 0;                ///< max of ContactWork::bad (0: all good)
+  int worst = 0;                ///< worst particle: 0 all good, 1 non-finite force or position, 2 overlap beyond the bound
 };
 
-/// Per-particle scratch of the force pass.
+/// Scratch of the force pass.
 struct ContactWork {
-  DVec<Scalar4> vp;               ///< predicted velocities v(t+dt) (input, see above; w unused)
-  DVec<int> bad;                  ///< 1: non-finite force or position, 2: overlap beyond the bound
+  DVec<double> fx, fy, fz;              ///< forces being computed (swapped with ParticleData's)
   DVec<ContactStepResult> block_flags;  ///< per-block partial results (md/engine/Launch.h)
   void resize(std::size_t n);
 };
 
-/// Contact forces of the current positions into p.fx, p.fy, p.fz (approach rates from work.vp),
-/// then the closing kick v += close_half_dt * f (pass 0 to leave v alone, e.g. for the forces of an
-/// initial state). \param max_overlap bound that flags a particle in work.bad.
+/// Contact forces of the current positions into p.fx, p.fy, p.fz (state as described above).
+/// \param dt the step just taken (0 for a state given at full step, e.g. an initial state: then
+/// v is v(t) itself and no pair counts as a new collision). \param max_overlap bound that flags
+/// the result.
 template <class Potential>
 ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                                       const typename Potential::Params& params, double max_overlap,
-                                       double close_half_dt, ContactWork& work);
+                                       const typename Potential::Params& params, double max_overlap, double dt,
+                                       ContactWork& work);
 
 /// Contact statistics of the current positions (positions only: no velocities needed).
 struct ContactSummary {

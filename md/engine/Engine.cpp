@@ -79,7 +79,7 @@ struct Engine::Impl {
   ParticleData p;
   NeighborList nl;
   ContactWork work;
-  DVec<double> block_max;  // kickDrift's per-block maximum displacements
+  DVec<double> block_max;  // kickDrift's per-block maximum speeds
   DVec<double> scratch_d;  // for permutations
   DVec<int> scratch_i;
   DVec<Scalar4> scratch4;
@@ -87,6 +87,8 @@ struct Engine::Impl {
   std::int64_t step = 0;
   double time = 0.0;
   std::int64_t collisions = 0;
+  bool close_pending = false;      // v holds u = v(t - dt/2): the closing kick is still to apply
+  double drift_since_build = 0.0;  // sum over steps of dt * max |u|: bounds every displacement
   bool hertz = true;
   HertzViscoelastic::Params hertz_params{};
   SpringDashpot::Params sd_params{};
@@ -95,7 +97,7 @@ struct Engine::Impl {
 
   /// Copies a host state (same N, wrapped, with images and charges) into the device arrays.
   void upload(const Frame& f) {
-    p.setPositions(f.x, f.y, f.z, f.charge);  // previous positions: overwritten by the next drift
+    p.setPositions(f.x, f.y, f.z, f.charge);
     toDevice(f.vx, p.vx);
     toDevice(f.vy, p.vy);
     toDevice(f.vz, p.vz);
@@ -112,36 +114,45 @@ struct Engine::Impl {
   void sortByCell() {
     const DVec<int>& order = nl.computeCellOrder(p, box);
     if (order.size() != p.size()) return;  // all-pairs builds: nothing to sort
-    for (auto* v : {&p.pos, &p.pos_prev, &work.vp}) permute(*v, order, scratch4);
+    permute(p.pos, order, scratch4);
     for (auto* v : {&p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz}) permute(*v, order, scratch_d);
     for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
   }
 
-  /// Forces of the current positions into p.f, then the closing kick v += close_half_dt f; counts
-  /// collisions; aborts on NaN / deep overlap. work.vp* must hold the predicted velocities.
-  /// \param max_displacement2 largest squared displacement since the last list build (from
-  /// kickDrift), or a negative value to have the list measure it.
-  void computeForces(double close_half_dt, double max_displacement2) {
-    if (max_displacement2 < 0.0 ? nl.needsRebuild(p, box) : nl.needsRebuild(p, max_displacement2)) {
-      // storage re-sorted at every build: the cost is a gather per array, far less than the
-      // cache misses of neighbours scattered in memory
-      sortByCell();
-      nl.build(p, box);
-    }
+  /// Builds the neighbour list for the current positions (storage first re-sorted by cell: the
+  /// cost is a gather per array, far less than the cache misses of neighbours scattered in memory).
+  void rebuildList(bool sort) {
+    if (sort) sortByCell();
+    nl.build(p, box);
+    drift_since_build = 0.0;
+  }
 
+  /// Forces of the current positions into p.f (state as in ContactForce.h; dt_taken = 0 for a
+  /// state given at full step); counts collisions; aborts on NaN / deep overlap.
+  void computeForces(double dt_taken) {
+    // Displacements since the last build are at most the sum of dt max|u| over the steps (a
+    // rigorous bound that needs no stored reference positions).
+    if (nl.needsRebuild(p, drift_since_build * drift_since_build)) rebuildList(true);
     const ContactStepResult r =
-        hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, cfg.run.max_overlap, close_half_dt, work)
-              : computeContactForces<SpringDashpot>(p, nl, box, sd_params, cfg.run.max_overlap, close_half_dt, work);
+        hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, cfg.run.max_overlap, dt_taken, work)
+              : computeContactForces<SpringDashpot>(p, nl, box, sd_params, cfg.run.max_overlap, dt_taken, work);
     if (r.worst != 0) abort(r.worst);
     collisions += r.collisions;
   }
 
-  /// Forces of a state given at full step (initial state): predicted velocities are v itself
-  /// (f = 0 until the first evaluation) and v is left alone.
+  /// Forces of a state given at full step (initial or restored state without forces): the
+  /// predicted velocities are v itself and no pair counts as a new collision.
   void computeInitialForces() {
     for (auto* f : {&p.fx, &p.fy, &p.fz}) thrust::fill(f->begin(), f->end(), 0.0);
-    predictVelocities(p, 0.0, work.vp);
-    computeForces(0.0, -1.0);
+    computeForces(0.0);
+    close_pending = false;
+  }
+
+  /// Applies a deferred closing kick: afterwards v = v(t).
+  void finishStep() {
+    if (!close_pending) return;
+    closeKick(p, 0.5 * dt);
+    close_pending = false;
   }
 
   ContactSummary summary() const {
@@ -150,13 +161,20 @@ struct Engine::Impl {
   }
 
   [[noreturn]] void abort(int worst) {
-    const auto bad = toHostById(work.bad, p.id);
     DVec<double> mx_slots;
     if (hertz)
       maxOverlapPerParticle<HertzViscoelastic>(p, nl, box, hertz_params, mx_slots);
     else
       maxOverlapPerParticle<SpringDashpot>(p, nl, box, sd_params, mx_slots);
     const auto mx = toHostById(mx_slots, p.id);
+    // which particles: the force pass's test again, per particle (cold path)
+    const auto pos = toHostById(p.pos, p.id);
+    const auto fx = toHostById(p.fx, p.id), fy = toHostById(p.fy, p.id), fz = toHostById(p.fz, p.id);
+    std::vector<int> bad(pos.size(), 0);
+    for (std::size_t i = 0; i < bad.size(); ++i) {
+      const bool finite = std::isfinite(pos[i].x + pos[i].y + pos[i].z + fx[i] + fy[i] + fz[i]);
+      bad[i] = !finite ? 1 : (mx[i] > cfg.run.max_overlap ? 2 : 0);
+    }
     std::ostringstream msg;
     msg << "step " << step << " (t = " << time << "): ";
     msg << (worst == 1 ? "non-finite force or position (NaN/inf)" : "overlap beyond run.max_overlap = ");
@@ -173,14 +191,16 @@ struct Engine::Impl {
     throw RunAborted(msg.str());
   }
 
-  /// One velocity-Verlet step in two passes (VelocityVerlet.h): kick + drift (+ predicted
-  /// velocities), then forces + closing kick.
+  /// One velocity-Verlet step in two passes (VelocityVerlet.h): [previous closing kick +] opening
+  /// kick + drift, then forces; the closing kick stays pending.
   void doStep() {
-    const double h = 0.5 * dt;
-    const double moved2 = kickDrift(p, h, dt, box, work.vp, nl.referencePositions(p.size()), block_max);
+    const double max_u2 = kickDrift(p, 0.5 * dt, dt, box, close_pending, block_max);
+    close_pending = false;
+    drift_since_build += dt * std::sqrt(max_u2);
     ++step;
     time = step * dt;  // no accumulated round-off in t
-    computeForces(h, moved2);
+    computeForces(dt);
+    close_pending = true;
   }
 };
 
@@ -242,7 +262,7 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
   d.time = init.step * d.dt;
 
   // overlapping initial states are refused (design.md section 2 / ground rules: bad input)
-  d.nl.build(d.p, d.box);
+  d.rebuildList(false);
   if (allow_contacts) {
     d.computeInitialForces();
     return;
@@ -267,6 +287,7 @@ Engine::~Engine() = default;
 
 void Engine::run(std::int64_t steps) {
   for (std::int64_t s = 0; s < steps; ++s) m_impl->doStep();
+  m_impl->finishStep();  // callers see full-step velocities
 }
 
 Frame Engine::frame() const {
@@ -318,7 +339,8 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
   d.step = s.step;
   d.time = s.step * d.dt;
   d.collisions = collisions;
-  d.nl.build(d.p, d.box);
+  d.close_pending = false;
+  d.rebuildList(false);
 }
 
 Observables Engine::observables() const {

@@ -36,7 +36,6 @@ struct alignas(32) Scalar4 {
 
 struct ParticleData {
   DVec<Scalar4> pos;       ///< wrapped positions in [0, L) (x, y, z) and charge (w)
-  DVec<Scalar4> pos_prev;  ///< positions one step earlier (collision = first overlapping step)
   DVec<double> vx, vy, vz;
   DVec<double> fx, fy, fz;  ///< forces of the current positions
   DVec<int> ix, iy, iz;     ///< image counts
@@ -45,20 +44,18 @@ struct ParticleData {
   DVec<int> id;
   void resize(std::size_t n) {
     pos.assign(n, Scalar4{0, 0, 0, 0});
-    pos_prev.assign(n, Scalar4{0, 0, 0, 0});
     for (auto* v : {&vx, &vy, &vz, &fx, &fy, &fz}) v->assign(n, 0.0);
     for (auto* v : {&ix, &iy, &iz}) v->assign(n, 0);
     id.resize(n);
     thrust::sequence(id.begin(), id.end());
   }
   std::size_t size() const { return pos.size(); }
-  /// Sets positions and charges from host arrays (slot order); pos_prev = pos.
+  /// Sets positions and charges from host arrays (slot order).
   void setPositions(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z,
                     const std::vector<double>& q) {
     std::vector<Scalar4> h(x.size());
     for (std::size_t i = 0; i < h.size(); ++i) h[i] = Scalar4{x[i], y[i], z[i], q.empty() ? 0.0 : q[i]};
     pos.assign(h.begin(), h.end());
-    pos_prev = pos;
   }
 };
 

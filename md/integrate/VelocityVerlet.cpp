@@ -10,13 +10,6 @@
 namespace granagg::md {
 
 namespace {
-struct Predict {
-  const double *vx, *vy, *vz, *fx, *fy, *fz;
-  Scalar4* vp;
-  double h;
-  HD void operator()(int i) const { vp[i] = Scalar4{vx[i] + h * fx[i], vy[i] + h * fy[i], vz[i] + h * fz[i], 0.0}; }
-};
-
 struct MaxReduction {
   using value_type = double;
   HD static double identity() { return 0.0; }
@@ -24,54 +17,67 @@ struct MaxReduction {
 };
 
 struct KickDrift {
-  Scalar4 *pos, *pos_prev, *vp;
+  Scalar4* pos;
   double *vx, *vy, *vz;
   const double *fx, *fy, *fz;
   int *ix, *iy, *iz;
-  const Scalar4* reference;
   double h, dt;
+  bool close_pending;
   common::Box box;
-  /// returns the squared displacement from the reference positions
+  /// returns |u|^2 of the drift velocity
   HD double operator()(int i) const {
     const double f0 = fx[i], f1 = fy[i], f2 = fz[i];
-    const double u0 = vx[i] + h * f0, u1 = vy[i] + h * f1, u2 = vz[i] + h * f2;  // v(t + dt/2)
+    double u0 = vx[i], u1 = vy[i], u2 = vz[i];
+    if (close_pending) {  // v(t) = u(t - dt/2) + (dt/2) f(t)
+      u0 += h * f0;
+      u1 += h * f1;
+      u2 += h * f2;
+    }
+    u0 += h * f0;  // u(t + dt/2) = v(t) + (dt/2) f(t)
+    u1 += h * f1;
+    u2 += h * f2;
     vx[i] = u0;
     vy[i] = u1;
     vz[i] = u2;
-    vp[i] = Scalar4{u0 + h * f0, u1 + h * f1, u2 + h * f2, 0.0};  // predicted v(t + dt) (ContactForce.h)
     const Scalar4 r = pos[i];
-    pos_prev[i] = r;
     double a = r.x + dt * u0, b = r.y + dt * u1, c = r.z + dt * u2;
-    ix[i] += box.wrap(a);
-    iy[i] += box.wrap(b);
-    iz[i] += box.wrap(c);
+    // image counts are touched only when a particle crosses a face (rare)
+    const int sa = box.wrap(a), sb = box.wrap(b), sc = box.wrap(c);
+    if (sa) ix[i] += sa;
+    if (sb) iy[i] += sb;
+    if (sc) iz[i] += sc;
     pos[i] = Scalar4{a, b, c, r.w};
-    if (!reference) return 0.0;
-    const Scalar4 r0 = reference[i];
-    const double dx = box.minimumImageWrapped(a - r0.x), dy = box.minimumImageWrapped(b - r0.y),
-                 dz = box.minimumImageWrapped(c - r0.z);
-    return dx * dx + dy * dy + dz * dz;
+    return u0 * u0 + u1 * u1 + u2 * u2;
+  }
+};
+
+struct CloseKick {
+  double *vx, *vy, *vz;
+  const double *fx, *fy, *fz;
+  double h;
+  HD void operator()(int i) const {
+    vx[i] += h * fx[i];
+    vy[i] += h * fy[i];
+    vz[i] += h * fz[i];
   }
 };
 }  // namespace
 
-void predictVelocities(const ParticleData& p, double half_dt, DVec<Scalar4>& vp) {
-  vp.resize(p.size());
-  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(static_cast<int>(p.size())),
-                   Predict{raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(vp), half_dt});
-}
-
-double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, DVec<Scalar4>& vp,
-                 const Scalar4* reference, DVec<double>& block_max) {
+double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending,
+                 DVec<double>& block_max) {
   const int n = static_cast<int>(p.size());
-  vp.resize(p.size());
   const int block = blockSizeFor(n);
   block_max.resize(blockCount(n, block));
   forEachBlocked(n, block,
-                 KickDrift{raw(p.pos), raw(p.pos_prev), raw(vp), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy),
-                           raw(p.fz), raw(p.ix), raw(p.iy), raw(p.iz), reference, half_dt, dt, box},
+                 KickDrift{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(p.ix),
+                           raw(p.iy), raw(p.iz), half_dt, dt, close_pending, box},
                  MaxReduction{}, raw(block_max));
   return thrust::reduce(block_max.begin(), block_max.end(), 0.0, thrust::maximum<double>());
+}
+
+void closeKick(ParticleData& p, double half_dt) {
+  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(static_cast<int>(p.size())),
+                   CloseKick{raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), half_dt});
 }
 
 }  // namespace granagg::md

@@ -5,25 +5,26 @@
 /// -- symplectic and time-reversible for conservative forces: energy errors O(dt^2), no drift
 /// (Swope et al., J. Chem. Phys. 76, 637 (1982)).
 ///
-/// The engine runs the first half (kick and drift) as one pass, kickDrift(), which also stores the
-/// predicted full-step velocity the dissipative contact force needs (ContactForce.h), and the
-/// closing kick inside the force pass (computeContactForces) as soon as a particle's new force is
-/// known: two passes over the particles per step instead of five, with the same arithmetic in the
-/// same order (bit-identical to separate kick / drift / predict / kick passes).
+/// The engine runs a step as two passes over the particles: kickDrift() (opening kick and drift)
+/// and the force pass (ContactForce.h). The closing kick of a step is deferred to the opening pass
+/// of the next one, which applies both kicks, (v + (dt/2) f) + (dt/2) f, in the same order as
+/// separate passes would (bit-identical); when a full-step velocity is wanted between steps
+/// (output, observables, checkpoints) closeKick() applies it alone. Between the passes v therefore
+/// holds the drift velocity u = v(t - dt/2), which the force pass reads for neighbours while
+/// writing the new forces elsewhere: no particle's data changes while others read it.
 #include "common/Box.h"
 #include "md/engine/ParticleData.h"
 
 namespace granagg::md {
 
-/// Predicted full-step velocities vp = v + half_dt f (packed; w unused).
-void predictVelocities(const ParticleData& p, double half_dt, DVec<Scalar4>& vp);
+/// Opening pass of a step: [if close_pending: v += half_dt f (the previous step's closing kick)];
+/// v += half_dt f; x += dt v; wrap into [0, L) and update the image counts.
+/// Returns the largest |v|^2 of the drift velocities (a bound on this step's displacements for the
+/// neighbour-list check). \param block_max scratch for the per-block maxima.
+double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending,
+                 DVec<double>& block_max);
 
-/// Opening half of a step: v += half_dt f; vp = v + half_dt f (prediction of v(t + dt));
-/// pos_prev = pos; x += dt v; wrap into [0, L) and update the image counts.
-/// Returns the largest squared displacement from `reference` (the neighbour list's positions at its
-/// last build, NeighborList::referencePositions(); 0 if null), computed in the same pass.
-/// \param block_max scratch for the per-block maxima.
-double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, DVec<Scalar4>& vp,
-                 const Scalar4* reference, DVec<double>& block_max);
+/// The closing kick alone: v += half_dt f.
+void closeKick(ParticleData& p, double half_dt);
 
 }  // namespace granagg::md

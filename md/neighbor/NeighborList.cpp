@@ -11,7 +11,6 @@
 #include <thrust/reduce.h>
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
-#include <thrust/transform_reduce.h>
 
 namespace granagg::md {
 
@@ -135,40 +134,14 @@ struct BuildAllPairs {
   }
 };
 
-struct Displacement2 {
-  const Scalar4 *pos, *pos0;
-  common::Box box;
-  HD double operator()(int i) const {
-    const Scalar4 a = pos[i], b = pos0[i];
-    const double dx = box.minimumImageWrapped(a.x - b.x), dy = box.minimumImageWrapped(a.y - b.y),
-                 dz = box.minimumImageWrapped(a.z - b.z);
-    return dx * dx + dy * dy + dz * dz;
-  }
-};
-
 }  // namespace
 
 NeighborList::NeighborList(double cutoff, double skin) : m_cutoff(cutoff), m_skin(skin) {
   if (!(cutoff > 0.0) || !(skin > 0.0)) throw std::invalid_argument("neighbour list needs cutoff > 0 and skin > 0.");
 }
 
-bool NeighborList::needsRebuild(const ParticleData& p, const common::Box& box) {
-  const int N = static_cast<int>(p.size());
-  if (m_builds == 0 || static_cast<int>(m_pos0.size()) != N) return true;
-  const double max2 = thrust::transform_reduce(
-      thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
-      Displacement2{raw(p.pos), raw(m_pos0), box}, 0.0, thrust::maximum<double>());
-  return needsRebuild(p, max2);
-}
-
 bool NeighborList::needsRebuild(const ParticleData& p, double max_displacement2) const {
-  return m_builds == 0 || m_pos0.size() != p.size() || !(max_displacement2 <= 0.25 * m_skin * m_skin);  // NaN: rebuild
-}
-
-bool NeighborList::update(const ParticleData& p, const common::Box& box) {
-  if (!needsRebuild(p, box)) return false;
-  build(p, box);
-  return true;
+  return m_builds == 0 || m_built_n != p.size() || !(max_displacement2 <= 0.25 * m_skin * m_skin);  // NaN: rebuild
 }
 
 int NeighborList::cellsPerSide(const common::Box& box) const {
@@ -226,7 +199,7 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
     }
     m_capacity = most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
   }
-  m_pos0 = p.pos;
+  m_built_n = p.size();
   ++m_builds;
 }
 

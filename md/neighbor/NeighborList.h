@@ -21,19 +21,14 @@ class NeighborList {
   /// \param cutoff interaction range (1 for contacts); \param skin added to it for the list.
   NeighborList(double cutoff, double skin);
 
-  /// Rebuilds if any particle moved more than skin/2 since the last build (or never built).
-  /// Returns true if it rebuilt.
-  bool update(const ParticleData& p, const common::Box& box);
-  /// True if some particle moved more than skin/2 since the last build (measured here), or never built.
-  bool needsRebuild(const ParticleData& p, const common::Box& box);
-  /// The same test given max_displacement2, the largest squared displacement since the last build
-  /// (e.g. from kickDrift, which measures it in its own pass).
+  /// True if never built (for this N) or if max_displacement2, a bound on the largest squared
+  /// displacement of any particle since the last build, exceeds (skin/2)^2 (then a pair may have
+  /// come within the cutoff unseen). The engine bounds displacements by the sum over steps of
+  /// dt max|v|, which kickDrift measures in its own pass.
   bool needsRebuild(const ParticleData& p, double max_displacement2) const;
   /// Slots sorted by cell for the current positions (stable), without building the list; empty if
   /// the box is too small for cells (all-pairs builds). For sorting the particle storage.
   const DVec<int>& computeCellOrder(const ParticleData& p, const common::Box& box);
-  /// Positions at the last build (slot order), or null before the first build / after N changed.
-  const Scalar4* referencePositions(std::size_t n) const { return m_builds > 0 && m_pos0.size() == n ? raw(m_pos0) : nullptr; }
   /// Unconditional rebuild.
   void build(const ParticleData& p, const common::Box& box);
 
@@ -49,7 +44,7 @@ class NeighborList {
   int m_capacity = 16;  // grows on overflow, shrinks when rows are mostly empty
   std::int64_t m_builds = 0;
   DVec<int> m_list, m_count;
-  DVec<Scalar4> m_pos0;  // positions at the last build
+  std::size_t m_built_n = 0;  // N at the last build
   DVec<int> m_cell, m_order, m_cell_start;
 };
 

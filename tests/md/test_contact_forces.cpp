@@ -87,9 +87,8 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   NeighborList nl(1.0, 0.3);
   nl.build(p, box);
   ContactWork w;
-  // half_dt = 0: predicted velocities equal v, as in the reference; no closing kick. Overlap bound
-  // 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite force.
-  predictVelocities(p, 0.0, w.vp);
+  // dt = 0: a state at full step, so the predicted velocities equal v, as in the reference. Overlap
+  // bound 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite force.
   const auto flags = computeContactForces<HertzViscoelastic>(p, nl, box, prm, 1.0, 0.0, w);
   CHECK(flags.worst == 0);
   std::vector<double> ref;
