@@ -76,6 +76,9 @@ std::vector<std::pair<std::string, double>> observableRow(const md::Observables&
           {"contacts_per_particle", o.contacts_per_particle},
           {"collisions", static_cast<double>(o.collisions)},
           {"mean_overlap", o.mean_overlap},
+          {"total_charge", o.total_charge},
+          {"mean_abs_charge", o.mean_abs_charge},
+          {"max_abs_charge", o.max_abs_charge},
           {"max_overlap", o.max_overlap}};
 }
 
@@ -148,6 +151,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     if (static_cast<int>(init.size()) != cfg.system.N)
       throw std::invalid_argument("system.initial '" + cfg.system.initial + "' holds " + std::to_string(init.size()) +
                                   " particles but system.N = " + std::to_string(cfg.system.N));
+    md::Engine::assignInitialCharges(cfg, init);
   }
   md::Engine engine(cfg, init, /*allow_contacts=*/restart);
   if (restart) {

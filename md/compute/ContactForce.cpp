@@ -32,6 +32,11 @@ struct ContactForceFunctor {
   typename Potential::Params params;
   double max_overlap, h_pred, dt_prev;
   double *fx, *fy, *fz;  // f(t), written
+  // collisional charging (null dq: off): the charge each particle gains at its new contacts
+  const int* id;
+  ChargeExchange::Params charging;
+  std::int64_t step;
+  double* dq;
 
   /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old
   HD void predicted(int k, double& a, double& b, double& c) const {
@@ -44,7 +49,7 @@ struct ContactForceFunctor {
   HD ContactStepResult operator()(int i) const {
     const Scalar4 ri = pos[i];
     const double xi_ = ri.x, yi_ = ri.y, zi_ = ri.z;
-    double f0 = 0.0, f1 = 0.0, f2 = 0.0, mx = 0.0;
+    double f0 = 0.0, f1 = 0.0, f2 = 0.0, mx = 0.0, dqi = 0.0;
     int nnew = 0;
     const int* row = rows + static_cast<long>(i) * cap;
     const int n = counts[i];
@@ -70,18 +75,22 @@ struct ContactForceFunctor {
       f1 += F * ny;
       f2 += F * nz;
       mx = xi > mx ? xi : mx;
-      if (j > i) {
-        // a collision is the first step at which the pair overlaps after not overlapping; the
-        // separation one step earlier is r - dt (u_i - u_j), the drift undone (antisymmetric in
-        // i and j to the last bit, so both partners agree)
-        const double px = rx - dt_prev * (vx[i] - vx[j]), py = ry - dt_prev * (vy[i] - vy[j]),
-                     pz = rz - dt_prev * (vz[i] - vz[j]);
-        if (px * px + py * py + pz * pz >= 1.0) ++nnew;
+      // a collision is the first step at which the pair overlaps after not overlapping; the
+      // separation one step earlier is r - dt (u_i - u_j), the drift undone (antisymmetric in i
+      // and j to the last bit, so both partners agree, as they must for the charge exchange)
+      const double px = rx - dt_prev * (vx[i] - vx[j]), py = ry - dt_prev * (vy[i] - vy[j]),
+                   pz = rz - dt_prev * (vz[i] - vz[j]);
+      if (px * px + py * py + pz * pz >= 1.0) {
+        if (j > i) ++nnew;  // each collision counted once
+        if (dq)             // xi_dot is the same for both partners (g and n both change sign)
+          dqi += ChargeExchange::transferTo(charging, step, static_cast<std::uint32_t>(id[i]),
+                                            static_cast<std::uint32_t>(id[j]), xi_dot);
       }
     }
     fx[i] = f0;
     fy[i] = f1;
     fz[i] = f2;
+    if (dqi != 0.0) dq[i] = dqi;  // applied by the next kick pass (charges are read by others now)
     // v - v == 0 exactly for finite v and is NaN for NaN or inf: a finiteness test that needs no
     // math library in device code
     const double probe = f0 + f1 + f2 + xi_ + yi_ + zi_;
@@ -151,14 +160,14 @@ struct MaxOverlapOf {
 
 template <class Potential>
 ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                                       const typename Potential::Params& params, double max_overlap, double dt,
+                                       const typename Potential::Params& params, const ContactStep& st,
                                        ContactWork& w) {
   const int N = static_cast<int>(p.size());
-  const double half_dt = 0.5 * dt;
+  const double dt = st.dt, half_dt = 0.5 * dt;
   if (w.fx.size() != p.size()) w.resize(p.size());
   ContactForceFunctor<Potential> f{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz),
-                                   nl.rows(), nl.counts(), nl.capacity(), box, params, max_overlap, half_dt, dt,
-                                   raw(w.fx), raw(w.fy), raw(w.fz)};
+                                   nl.rows(), nl.counts(), nl.capacity(), box, params, st.max_overlap, half_dt, dt,
+                                   raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id), st.charging, st.step, st.dq};
   // forces and, per block, collisions (sum) and the worst flag (max); then one reduction over blocks
   const int block = blockSizeFor(N);
   w.block_flags.resize(blockCount(N, block));
@@ -191,7 +200,7 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
 // the contact models: adding one = one header + one line per function here
 #define GRANAGG_CONTACT_MODEL(P)                                                                                  \
   template ContactStepResult computeContactForces<P>(ParticleData&, const NeighborList&, const common::Box&,      \
-                                                     const P::Params&, double, double, ContactWork&);            \
+                                                     const P::Params&, const ContactStep&, ContactWork&);        \
   template ContactSummary contactSummary<P>(const ParticleData&, const NeighborList&, const common::Box&,          \
                                             const P::Params&);                                                    \
   template void maxOverlapPerParticle<P>(const ParticleData&, const NeighborList&, const common::Box&,             \

@@ -23,6 +23,7 @@
 #include "common/Box.h"
 #include "md/engine/ParticleData.h"
 #include "md/neighbor/NeighborList.h"
+#include "md/potentials/ChargeExchange.h"
 
 namespace granagg::md {
 
@@ -39,13 +40,23 @@ struct ContactWork {
   void resize(std::size_t n);
 };
 
-/// Contact forces of the current positions into p.fx, p.fy, p.fz (state as described above).
-/// \param dt the step just taken (0 for a state given at full step, e.g. an initial state: then
-/// v is v(t) itself and no pair counts as a new collision). \param max_overlap bound that flags
-/// the result.
+/// What the force pass needs to know about the step.
+struct ContactStep {
+  double dt = 0.0;           ///< the step just taken (0 for a state given at full step, e.g. an initial
+                             ///< state: v is then v(t) itself and no pair counts as a new collision)
+  double max_overlap = 1.0;  ///< an overlap beyond this flags the result
+  std::int64_t step = 0;     ///< step number (counter of the charge-exchange random numbers)
+  ChargeExchange::Params charging{};
+  /// Charging on: per-particle charge gained this step, written where nonzero (the caller applies
+  /// and clears it before the next pass: kickDrift / closeKick). Null: no charging.
+  double* dq = nullptr;
+};
+
+/// Contact forces of the current positions into p.fx, p.fy, p.fz (state as described above),
+/// collisions, and with charging the charge each particle gains at its new contacts.
 template <class Potential>
 ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                                       const typename Potential::Params& params, double max_overlap, double dt,
+                                       const typename Potential::Params& params, const ContactStep& step,
                                        ContactWork& work);
 
 /// Contact statistics of the current positions (positions only: no velocities needed).

@@ -67,6 +67,16 @@ const std::vector<Section>& schema() {
         Key{"impact_speed_max", +[](MdConfig& c) -> double& { return c.integrator.impact_speed_max; },
             true}}},
       {"neighbor", {GRANAGG_KEY(neighbor, skin)}},
+      {"charging",
+       {GRANAGG_KEY(charging, mode), GRANAGG_KEY(charging, initial), GRANAGG_KEY(charging, q0),
+        GRANAGG_KEY(charging, Q), GRANAGG_KEY(charging, kappa), GRANAGG_KEY(charging, psi1_min),
+        GRANAGG_KEY(charging, psi1_max), GRANAGG_KEY(charging, psi2_fraction)}},
+      {"coulomb",
+       {GRANAGG_KEY(coulomb, K), GRANAGG_KEY(coulomb, method), GRANAGG_KEY(coulomb, accuracy),
+        Key{"r_cut", +[](MdConfig& c) -> double& { return c.coulomb.r_cut; }, true},
+        Key{"mesh", +[](MdConfig& c) -> int& { return c.coulomb.mesh; }, true},
+        Key{"order", +[](MdConfig& c) -> int& { return c.coulomb.order; }, true},
+        GRANAGG_KEY(coulomb, kspace_every)}},
       {"run", {GRANAGG_KEY(run, t_end), GRANAGG_KEY(run, max_overlap)}},
       {"output",
        {GRANAGG_KEY(output, frames_per_decade), GRANAGG_KEY(output, frame_interval),
@@ -252,8 +262,14 @@ struct Issue {
 std::string assign(const Key& key, const std::string& full, const toml::node& node, MdConfig& config) {
   const std::string got = ", got " + describe(node);
   if (auto r = std::get_if<IntRef>(&key.ref)) {
+    if (auto str = node.as_string(); str && key.auto_allowed && str->get() == "auto") {
+      (*r)(config) = 0;  // zero is how "auto" is stored
+      return "";
+    }
     auto v = node.as_integer();
-    if (!v) return full + " must be an integer" + got;
+    if (!v) return full + (key.auto_allowed ? " must be an integer or \"auto\"" : " must be an integer") + got;
+    if (key.auto_allowed && v->get() <= 0)
+      return full + " = " + std::to_string(v->get()) + " is invalid: must be > 0 or \"auto\"";
     if (v->get() < std::numeric_limits<int>::min() || v->get() > std::numeric_limits<int>::max())
       return full + " = " + std::to_string(v->get()) + " is out of range for a 32-bit integer";
     (*r)(config) = static_cast<int>(v->get());
@@ -443,7 +459,10 @@ MdConfig parseImpl(const std::string& text, const std::string& source_name,
 // One value as text: TOML literal (toml = true) or plain provenance text.
 std::string valueText(const Key& key, const MdConfig& config, bool toml) {
   MdConfig& c = const_cast<MdConfig&>(config);  // the accessors only read here
-  if (auto r = std::get_if<IntRef>(&key.ref)) return std::to_string((*r)(c));
+  if (auto r = std::get_if<IntRef>(&key.ref)) {
+    if (key.auto_allowed && (*r)(c) == 0) return toml ? "\"auto\"" : "auto";
+    return std::to_string((*r)(c));
+  }
   if (auto r = std::get_if<LongRef>(&key.ref)) return std::to_string((*r)(c));
   if (auto r = std::get_if<SeedRef>(&key.ref)) {
     const std::uint64_t s = (*r)(c);
@@ -513,6 +532,33 @@ void validateConfig(const MdConfig& c) {
 
   if (!(c.neighbor.skin > 0.0 && c.neighbor.skin <= 2.0))
     invalid("neighbor.skin", formatReal(c.neighbor.skin), "lie in (0, 2]");
+
+  const ChargingConfig& q = c.charging;
+  if (q.mode != "exchange" && q.mode != "fixed")
+    invalid("charging.mode", quote(q.mode), "be one of \"exchange\", \"fixed\"");
+  if (q.initial != "neutral" && q.initial != "monopolar" && q.initial != "bipolar" && q.initial != "file")
+    invalid("charging.initial", quote(q.initial), "be one of \"neutral\", \"monopolar\", \"bipolar\", \"file\"");
+  if (q.initial == "file" && s.initial == "random")
+    invalid("charging.initial", quote(q.initial), "be used with system.initial = a file that holds charges");
+  if (!(q.q0 > 0.0 && finite(q.q0))) invalid("charging.q0", formatReal(q.q0), "be > 0 and finite");
+  if (!(q.Q >= 0.0 && finite(q.Q))) invalid("charging.Q", formatReal(q.Q), "be >= 0 and finite");
+  if (!(q.kappa > 0.0 && finite(q.kappa))) invalid("charging.kappa", formatReal(q.kappa), "be > 0 and finite");
+  if (!(q.psi1_min > 0.0 && q.psi1_max >= q.psi1_min && finite(q.psi1_max)))
+    invalid("charging.psi1_min", formatReal(q.psi1_min), "be > 0 and <= charging.psi1_max (" + formatReal(q.psi1_max) + ")");
+  if (!(q.psi2_fraction >= 0.0 && q.psi2_fraction < 1.0))
+    invalid("charging.psi2_fraction", formatReal(q.psi2_fraction), "lie in [0, 1)");
+
+  const CoulombConfig& e = c.coulomb;
+  if (!(e.K >= 0.0 && finite(e.K))) invalid("coulomb.K", formatReal(e.K), "be >= 0 and finite");
+  if (e.method != "pppm" && e.method != "ewald")
+    invalid("coulomb.method", quote(e.method), "be one of \"pppm\", \"ewald\"");
+  if (!(e.accuracy > 0.0 && e.accuracy < 0.1))
+    invalid("coulomb.accuracy", formatReal(e.accuracy), "lie in (0, 0.1) (relative RMS force error)");
+  if (!(e.r_cut >= 0.0 && finite(e.r_cut))) invalid("coulomb.r_cut", formatReal(e.r_cut), "be > 0 or \"auto\"");
+  if (e.mesh < 0) invalid("coulomb.mesh", std::to_string(e.mesh), "be > 0 or \"auto\"");
+  if (e.order < 0 || e.order == 1 || e.order > 7)
+    invalid("coulomb.order", std::to_string(e.order), "lie in 2..7 or be \"auto\"");
+  if (e.kspace_every < 1) invalid("coulomb.kspace_every", std::to_string(e.kspace_every), "be >= 1");
 
   if (!(c.run.t_end > 0.0 && finite(c.run.t_end)))
     invalid("run.t_end", formatReal(c.run.t_end), "be > 0 and finite");

@@ -12,6 +12,10 @@
 ///     [contact]     model ("hertz" | "spring_dashpot"), E, D, clamp, stiffness, restitution
 ///     [integrator]  dt ("auto" or a number), steps_per_contact, impact_speed_max ("auto" or number)
 ///     [neighbor]    skin
+///     [charging]    mode ("exchange" | "fixed"), initial ("neutral" | "monopolar" | "bipolar" | "file"),
+///                   q0, Q, kappa, psi1_min, psi1_max, psi2_fraction
+///     [coulomb]     K, method ("pppm" | "ewald"), accuracy, r_cut, mesh, order ("auto" or numbers),
+///                   kspace_every
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
 ///                   checkpoint_wall_seconds, write_velocities
@@ -50,6 +54,33 @@ struct NeighborConfig {
   double skin = 0.3;            ///< Verlet skin; lists rebuilt when a particle moved skin/2
 };
 
+/// Collisional charging (design.md section 2): at the first step of a contact, |dq| =
+/// Q [Psi1 m_eff xi'^2]^(kappa + Psi2) moves from one partner to the other (sign + or - with
+/// probability 1/2), Psi1 ~ U[psi1_min, psi1_max], Psi2 ~ U[-psi2_fraction kappa, +psi2_fraction kappa].
+struct ChargingConfig {
+  std::string mode = "exchange";   ///< "exchange" (the paper's model) or "fixed" (charges never change)
+  /// initial charges: "neutral" (all 0), "monopolar" (all +q0), "bipolar" (+q0 or -q0 at random,
+  /// zero net charge for even N), "file" (from system.initial)
+  std::string initial = "neutral";
+  double q0 = 1.0;                 ///< charge magnitude of monopolar / bipolar initial states
+  double Q = 1.0;                  ///< charge scale of the exchange rule
+  double kappa = 0.83;             ///< exponent (Poppe et al. 2000, silica)
+  double psi1_min = 0.1;           ///< Psi1 range: U[0.1, 3.1623], mean 1.63
+  double psi1_max = 3.1623;
+  double psi2_fraction = 0.05;     ///< Psi2 ~ U[-0.05 kappa, +0.05 kappa] (mean 0; the paper's typo, design.md)
+};
+
+/// Coulomb interaction K q_i q_k / r^2 with all periodic images (Ewald, tinfoil boundary).
+struct CoulombConfig {
+  double K = 0.0;                  ///< Coulomb constant l_B / d (paper: 0, 0.25, 1, 5); 0 switches Coulomb off
+  std::string method = "pppm";     ///< "pppm" (particle-mesh Ewald, production) or "ewald" (plain, reference)
+  double accuracy = 1e-4;          ///< requested relative RMS force accuracy (docs/coulomb.md)
+  double r_cut = 0.0;              ///< real-space cutoff; 0 = "auto"
+  int mesh = 0;                    ///< mesh points per side (pppm); 0 = "auto"
+  int order = 0;                   ///< charge-assignment order 2..7 (pppm); 0 = "auto"
+  int kspace_every = 1;            ///< evaluate the mesh (k-space) part every this many steps
+};
+
 struct RunConfig {
   double t_end = 100.0;         ///< simulated time to reach
   /// stop (keeping the last checkpoint) if an overlap exceeds this. The paper's soft contacts
@@ -73,6 +104,8 @@ struct MdConfig {
   ContactConfig contact;
   IntegratorConfig integrator;
   NeighborConfig neighbor;
+  ChargingConfig charging;
+  CoulombConfig coulomb;
   RunConfig run;
   OutputConfig output;
 };

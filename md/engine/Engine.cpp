@@ -67,6 +67,20 @@ void permute(DVec<T>& d, const DVec<int>& order, DVec<T>& scratch) {
 struct Square {
   HD double operator()(double v) const { return v * v; }
 };
+struct ChargeSums {
+  double total = 0.0, abs_sum = 0.0, abs_max = 0.0;
+};
+struct ChargeOf {
+  HD ChargeSums operator()(const Scalar4& r) const {
+    const double a = r.w < 0.0 ? -r.w : r.w;
+    return ChargeSums{r.w, a, a};
+  }
+};
+struct CombineCharges {
+  HD ChargeSums operator()(const ChargeSums& a, const ChargeSums& b) const {
+    return ChargeSums{a.total + b.total, a.abs_sum + b.abs_sum, a.abs_max > b.abs_max ? a.abs_max : b.abs_max};
+  }
+};
 struct Abs3 {
   const double *vx, *vy, *vz;
   HD double operator()(int i) const { return sqrt(vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]); }
@@ -89,11 +103,25 @@ struct Engine::Impl {
   std::int64_t collisions = 0;
   bool close_pending = false;      // v holds u = v(t - dt/2): the closing kick is still to apply
   double drift_since_build = 0.0;  // sum over steps of dt * max |u|: bounds every displacement
+  bool exchange = false;           // collisional charging on (charging.mode = "exchange")
+  ChargeExchange::Params charging{};
+  DVec<double> dq;                 // charge gained at the last force pass, per slot (exchange only)
   bool hertz = true;
   HertzViscoelastic::Params hertz_params{};
   SpringDashpot::Params sd_params{};
 
-  explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {}
+  explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
+    exchange = c.charging.mode == "exchange";
+    charging.seed = c.system.seed;
+    charging.Q = c.charging.Q;
+    charging.kappa = c.charging.kappa;
+    charging.psi1_min = c.charging.psi1_min;
+    charging.psi1_max = c.charging.psi1_max;
+    charging.psi2_half_width = c.charging.psi2_fraction * c.charging.kappa;
+    charging.m_eff = M_EFF;
+  }
+
+  double* dqOrNull() { return exchange ? raw(dq) : nullptr; }
 
   /// Copies a host state (same N, wrapped, with images and charges) into the device arrays.
   void upload(const Frame& f) {
@@ -106,6 +134,7 @@ struct Engine::Impl {
     toDevice(f.iz, p.iz);
     p.id.resize(f.size());
     thrust::sequence(p.id.begin(), p.id.end());
+    if (exchange) dq.assign(f.size(), 0.0);
   }
 
   /// Stores particles in cell order (memory locality for the neighbour gathers: a particle's
@@ -114,7 +143,7 @@ struct Engine::Impl {
   void sortByCell() {
     const DVec<int>& order = nl.computeCellOrder(p, box);
     if (order.size() != p.size()) return;  // all-pairs builds: nothing to sort
-    permute(p.pos, order, scratch4);
+    permute(p.pos, order, scratch4);  // (dq is all zero here: applied by the kick pass before)
     for (auto* v : {&p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz}) permute(*v, order, scratch_d);
     for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
   }
@@ -133,9 +162,14 @@ struct Engine::Impl {
     // Displacements since the last build are at most the sum of dt max|u| over the steps (a
     // rigorous bound that needs no stored reference positions).
     if (nl.needsRebuild(p, drift_since_build * drift_since_build)) rebuildList(true);
-    const ContactStepResult r =
-        hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, cfg.run.max_overlap, dt_taken, work)
-              : computeContactForces<SpringDashpot>(p, nl, box, sd_params, cfg.run.max_overlap, dt_taken, work);
+    ContactStep st;
+    st.dt = dt_taken;
+    st.max_overlap = cfg.run.max_overlap;
+    st.step = step;
+    st.charging = charging;
+    st.dq = dqOrNull();
+    const ContactStepResult r = hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
+                                      : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
     if (r.worst != 0) abort(r.worst);
     collisions += r.collisions;
   }
@@ -151,7 +185,7 @@ struct Engine::Impl {
   /// Applies a deferred closing kick: afterwards v = v(t).
   void finishStep() {
     if (!close_pending) return;
-    closeKick(p, 0.5 * dt);
+    closeKick(p, 0.5 * dt, dqOrNull());
     close_pending = false;
   }
 
@@ -194,7 +228,7 @@ struct Engine::Impl {
   /// One velocity-Verlet step in two passes (VelocityVerlet.h): [previous closing kick +] opening
   /// kick + drift, then forces; the closing kick stays pending.
   void doStep() {
-    const double max_u2 = kickDrift(p, 0.5 * dt, dt, box, close_pending, block_max);
+    const double max_u2 = kickDrift(p, 0.5 * dt, dt, box, close_pending, dqOrNull(), block_max);
     close_pending = false;
     drift_since_build += dt * std::sqrt(max_u2);
     ++step;
@@ -367,6 +401,10 @@ Observables Engine::observables() const {
   o.collisions = d.collisions;
   o.mean_overlap = c.contacts > 0 ? c.overlap_sum / (0.5 * c.contacts) : 0.0;
   o.max_overlap = c.max_overlap;
+  const ChargeSums q = thrust::transform_reduce(d.p.pos.begin(), d.p.pos.end(), ChargeOf{}, ChargeSums{}, CombineCharges{});
+  o.total_charge = q.total;
+  o.mean_abs_charge = q.abs_sum / N;
+  o.max_abs_charge = q.abs_max;
   return o;
 }
 
@@ -471,10 +509,38 @@ Frame Engine::randomInitialState(const MdConfig& c) {
     f.vz[i] *= scale;
   }
   f.charge.assign(N, 0.0);
+  assignInitialCharges(c, f);
   f.ix.assign(N, 0);
   f.iy.assign(N, 0);
   f.iz.assign(N, 0);
   return f;
+}
+
+}  // namespace granagg::md
+
+namespace granagg::md {
+
+void Engine::assignInitialCharges(const MdConfig& c, Frame& f) {
+  const std::size_t N = f.size();
+  const std::string& how = c.charging.initial;
+  if (how == "file") {
+    if (f.charge.size() != N) throw std::invalid_argument("charging.initial = \"file\" but the initial state holds no charges");
+    return;
+  }
+  f.charge.assign(N, 0.0);
+  if (how == "neutral") return;
+  if (how == "monopolar") {
+    f.charge.assign(N, c.charging.q0);
+    return;
+  }
+  if (how != "bipolar") throw std::invalid_argument("charging.initial = \"" + how + "\" is not one of neutral, monopolar, bipolar, file");
+  // bipolar: a random half +q0, the other half -q0 (exactly zero net; for odd N one particle stays
+  // neutral). The halves come from ordering particles by a Philox key per particle.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> key(N);
+  for (std::size_t i = 0; i < N; ++i)
+    key[i] = {philoxDraw(c.system.seed, RNG_INIT_CHARGE, static_cast<std::uint32_t>(i), 0, 0)[0], static_cast<std::uint32_t>(i)};
+  std::sort(key.begin(), key.end());
+  for (std::size_t k = 0; k < 2 * (N / 2); ++k) f.charge[key[k].second] = k < N / 2 ? c.charging.q0 : -c.charging.q0;
 }
 
 }  // namespace granagg::md

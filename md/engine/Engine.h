@@ -38,6 +38,9 @@ struct Observables {
   std::int64_t collisions = 0;       ///< new contacts since the start of the run
   double mean_overlap = 0.0;         ///< over pairs in contact (0 if none)
   double max_overlap = 0.0;
+  double total_charge = 0.0;         ///< sum q (conserved by the exchange rule)
+  double mean_abs_charge = 0.0;      ///< (1/N) sum |q|, the paper's q-bar
+  double max_abs_charge = 0.0;
 };
 
 /// Thrown when a run must stop (NaN, overlap beyond the bound): the state before the failing step
@@ -63,6 +66,10 @@ class Engine {
   /// T_g = temperature exactly with zero total momentum, zero charges (design.md section 2).
   /// Deterministic in config.system.seed (Philox streams RNG_INIT_*).
   static Frame randomInitialState(const MdConfig& config);
+  /// Sets the charges of an initial state from config.charging.initial: "neutral" (0), "monopolar"
+  /// (+q0), "bipolar" (a random half +q0, the other -q0: zero net charge; Philox stream
+  /// RNG_INIT_CHARGE) or "file" (kept; throws if the state has none).
+  static void assignInitialCharges(const MdConfig& config, Frame& state);
 
   /// Advances `steps` velocity-Verlet steps. Throws RunAborted (state of the last good step kept).
   void run(std::int64_t steps);

@@ -21,6 +21,7 @@ struct KickDrift {
   double *vx, *vy, *vz;
   const double *fx, *fy, *fz;
   int *ix, *iy, *iz;
+  double* dq;
   double h, dt;
   bool close_pending;
   common::Box box;
@@ -40,13 +41,18 @@ struct KickDrift {
     vy[i] = u1;
     vz[i] = u2;
     const Scalar4 r = pos[i];
+    double q = r.w;
+    if (dq && dq[i] != 0.0) {  // charge exchanged at the last force pass
+      q += dq[i];
+      dq[i] = 0.0;
+    }
     double a = r.x + dt * u0, b = r.y + dt * u1, c = r.z + dt * u2;
     // image counts are touched only when a particle crosses a face (rare)
     const int sa = box.wrap(a), sb = box.wrap(b), sc = box.wrap(c);
     if (sa) ix[i] += sa;
     if (sb) iy[i] += sb;
     if (sc) iz[i] += sc;
-    pos[i] = Scalar4{a, b, c, r.w};
+    pos[i] = Scalar4{a, b, c, q};
     return u0 * u0 + u1 * u1 + u2 * u2;
   }
 };
@@ -54,30 +60,36 @@ struct KickDrift {
 struct CloseKick {
   double *vx, *vy, *vz;
   const double *fx, *fy, *fz;
+  Scalar4* pos;
+  double* dq;
   double h;
   HD void operator()(int i) const {
     vx[i] += h * fx[i];
     vy[i] += h * fy[i];
     vz[i] += h * fz[i];
+    if (dq && dq[i] != 0.0) {
+      pos[i].w += dq[i];
+      dq[i] = 0.0;
+    }
   }
 };
 }  // namespace
 
-double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending,
+double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending, double* dq,
                  DVec<double>& block_max) {
   const int n = static_cast<int>(p.size());
   const int block = blockSizeFor(n);
   block_max.resize(blockCount(n, block));
   forEachBlocked(n, block,
                  KickDrift{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(p.ix),
-                           raw(p.iy), raw(p.iz), half_dt, dt, close_pending, box},
+                           raw(p.iy), raw(p.iz), dq, half_dt, dt, close_pending, box},
                  MaxReduction{}, raw(block_max));
   return thrust::reduce(block_max.begin(), block_max.end(), 0.0, thrust::maximum<double>());
 }
 
-void closeKick(ParticleData& p, double half_dt) {
+void closeKick(ParticleData& p, double half_dt, double* dq) {
   thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(static_cast<int>(p.size())),
-                   CloseKick{raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), half_dt});
+                   CloseKick{raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(p.pos), dq, half_dt});
 }
 
 }  // namespace granagg::md

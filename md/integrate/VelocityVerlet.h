@@ -18,13 +18,14 @@
 namespace granagg::md {
 
 /// Opening pass of a step: [if close_pending: v += half_dt f (the previous step's closing kick)];
-/// v += half_dt f; x += dt v; wrap into [0, L) and update the image counts.
+/// v += half_dt f; x += dt v; wrap into [0, L) and update the image counts; with dq (charging)
+/// q += dq and dq = 0, the charges exchanged at the previous force pass.
 /// Returns the largest |v|^2 of the drift velocities (a bound on this step's displacements for the
 /// neighbour-list check). \param block_max scratch for the per-block maxima.
-double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending,
+double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending, double* dq,
                  DVec<double>& block_max);
 
-/// The closing kick alone: v += half_dt f.
-void closeKick(ParticleData& p, double half_dt);
+/// The closing kick alone: v += half_dt f; with dq, q += dq and dq = 0.
+void closeKick(ParticleData& p, double half_dt, double* dq);
 
 }  // namespace granagg::md

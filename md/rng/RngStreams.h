@@ -16,7 +16,9 @@ namespace granagg::md {
 enum RngStream : std::uint32_t {
   RNG_INIT_POSITION = 0x11,   ///< (particle, attempt): random insertion
   RNG_INIT_VELOCITY = 0x12,   ///< (particle): Maxwell velocities
-  RNG_CHARGE_EXCHANGE = 0x21, ///< (step, min(i,j), max(i,j)): collisional charging (issue 4)
+  RNG_INIT_CHARGE = 0x13,     ///< (particle): which half of a bipolar initial state is positive
+  RNG_CHARGE_EXCHANGE = 0x21, ///< (step, min id, max id): collisional charging; the step's high
+                              ///< 32 bits sit above the 8-bit stream id (ChargeExchange.h)
 };
 
 /// Four 32-bit random words for (seed, stream, a, b, c).

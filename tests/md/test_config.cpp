@@ -260,12 +260,12 @@ TEST_CASE("unknown keys and sections are reported with file:line:col", "[md][con
 
   CHECK(errorOf([&] { parseConfigString("[sytem]\nN = 2\n", "run.toml"); }) ==
         "run.toml:1:2: unknown section 'sytem' (known sections: input, system, contact, integrator, "
-        "neighbor, run, "
+        "neighbor, charging, coulomb, run, "
         "output); did you mean 'system'?");
   CHECK(
       errorOf([&] { parseConfigString("N = 2\n", "run.toml"); }) ==
       "run.toml:1:1: unknown key 'N' at top level (keys belong in a section; known sections: input, system, "
-      "contact, integrator, neighbor, run, output); did you mean 'system.N'?");
+      "contact, integrator, neighbor, charging, coulomb, run, output); did you mean 'system.N'?");
   // A nested table is an unknown key of its section.
   CHECK(errorOf([&] {
           parseConfigString("[system.extra]\nx = 1\n", "run.toml");
@@ -331,7 +331,7 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
        "did you mean 'system.N'?"},
       {"sytem.N=2",
        "--set sytem.N=2: unknown section 'sytem' (known sections: input, system, contact, integrator, "
-       "neighbor, run, output); did you mean 'system'?"},
+       "neighbor, charging, coulomb, run, output); did you mean 'system'?"},
       {"N=2", "--set N=2: unknown key 'N' at top level"},
       {"system.N", "--set system.N: expected section.key=value"},
       {"system.N=abc", "--set system.N=abc: system.N must be an integer, got string \"abc\""},
@@ -344,6 +344,14 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
        "--set integrator.dt=Auto: integrator.dt must be a number or \"auto\", got string \"Auto\""},
       {"system.phi=0.7", "--set system.phi=0.7: system.phi = 0.7 is invalid: must lie in (0, 0.6)"},
       {"contact.model=hooke", "--set contact.model=hooke: contact.model = \"hooke\" is invalid"},
+      {"charging.mode=static", "--set charging.mode=static: charging.mode = \"static\" is invalid"},
+      {"charging.initial=file", "--set charging.initial=file: charging.initial = \"file\" is invalid: must be used with"},
+      {"charging.kappa=0", "--set charging.kappa=0: charging.kappa = 0 is invalid: must be > 0"},
+      {"coulomb.K=-1", "--set coulomb.K=-1: coulomb.K = -1 is invalid: must be >= 0"},
+      {"coulomb.accuracy=0.5", "--set coulomb.accuracy=0.5: coulomb.accuracy = 0.5 is invalid"},
+      {"coulomb.method=p3m", "--set coulomb.method=p3m: coulomb.method = \"p3m\" is invalid"},
+      {"coulomb.mesh=0", "--set coulomb.mesh=0: coulomb.mesh = 0 is invalid: must be > 0 or \"auto\""},
+      {"coulomb.order=9", "--set coulomb.order=9: coulomb.order = 9 is invalid: must lie in 2..7"},
   };
   for (const auto& [set, message] : bad) {
     INFO(set);
@@ -406,7 +414,7 @@ TEST_CASE("flatten lists every key with round-trip numbers", "[md][config]") {
   MdConfig c;
   c.system.phi = 0.1 + 0.2;
   const auto f = flatten(c);
-  REQUIRE(f.size() == 24);
+  REQUIRE(f.size() == 39);
   CHECK(f.front() == std::make_pair(std::string("input.version"), std::string("1")));
   CHECK(f[1] == std::make_pair(std::string("system.N"), std::string("1000")));
   CHECK(f[2] == std::make_pair(std::string("system.phi"), std::string("0.30000000000000004")));
@@ -414,6 +422,10 @@ TEST_CASE("flatten lists every key with round-trip numbers", "[md][config]") {
   CHECK(f[9] == std::make_pair(std::string("contact.clamp"), std::string("true")));
   CHECK(f[12] == std::make_pair(std::string("integrator.dt"), std::string("auto")));
   CHECK(f[13] == std::make_pair(std::string("integrator.steps_per_contact"), std::string("50")));
+  CHECK(f[16] == std::make_pair(std::string("charging.mode"), std::string("exchange")));
+  CHECK(f[24] == std::make_pair(std::string("coulomb.K"), std::string("0")));
+  CHECK(f[27] == std::make_pair(std::string("coulomb.r_cut"), std::string("auto")));
+  CHECK(f[28] == std::make_pair(std::string("coulomb.mesh"), std::string("auto")));
   // toToml has exactly these keys in this order.
   const std::string text = toToml(c);
   std::size_t pos = 0;

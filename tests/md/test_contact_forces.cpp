@@ -89,7 +89,10 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   ContactWork w;
   // dt = 0: a state at full step, so the predicted velocities equal v, as in the reference. Overlap
   // bound 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite force.
-  const auto flags = computeContactForces<HertzViscoelastic>(p, nl, box, prm, 1.0, 0.0, w);
+  ContactStep st;
+  st.dt = 0.0;
+  st.max_overlap = 1.0;
+  const auto flags = computeContactForces<HertzViscoelastic>(p, nl, box, prm, st, w);
   CHECK(flags.worst == 0);
   std::vector<double> ref;
   int pairs;

@@ -51,7 +51,7 @@ MdConfig gasConfig(int N, double D, std::uint64_t seed) {
 
 bool identical(const Frame& a, const Frame& b) {
   return a.x == b.x && a.y == b.y && a.z == b.z && a.vx == b.vx && a.vy == b.vy && a.vz == b.vz && a.ix == b.ix &&
-         a.iy == b.iy && a.iz == b.iz && a.step == b.step;
+         a.iy == b.iy && a.iz == b.iz && a.step == b.step && a.charge == b.charge;
 }
 }  // namespace
 
@@ -134,6 +134,7 @@ TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart"
   two.run(400);
   omp_set_num_threads(threads);
   CHECK(one.observables().collisions > 50);
+  CHECK(one.observables().mean_abs_charge > 0.0);  // charges exchanged (default mode): compared too
   CHECK(identical(one.frame(), two.frame()));
 
   // restart from the state at step 200 (frame, forces, collision count) continues bit for bit
