@@ -79,6 +79,7 @@ std::vector<std::pair<std::string, double>> observableRow(const md::Observables&
           {"total_charge", o.total_charge},
           {"mean_abs_charge", o.mean_abs_charge},
           {"max_abs_charge", o.max_abs_charge},
+          {"coulomb_energy", o.coulomb_energy},
           {"max_overlap", o.max_overlap}};
 }
 
@@ -159,6 +160,8 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     f.insert(f.end(), ck.extra.fy.begin(), ck.extra.fy.end());
     f.insert(f.end(), ck.extra.fz.begin(), ck.extra.fz.end());
     const auto it = ck.extra.int_scalars.find("collisions");
+    const auto design = ck.extra.real_scalars.find("coulomb_sum_q2_design");
+    if (design != ck.extra.real_scalars.end()) engine.useCoulombDesign(design->second);
     engine.restore(ck.state, f, it == ck.extra.int_scalars.end() ? 0 : it->second);
   }
   std::string dt_reason;
@@ -174,6 +177,12 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                 engine.box(), cfg.contact.model.c_str(), static_cast<unsigned long long>(cfg.system.seed));
     std::printf("md: dt = %.6g (%s); %lld steps to t_end = %g\n", dt, dt_reason.c_str(), static_cast<long long>(last),
                 cfg.run.t_end);
+    if (const md::CoulombSetup* cs = engine.coulombSetup())
+      std::printf("md: Coulomb K = %g, %s: alpha = %.6g, r_cut = %.6g, %s; estimated relative force error %.2g (for sum q^2 = %.4g)\n",
+                  cfg.coulomb.K, cs->method.c_str(), cs->alpha, cs->r_cut,
+                  cs->method == "pppm" ? ("mesh " + std::to_string(cs->mesh) + "^3, order " + std::to_string(cs->order)).c_str()
+                                       : ("k_max " + std::to_string(cs->k_max)).c_str(),
+                  cs->estimated_error, cs->sum_q2_design);
     if (restart) std::printf("md: restarting from step %lld of %s\n", static_cast<long long>(engine.step()), out.c_str());
   }
 
@@ -190,6 +199,15 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     params.emplace_back("backend", md::Engine::backendDescription());
     params.emplace_back("dt", common::formatReal(dt));
     params.emplace_back("dt_reason", dt_reason);
+    if (const md::CoulombSetup* cs = engine.coulombSetup()) {  // the parameters chosen for coulomb.accuracy
+      params.emplace_back("coulomb_alpha", common::formatReal(cs->alpha));
+      params.emplace_back("coulomb_r_cut_used", common::formatReal(cs->r_cut));
+      params.emplace_back("coulomb_mesh_used", std::to_string(cs->mesh));
+      params.emplace_back("coulomb_order_used", std::to_string(cs->order));
+      params.emplace_back("coulomb_k_max", std::to_string(cs->k_max));
+      params.emplace_back("coulomb_estimated_error", common::formatReal(cs->estimated_error));
+      params.emplace_back("coulomb_sum_q2_design", common::formatReal(cs->sum_q2_design));
+    }
     writer = std::make_unique<md::H5mdWriter>(traj.string(), engine.size(), params, md::toToml(cfg), a.force,
                                               cfg.output.write_velocities);
   }
@@ -216,6 +234,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     c.frames_written = writer->frames();
     c.next_frame_index = static_cast<std::uint64_t>(nextFrame - frames.begin());
     c.int_scalars["collisions"] = engine.observables().collisions;
+    if (const md::CoulombSetup* cs = engine.coulombSetup()) c.real_scalars["coulomb_sum_q2_design"] = cs->sum_q2_design;
     md::writeCheckpoint(cpath.string(), state, c);
   };
   auto lastCheckpoint = std::chrono::steady_clock::now();

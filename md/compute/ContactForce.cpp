@@ -1,6 +1,7 @@
 #include "md/compute/ContactForce.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -9,6 +10,7 @@
 
 #include <thrust/reduce.h>
 
+#include "md/coulomb/RealSpace.h"
 #include "md/engine/Launch.h"
 #include "md/potentials/HertzViscoelastic.h"
 #include "md/potentials/SpringDashpot.h"
@@ -21,7 +23,7 @@ void ContactWork::resize(std::size_t n) {
 
 namespace {
 
-template <class Potential>
+template <class Potential, bool COULOMB>
 struct ContactForceFunctor {
   const Scalar4* pos;
   const double *vx, *vy, *vz;        // drift velocities u = v(t - dt/2) of the step just taken
@@ -37,6 +39,8 @@ struct ContactForceFunctor {
   ChargeExchange::Params charging;
   std::int64_t step;
   double* dq;
+  double K, alpha, rc2;  // Coulomb real space (COULOMB only)
+  const double *ext_fx, *ext_fy, *ext_fz;
 
   /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old
   HD void predicted(int k, double& a, double& b, double& c) const {
@@ -60,6 +64,14 @@ struct ContactForceFunctor {
       const double rx = box.minimumImageWrapped(xi_ - rj.x), ry = box.minimumImageWrapped(yi_ - rj.y),
                    rz = box.minimumImageWrapped(zi_ - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
+      if (COULOMB) {
+        if (r2 < rc2) {
+          const double fr = ewaldRealForceOverR(ri.w * rj.w, sqrt(r2), alpha, K);
+          f0 += fr * rx;
+          f1 += fr * ry;
+          f2 += fr * rz;
+        }
+      }
       if (r2 >= 1.0) continue;
       const double r = sqrt(r2);
       const double inv_r = 1.0 / r;
@@ -86,6 +98,11 @@ struct ContactForceFunctor {
           dqi += ChargeExchange::transferTo(charging, step, static_cast<std::uint32_t>(id[i]),
                                             static_cast<std::uint32_t>(id[j]), xi_dot);
       }
+    }
+    if (ext_fx) {
+      f0 += ext_fx[i];
+      f1 += ext_fy[i];
+      f2 += ext_fz[i];
     }
     fx[i] = f0;
     fy[i] = f1;
@@ -121,6 +138,8 @@ struct SummaryFunctor {
   int cap;
   common::Box box;
   typename Potential::Params params;
+  bool coulomb;
+  double K, alpha, rc2;
   HD ContactSummary operator()(int i) const {
     ContactSummary s;
     const int* row = rows + static_cast<long>(i) * cap;
@@ -130,6 +149,7 @@ struct SummaryFunctor {
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
+      if (coulomb && r2 < rc2) s.coulomb_real_energy += 0.5 * ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);
       if (r2 >= 1.0) continue;
       const double xi = 1.0 - sqrt(r2);
       s.elastic_energy += 0.5 * Potential::elasticEnergy(xi, params);  // half per partner
@@ -147,6 +167,7 @@ struct CombineSummary {
     r.overlap_sum = a.overlap_sum + b.overlap_sum;
     r.max_overlap = a.max_overlap > b.max_overlap ? a.max_overlap : b.max_overlap;
     r.contacts = a.contacts + b.contacts;
+    r.coulomb_real_energy = a.coulomb_real_energy + b.coulomb_real_energy;
     return r;
   }
 };
@@ -158,16 +179,17 @@ struct MaxOverlapOf {
 
 }  // namespace
 
-template <class Potential>
-ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                                       const typename Potential::Params& params, const ContactStep& st,
-                                       ContactWork& w) {
+template <class Potential, bool COULOMB>
+ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const common::Box& box,
+                            const typename Potential::Params& params, const ContactStep& st, ContactWork& w) {
   const int N = static_cast<int>(p.size());
   const double dt = st.dt, half_dt = 0.5 * dt;
   if (w.fx.size() != p.size()) w.resize(p.size());
-  ContactForceFunctor<Potential> f{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz),
-                                   nl.rows(), nl.counts(), nl.capacity(), box, params, st.max_overlap, half_dt, dt,
-                                   raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id), st.charging, st.step, st.dq};
+  ContactForceFunctor<Potential, COULOMB> f{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz),
+                                            nl.rows(), nl.counts(), nl.capacity(), box, params, st.max_overlap, half_dt, dt,
+                                            raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id), st.charging, st.step, st.dq,
+                                            st.coulomb_K, st.coulomb_alpha, st.coulomb_r_cut * st.coulomb_r_cut,
+                                            st.ext_fx, st.ext_fy, st.ext_fz};
   // forces and, per block, collisions (sum) and the worst flag (max); then one reduction over blocks
   const int block = blockSizeFor(N);
   w.block_flags.resize(blockCount(N, block));
@@ -179,10 +201,21 @@ ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, 
 }
 
 template <class Potential>
+ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
+                                       const typename Potential::Params& params, const ContactStep& st,
+                                       ContactWork& w) {
+  if (st.coulomb_real && nl.listRange() < st.coulomb_r_cut)
+    throw std::logic_error("neighbour list range below the Coulomb real-space cutoff");
+  return st.coulomb_real ? forcePass<Potential, true>(p, nl, box, params, st, w)
+                         : forcePass<Potential, false>(p, nl, box, params, st, w);
+}
+
+template <class Potential>
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                              const typename Potential::Params& params) {
+                              const typename Potential::Params& params, const ContactStep& st) {
   const int N = static_cast<int>(p.size());
-  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
+  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params,
+                              st.coulomb_real, st.coulomb_K, st.coulomb_alpha, st.coulomb_r_cut * st.coulomb_r_cut};
   return thrust::transform_reduce(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), s, ContactSummary{},
                                   CombineSummary{});
 }
@@ -192,7 +225,7 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
                            const typename Potential::Params& params, DVec<double>& out) {
   const int N = static_cast<int>(p.size());
   out.resize(p.size());
-  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
+  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params, false, 0.0, 0.0, 0.0};
   thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), out.begin(),
                     MaxOverlapOf<Potential>{s});
 }
@@ -202,7 +235,7 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
   template ContactStepResult computeContactForces<P>(ParticleData&, const NeighborList&, const common::Box&,      \
                                                      const P::Params&, const ContactStep&, ContactWork&);        \
   template ContactSummary contactSummary<P>(const ParticleData&, const NeighborList&, const common::Box&,          \
-                                            const P::Params&);                                                    \
+                                            const P::Params&, const ContactStep&);                                \
   template void maxOverlapPerParticle<P>(const ParticleData&, const NeighborList&, const common::Box&,             \
                                          const P::Params&, DVec<double>&);
 GRANAGG_CONTACT_MODEL(HertzViscoelastic)

@@ -50,6 +50,13 @@ struct ContactStep {
   /// Charging on: per-particle charge gained this step, written where nonzero (the caller applies
   /// and clears it before the next pass: kickDrift / closeKick). Null: no charging.
   double* dq = nullptr;
+  /// Coulomb real-space (Ewald-split) pair force K q_i q_j [erfc(alpha r)/r^2 + ...] for pairs
+  /// closer than coulomb_r_cut (md/coulomb/RealSpace.h); the neighbour list must reach that far.
+  bool coulomb_real = false;
+  double coulomb_K = 0.0, coulomb_alpha = 0.0, coulomb_r_cut = 0.0;
+  /// Forces computed elsewhere (the mesh part of PPPM, or a whole plain-Ewald evaluation), added
+  /// to each particle's total; null: none.
+  const double *ext_fx = nullptr, *ext_fy = nullptr, *ext_fz = nullptr;
 };
 
 /// Contact forces of the current positions into p.fx, p.fy, p.fz (state as described above),
@@ -65,10 +72,12 @@ struct ContactSummary {
   double overlap_sum = 0.0;     ///< sum of overlaps over pairs in contact (each pair once)
   double max_overlap = 0.0;
   std::int64_t contacts = 0;    ///< sum over particles of partners in contact (2 x pairs)
+  double coulomb_real_energy = 0.0;  ///< real-space Ewald energy (0 unless `step` has coulomb_real)
 };
+/// \param step only its Coulomb fields are used (the real-space energy).
 template <class Potential>
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                              const typename Potential::Params& params);
+                              const typename Potential::Params& params, const ContactStep& step = {});
 /// Largest overlap of each particle (storage order), for error messages.
 template <class Potential>
 void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const common::Box& box,

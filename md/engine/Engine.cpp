@@ -27,6 +27,9 @@
 #include "common/Box.h"
 #include "common/Csv.h"
 #include "md/compute/ContactForce.h"
+#include "md/coulomb/Ewald.h"
+#include "md/coulomb/EwaldParams.h"
+#include "md/coulomb/Pppm.h"
 #include "md/engine/ParticleData.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/neighbor/NeighborList.h"
@@ -106,6 +109,14 @@ struct Engine::Impl {
   bool exchange = false;           // collisional charging on (charging.mode = "exchange")
   ChargeExchange::Params charging{};
   DVec<double> dq;                 // charge gained at the last force pass, per slot (exchange only)
+  // Coulomb (coulomb.K > 0): mesh part (PPPM) or a whole plain-Ewald evaluation into ext_f*
+  bool coulomb = false;
+  CoulombSetup csetup;
+  std::unique_ptr<Pppm> pppm;
+  std::unique_ptr<EwaldReference> ewald;
+  DVec<double> ext_fx, ext_fy, ext_fz;
+  double coulomb_ext_energy = 0.0;          // pppm: mesh + self + background; ewald: everything
+  std::int64_t kspace_step = -1;            // step of the last mesh evaluation (-1: none yet)
   bool hertz = true;
   HertzViscoelastic::Params hertz_params{};
   SpringDashpot::Params sd_params{};
@@ -145,6 +156,8 @@ struct Engine::Impl {
     if (order.size() != p.size()) return;  // all-pairs builds: nothing to sort
     permute(p.pos, order, scratch4);  // (dq is all zero here: applied by the kick pass before)
     for (auto* v : {&p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz}) permute(*v, order, scratch_d);
+    if (coulomb)  // mesh forces reused between evaluations (coulomb.kspace_every > 1) follow their particles
+      for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) permute(*v, order, scratch_d);
     for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
   }
 
@@ -156,17 +169,108 @@ struct Engine::Impl {
     drift_since_build = 0.0;
   }
 
+  /// Chooses the Coulomb method's parameters for the configured accuracy (docs/coulomb.md) and
+  /// builds the solver; the neighbour list then reaches the real-space cutoff. The error estimates
+  /// scale with sum q^2: parameters are chosen for sum_q2_design (the engine uses the larger of the
+  /// initial sum q^2 and N, i.e. charges of order the unit q_ref at least, since an exchanging gas
+  /// starts neutral) and stored, so that a restart reuses them.
+  void setupCoulomb(double sum_q2_design) {
+    const CoulombConfig& cc = cfg.coulomb;
+    const std::size_t N = p.size();
+    const double L = box.L, skin = cfg.neighbor.skin;
+    csetup = CoulombSetup{};
+    csetup.method = cc.method;
+    csetup.sum_q2_design = sum_q2_design;
+    pppm.reset();
+    ewald.reset();
+    double list_cutoff = 1.0;
+    if (cc.method == "pppm") {
+      const double rc_max = 0.5 * L - skin;  // the list must reach r_cut + skin within L/2
+      if (cc.r_cut > rc_max)
+        throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) + " exceeds L/2 - neighbor.skin = " +
+                                    common::formatReal(rc_max) + " for this box (L = " + common::formatReal(L) + ")");
+      PppmParams prm;
+      if (cc.r_cut > 0.0) {
+        prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut, cc.order > 0 ? cc.order : 5);
+      } else {
+        if (!(rc_max >= 1.0)) throw std::invalid_argument("box too small for PPPM with this neighbor.skin (L/2 - skin < 1)");
+        prm = optimizePppmParams(cc.accuracy, N, L, sum_q2_design, 1.0, rc_max);
+        if (cc.order > 0 && cc.order != prm.order)
+          prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, prm.r_cut, cc.order);
+      }
+      if (cc.mesh > 0) {  // a mesh given explicitly overrides the chosen one (its error is reported)
+        prm.mesh = cc.mesh;
+        prm.estimated_error_kspace = pppmKspaceError(prm.alpha, prm.mesh, prm.order, N, L, sum_q2_design);
+      }
+      pppm = std::make_unique<Pppm>(prm, L, cc.K);
+      csetup.alpha = prm.alpha;
+      csetup.r_cut = prm.r_cut;
+      csetup.mesh = prm.mesh;
+      csetup.order = prm.order;
+      csetup.estimated_error = prm.estimatedError();
+      list_cutoff = std::max(1.0, prm.r_cut);
+    } else {
+      const EwaldParams prm = chooseEwaldParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut);
+      ewald = std::make_unique<EwaldReference>(prm, L, cc.K);
+      csetup.alpha = prm.alpha;
+      csetup.r_cut = prm.r_cut;
+      csetup.k_max = prm.k_max;
+      csetup.estimated_error = prm.estimatedError();
+    }
+    for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(N, 0.0);
+    kspace_step = -1;
+    nl = NeighborList(list_cutoff, skin);
+  }
+
+  /// Coulomb forces computed outside the force pass into ext_f*: PPPM's mesh part (every
+  /// kspace_every steps, reused in between), or everything for plain Ewald (host, O(N^2) real space).
+  void computeCoulombExternal() {
+    const int every = cfg.coulomb.kspace_every;
+    const std::size_t N = p.size();
+    if (pppm) {
+      if (kspace_step >= 0 && step - kspace_step < every && step % every != 0) return;
+      for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) thrust::fill(v->begin(), v->end(), 0.0);
+      coulomb_ext_energy = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), N, raw(ext_fx), raw(ext_fy),
+                                         raw(ext_fz), raw(p.id));
+      kspace_step = step;
+      return;
+    }
+    const auto pos = toHost(p.pos);
+    std::vector<double> x(N), y(N), z(N), q(N);
+    for (std::size_t i = 0; i < N; ++i) x[i] = pos[i].x, y[i] = pos[i].y, z[i] = pos[i].z, q[i] = pos[i].w;
+    const CoulombResult r = ewald->compute(x, y, z, q);
+    toDevice(r.fx, ext_fx);
+    toDevice(r.fy, ext_fy);
+    toDevice(r.fz, ext_fz);
+    coulomb_ext_energy = r.energy;
+  }
+
+  ContactStep makeStep(double dt_taken) const {
+    ContactStep st;
+    st.dt = dt_taken;
+    st.max_overlap = cfg.run.max_overlap;
+    st.step = step;
+    st.charging = charging;
+    if (coulomb) {
+      st.coulomb_real = pppm != nullptr;  // plain Ewald: all in ext_f*
+      st.coulomb_K = cfg.coulomb.K;
+      st.coulomb_alpha = csetup.alpha;
+      st.coulomb_r_cut = csetup.r_cut;
+      st.ext_fx = raw(ext_fx);
+      st.ext_fy = raw(ext_fy);
+      st.ext_fz = raw(ext_fz);
+    }
+    return st;
+  }
+
   /// Forces of the current positions into p.f (state as in ContactForce.h; dt_taken = 0 for a
   /// state given at full step); counts collisions; aborts on NaN / deep overlap.
   void computeForces(double dt_taken) {
     // Displacements since the last build are at most the sum of dt max|u| over the steps (a
     // rigorous bound that needs no stored reference positions).
     if (nl.needsRebuild(p, drift_since_build * drift_since_build)) rebuildList(true);
-    ContactStep st;
-    st.dt = dt_taken;
-    st.max_overlap = cfg.run.max_overlap;
-    st.step = step;
-    st.charging = charging;
+    if (coulomb) computeCoulombExternal();
+    ContactStep st = makeStep(dt_taken);
     st.dq = dqOrNull();
     const ContactStepResult r = hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
                                       : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
@@ -190,8 +294,9 @@ struct Engine::Impl {
   }
 
   ContactSummary summary() const {
-    return hertz ? contactSummary<HertzViscoelastic>(p, nl, box, hertz_params)
-                 : contactSummary<SpringDashpot>(p, nl, box, sd_params);
+    const ContactStep st = makeStep(0.0);
+    return hertz ? contactSummary<HertzViscoelastic>(p, nl, box, hertz_params, st)
+                 : contactSummary<SpringDashpot>(p, nl, box, sd_params, st);
   }
 
   [[noreturn]] void abort(int worst) {
@@ -295,6 +400,13 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
   d.step = init.step;
   d.time = init.step * d.dt;
 
+  d.coulomb = config.coulomb.K > 0.0;
+  if (d.coulomb) {
+    double sum_q2 = 0.0;
+    for (double q : f.charge) sum_q2 += q * q;
+    d.setupCoulomb(std::max(sum_q2, static_cast<double>(N)));
+  }
+
   // overlapping initial states are refused (design.md section 2 / ground rules: bad input)
   d.rebuildList(false);
   if (allow_contacts) {
@@ -396,6 +508,7 @@ Observables Engine::observables() const {
                                                 thrust::counting_iterator<int>(static_cast<int>(N)),
                                                 Abs3{raw(d.p.vx), raw(d.p.vy), raw(d.p.vz)}, 0.0, thrust::plus<double>());
   const ContactSummary c = d.summary();
+  o.coulomb_energy = d.coulomb ? c.coulomb_real_energy + d.coulomb_ext_energy : 0.0;
   o.elastic_energy = c.elastic_energy;
   o.contacts_per_particle = static_cast<double>(c.contacts) / N;
   o.collisions = d.collisions;
@@ -414,6 +527,15 @@ double Engine::time() const { return m_impl->time; }
 double Engine::box() const { return m_impl->box.L; }
 std::size_t Engine::size() const { return m_impl->p.size(); }
 std::int64_t Engine::neighborBuilds() const { return m_impl->nl.builds(); }
+
+const CoulombSetup* Engine::coulombSetup() const { return m_impl->coulomb ? &m_impl->csetup : nullptr; }
+
+void Engine::useCoulombDesign(double sum_q2_design) {
+  Impl& d = *m_impl;
+  if (!d.coulomb || d.csetup.sum_q2_design == sum_q2_design) return;
+  d.setupCoulomb(sum_q2_design);
+  d.rebuildList(false);
+}
 
 std::string Engine::backendDescription() {
 #if defined(__CUDACC__)

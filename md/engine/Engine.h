@@ -41,6 +41,18 @@ struct Observables {
   double total_charge = 0.0;         ///< sum q (conserved by the exchange rule)
   double mean_abs_charge = 0.0;      ///< (1/N) sum |q|, the paper's q-bar
   double max_abs_charge = 0.0;
+  double coulomb_energy = 0.0;       ///< Ewald total (real + mesh/reciprocal + self + background); 0 without Coulomb
+};
+
+/// The Coulomb method's parameters as chosen for a run (docs/coulomb.md), logged and stored.
+struct CoulombSetup {
+  std::string method;              ///< "pppm" or "ewald"
+  double alpha = 0.0;              ///< Ewald splitting parameter (1/d)
+  double r_cut = 0.0;              ///< real-space cutoff (d)
+  int mesh = 0, order = 0;         ///< PPPM mesh points per side, assignment order
+  int k_max = 0;                   ///< plain Ewald reciprocal cutoff
+  double estimated_error = 0.0;    ///< estimated relative RMS force error at sum_q2_design
+  double sum_q2_design = 0.0;      ///< sum q^2 the parameters were chosen for
 };
 
 /// Thrown when a run must stop (NaN, overlap beyond the bound): the state before the failing step
@@ -89,6 +101,11 @@ class Engine {
   std::size_t size() const;
   /// Number of neighbour-list builds so far (diagnostics).
   std::int64_t neighborBuilds() const;
+  /// The Coulomb parameters in use, or null when coulomb.K = 0.
+  const CoulombSetup* coulombSetup() const;
+  /// Re-chooses the Coulomb parameters for sum_q2_design (a restart passes the stored value, so
+  /// that it continues with the same parameters as the uninterrupted run). No-op without Coulomb.
+  void useCoulombDesign(double sum_q2_design);
   /// "OpenMP (2 threads)" or "CUDA (device name)": printed at start-up and stored in outputs.
   static std::string backendDescription();
   /// The time step chosen for a configuration (fixed, or auto from the contact time) and why.
