@@ -22,5 +22,7 @@ void registerSmolCommand(CLI::App& app, const CliContext& ctx);
 void registerMdCommand(CLI::App& app, const CliContext& ctx);
 /// Registers `granagg kinetic ...` (cli/KineticCommand.cpp).
 void registerKineticCommand(CLI::App& app, const CliContext& ctx);
+/// Registers `granagg analyze ...` (cli/AnalyzeCommand.cpp).
+void registerAnalyzeCommand(CLI::App& app, const CliContext& ctx);
 
 }  // namespace granagg::cli

@@ -1,0 +1,24 @@
+#pragma once
+/// \file ClusterSizes.h
+/// Cluster-size distribution N_s(s) and the mean cluster size
+/// S = sum_s s^2 N_s / sum_s s N_s (design.md section 3; the paper's S(t)).
+#include <cstdint>
+#include <map>
+#include <vector>
+
+namespace granagg::analysis {
+
+struct ClusterSizes {
+  std::map<std::uint64_t, std::uint64_t> n_s;  ///< size s -> number of clusters N_s of that size
+  std::uint64_t clusters = 0;                  ///< sum_s N_s
+  std::uint64_t mass = 0;                      ///< sum_s s N_s (sites or particles in clusters)
+  std::uint64_t largest = 0;                   ///< largest s (0 when there is no cluster)
+  double S = 0.0;                              ///< sum s^2 N_s / sum s N_s (NaN when no cluster)
+
+  /// Builds the distribution from a list of cluster sizes (one entry per cluster, s >= 1).
+  static ClusterSizes fromSizes(const std::vector<std::uint64_t>& sizes);
+  /// All cluster sizes, one entry per cluster, in increasing order (input of the power-law MLE).
+  std::vector<std::uint64_t> samples() const;
+};
+
+}  // namespace granagg::analysis

@@ -1,0 +1,463 @@
+#include "analysis/pipeline/RunAnalyzer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "analysis/io/TrajectoryReader.h"
+#include "analysis/stats/ChargeStats.h"
+#include "analysis/stats/Msd.h"
+#include "analysis/stats/PowerLawFit.h"
+#include "analysis/stats/PowerLawMle.h"
+#include "analysis/stats/VelocityStats.h"
+#include "common/Csv.h"
+#include "common/Strings.h"
+
+namespace granagg::analysis {
+
+namespace {
+
+constexpr double DEFAULT_KAPPA = 0.83;  // Poppe et al. 2000, silica (design.md section 2)
+const double NaN = std::numeric_limits<double>::quiet_NaN();
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+
+/// kappa from the options, else from the file's parameters, else the default.
+void resolveKappa(const AnalysisOptions& o, RunResult& r) {
+  if (std::isfinite(o.kappa)) {
+    r.kappa = o.kappa;
+    r.kappa_source = "option";
+    return;
+  }
+  for (const char* key : {"charging.kappa", "kappa"}) {
+    auto it = r.parameters.find(key);
+    double v;
+    if (it != r.parameters.end() && common::parseReal(it->second, v) && std::isfinite(v)) {
+      r.kappa = v;
+      r.kappa_source = std::string("file (") + key + ")";
+      return;
+    }
+  }
+  r.kappa = DEFAULT_KAPPA;
+  r.kappa_source = "default";
+}
+
+/// Growth-exponent window: the options, or the last decade of the data.
+std::pair<double, double> fitWindow(const AnalysisOptions& o, const std::vector<double>& t) {
+  if (o.fit_t_min > 0 || o.fit_t_max > 0) {
+    return {o.fit_t_min, o.fit_t_max > 0 ? o.fit_t_max : std::numeric_limits<double>::infinity()};
+  }
+  const double last = t.empty() ? 0.0 : t.back();
+  return {last / 10.0, last};
+}
+
+const std::vector<std::string> FITS_COLUMNS = {
+    "z_grid", "z_grid_err", "z_grid_low", "z_grid_high", "z_particle", "z_particle_err", "z_particle_low",
+    "z_particle_high", "fit_t_min", "fit_t_max", "fit_points", "charging_rate_exponent", "charging_rate_exponent_err",
+    "charging_rate_low", "charging_rate_high", "charging_rate_expected", "kappa", "charge_fit_t_min",
+    "charge_fit_t_max", "charge_fit_points", "runs"};
+const char* FITS_DESCRIPTION =
+    "growth exponent z of S(t) ~ t^z (grid and particle clusters) by least squares of ln S on ln t over "
+    "[fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; bootstrap over runs, percentile "
+    "interval, for the ensemble); err = standard error (bootstrap: std of replicates); charging_rate_exponent: "
+    "the same fit to d<|q|>/dt over [charge_fit_t_min, charge_fit_t_max], beside the expected -5/6 - 5 kappa/3";
+
+std::vector<double> fitColumns(const PowerLawFitResult& g, const PowerLawFitResult& p, double t0, double t1,
+                               const PowerLawFitResult& q, double kappa, double q0, double q1, double runs) {
+  auto v = [](const PowerLawFitResult& f, double x) { return f.valid ? x : NaN; };
+  return {v(g, g.exponent), v(g, g.stderr_z), v(g, g.low),  v(g, g.high), v(p, p.exponent), v(p, p.stderr_z),
+          v(p, p.low),      v(p, p.high),     t0,           t1,           static_cast<double>(std::max(g.points, p.points)),
+          v(q, q.exponent), v(q, q.stderr_z), v(q, q.low),  v(q, q.high), expectedChargingRateExponent(kappa),
+          kappa,            q0,               q1,           static_cast<double>(q.points), runs};
+}
+
+}  // namespace
+
+void AnalysisOptions::validate() const {
+  require(slope_ratio > 1.0 && std::isfinite(slope_ratio), "--slope-ratio must be > 1 (got " + common::formatReal(slope_ratio) + ").");
+  require(fit_t_min >= 0 && fit_t_max >= 0 && (fit_t_max == 0 || fit_t_max > fit_t_min),
+          "--fit-window must be two times 0 <= t_min < t_max.");
+  require(charge_fit_t_max > charge_fit_t_min && charge_fit_t_min >= 0, "--charge-fit-window must be two times 0 <= t_min < t_max.");
+  require(speed_max > 0 && std::isfinite(speed_max), "--speed-max must be positive.");
+  require(speed_bins >= 1 && speed_bins <= 100000, "--speed-bins must lie in [1, 100000].");
+  require(msd_origins == "auto" || msd_origins == "t0" || msd_origins == "all",
+          "--msd-origins must be auto, t0 or all (got '" + msd_origins + "').");
+  require(!(std::isfinite(kappa)) || kappa >= 0, "--kappa must be >= 0.");
+  require(std::isnan(kappa) || std::isfinite(kappa), "--kappa must be finite.");
+  require(mle_min_tail >= 2, "--mle-min-tail must be at least 2.");
+  require(bootstrap_replicates >= 10, "--bootstrap must be at least 10 replicates.");
+  require(lammps_dt >= 0 && std::isfinite(lammps_dt), "--lammps-dt must be >= 0.");
+  // The constructors validate their own parameters (and name them).
+  GridClusters g(grid);
+  ParticleClusters p(particle);
+}
+
+const Table& RunResult::table(const std::string& name) const {
+  for (const auto& t : tables)
+    if (t.name == name) return t;
+  throw std::out_of_range("no table '" + name + "' for run " + source);
+}
+
+bool RunResult::hasTable(const std::string& name) const {
+  for (const auto& t : tables)
+    if (t.name == name) return true;
+  return false;
+}
+
+RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const RunCallbacks& cb) {
+  o.validate();
+  auto reader = openTrajectory(path, o.lammps_dt);
+  RunResult r;
+  r.source = path;
+  r.format = reader->format();
+  r.parameters = reader->parameters();
+  resolveKappa(o, r);
+
+  GridClusters grid(o.grid);
+  ParticleClusters part(o.particle);
+  SpeedHistogram hist(o.speed_max, o.speed_bins);
+  MsdFromOrigin msd0;
+  MsdAllOrigins msd_all(o.msd_origins == "t0" ? 0 : o.msd_max_bytes);
+
+  Table S_t("S_t",
+            "t: time [sqrt(m d^2/T0)]; step; S = sum s^2 N_s / sum s N_s (grid: s in sites; particle: s in particles); "
+            "clusters = number of clusters; largest = largest s; occupied_fraction = occupied grid sites / all sites; "
+            "mean_contacts = partners within 1 + tolerance per particle; z_local = ln[S(t)/S(t/p)]/ln p",
+            {"t", "step", "S_grid", "S_particle", "clusters_grid", "clusters_particle", "largest_grid", "largest_particle",
+             "occupied_fraction", "mean_contacts", "z_local_grid", "z_local_particle"});
+  Table Ns_grid("N_s_grid", "t: time; s: cluster size in grid sites; N_s: number of grid clusters of s sites",
+                {"t", "s", "N_s"}, 2);
+  Ns_grid.missing_is_zero = true;
+  Table Ns_part("N_s_particle", "t: time; s: cluster size in particles; N_s: number of particle clusters of s particles",
+                {"t", "s", "N_s"}, 2);
+  Ns_part.missing_is_zero = true;
+  Table fisher("fisher",
+               "Fisher exponent tau of N_s ~ s^-tau per frame: discrete power-law MLE with xmin by KS distance "
+               "(Clauset, Shalizi & Newman 2009); tau_err = 1/sqrt(n I(tau)); tail = clusters with s >= xmin; ks = KS "
+               "distance; NaN when fewer than min_tail clusters or no maximum",
+               {"t", "tau_grid", "tau_grid_err", "xmin_grid", "tail_grid", "ks_grid", "tau_particle", "tau_particle_err",
+                "xmin_particle", "tail_particle", "ks_particle"});
+  Table thermo("thermo",
+               "t: time; T_g = <|v - <v>|^2>/3 [T0]; a2 = (3/5)<c^4>/<c^2>^2 - 1 (Sonine) and its standard error; "
+               "mean_abs_q = <|q|> [q_ref]; rms_q; net_q = sum q; max_abs_q; corr_absq_speed = Pearson correlation of |q~| and v~",
+               {"t", "T_g", "a2", "a2_err", "mean_abs_q", "rms_q", "net_q", "max_abs_q", "corr_absq_speed"});
+  Table msd("msd", "t: time; msd = <|r(t) - r(t0)|^2> [d^2] from the first frame t0, unwrapped with image counts",
+            {"t", "msd"});
+  Table speed("speed_dist",
+              "t: time; v_low, v_high: bin of v~ = |c|/<|c|^2>^{1/2}; f: probability density of v~; f_maxwell: the "
+              "Maxwellian sqrt(54/pi) v~^2 exp(-3 v~^2/2) averaged over the bin; count: particles in the bin",
+              {"t", "v_low", "v_high", "f", "f_maxwell", "count"}, 3);
+  std::vector<std::string> stick_cols{"t", "n_stick_mean"};
+  Table nstick("nstick", "", {});
+  std::vector<std::size_t> tracked;
+  std::vector<double> t_series, Sg, Sp, mean_q;
+  double last_scatter_t = NaN;
+  std::vector<double> last_q, last_speeds;
+  std::vector<std::int64_t> last_ids;
+
+  Frame f;
+  std::size_t n_particles = 0;
+  bool have_vel = false, have_q = false, first = true;
+  while (true) {
+    try {
+      if (!reader->next(f)) break;
+      if (first) {
+        n_particles = f.size();
+      } else if (f.size() != n_particles) {
+        throw TrajectoryError(reader->path(), f.index,
+                              "has " + std::to_string(f.size()) + " particles, the first frame had " + std::to_string(n_particles));
+      }
+      if (!first && !t_series.empty() && !(f.time > t_series.back()))
+        throw TrajectoryError(reader->path(), f.index, "time " + common::formatReal(f.time) + " does not increase");
+    } catch (const TrajectoryError& e) {
+      if (!o.allow_partial || r.frames == 0) throw;
+      r.partial = true;
+      r.partial_reason = e.what();
+      break;
+    }
+    if (first) {
+      have_vel = f.hasVelocities();
+      have_q = f.hasCharges();
+      // N_stick: particles with the smallest ids (frames are in id order)
+      for (std::size_t i = 0; i < std::min(o.track, f.size()); ++i) {
+        tracked.push_back(i);
+        stick_cols.push_back("n_stick_id" + std::to_string(f.id[i]));
+      }
+      nstick = Table("nstick",
+                     "t: time; n_stick_id<k>: number of particles within 1 + tolerance of tracked particle k (N_stick, "
+                     "contact persistence); n_stick_mean: their mean",
+                     stick_cols);
+      if (!f.hasImages()) r.notes.push_back("no image counts in the trajectory: MSD skipped");
+      if (!have_vel) r.notes.push_back("no velocities: T_g, a2, f(v~) and the charge-speed scatter skipped");
+      if (!have_q) r.notes.push_back("no charges: charge observables skipped");
+      first = false;
+    }
+    const double t = f.time;
+    t_series.push_back(t);
+    double sg = NaN, sp = NaN, cg = NaN, cp = NaN, lg = NaN, lp = NaN, occ = NaN, mc = NaN;
+    PowerLawMleResult fg, fp;
+    if (o.grid_clusters) {
+      grid.compute(f);
+      const ClusterSizes& c = grid.result();
+      sg = c.S;
+      cg = static_cast<double>(c.clusters);
+      lg = static_cast<double>(c.largest);
+      occ = grid.occupiedFraction();
+      for (const auto& [s, count] : c.n_s) Ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
+      fg = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
+      if (cb.grid) cb.grid(f, grid);
+    }
+    if (o.particle_clusters) {
+      part.compute(f);
+      const ClusterSizes& c = part.result();
+      sp = c.S;
+      cp = static_cast<double>(c.clusters);
+      lp = static_cast<double>(c.largest);
+      mc = 2.0 * static_cast<double>(part.bonds()) / static_cast<double>(f.size());
+      for (const auto& [s, count] : c.n_s) Ns_part.add({t, static_cast<double>(s), static_cast<double>(count)});
+      fp = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
+      std::vector<double> row{t, 0.0};
+      double sum = 0;
+      for (std::size_t i : tracked) {
+        row.push_back(part.contacts()[i]);
+        sum += part.contacts()[i];
+      }
+      row[1] = tracked.empty() ? NaN : sum / static_cast<double>(tracked.size());
+      nstick.add(row);
+    }
+    Sg.push_back(sg);
+    Sp.push_back(sp);
+    S_t.add({t, static_cast<double>(f.step), sg, sp, cg, cp, lg, lp, occ, mc, NaN, NaN});
+    auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
+    fisher.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)), fv(fg, double(fg.n_tail)), fv(fg, fg.ks),
+                fv(fp, fp.tau), fv(fp, fp.tau_err), fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks)});
+
+    std::vector<double> speeds;
+    VelocityMoments vm;
+    vm.T_g = vm.a2 = vm.a2_err = NaN;
+    if (have_vel && f.hasVelocities()) {
+      vm = velocityMoments(f.velocity);
+      hist.reset();
+      speeds = hist.add(f.velocity);
+      const auto dens = hist.density();
+      for (int k = 0; k < hist.bins(); ++k) {
+        const double lo = hist.binLow(k), hi = lo + hist.binWidth();
+        const double fm = (maxwellianScaledSpeedCdf(hi) - maxwellianScaledSpeedCdf(lo)) / hist.binWidth();
+        speed.add({t, lo, hi, dens[static_cast<std::size_t>(k)], fm, hist.counts()[static_cast<std::size_t>(k)]});
+      }
+    }
+    ChargeMoments qm{NaN, NaN, NaN, NaN};
+    double corr = NaN;
+    if (have_q && f.hasCharges()) {
+      qm = chargeMoments(f.charge);
+      if (!speeds.empty()) {
+        std::vector<double> aq = scaledCharges(f.charge);
+        for (double& x : aq) x = std::fabs(x);
+        corr = pearson(aq, speeds);
+      }
+    }
+    mean_q.push_back(qm.mean_abs);
+    thermo.add({t, vm.T_g, vm.a2, vm.a2_err, qm.mean_abs, qm.rms, qm.net, qm.max_abs, corr});
+    if (f.hasImages()) {
+      msd0.accumulate(f);
+      msd.add({t, msd0.msd().back()});
+      if (o.msd_origins != "t0") msd_all.accumulate(f);
+    } else if (o.msd_origins != "t0") {
+      msd_all.accumulate(f);  // records why it is unavailable
+    }
+    // charge-speed scatter: kept for the last frame only (the table is built after the loop)
+    if (have_q && !speeds.empty()) {
+      last_scatter_t = t;
+      last_q = scaledCharges(f.charge);
+      last_speeds = std::move(speeds);
+      last_ids = f.id;
+    }
+    ++r.frames;
+    if (cb.progress) cb.progress(r.frames, reader->frameCountHint());
+  }
+  if (r.frames == 0) throw std::invalid_argument("trajectory '" + path + "' holds no frames");
+  r.particles = n_particles;
+  if (o.grid_clusters) {
+    r.grid_cells = grid.cellsPerSide();
+    r.grid_cell_size = grid.cellSize();
+    r.grid_min_count = grid.minCount();
+  }
+
+  // Local slopes of S(t).
+  const auto zg = localSlope(t_series, Sg, o.slope_ratio), zp = localSlope(t_series, Sp, o.slope_ratio);
+  for (std::size_t k = 0; k < S_t.rows.size(); ++k) {
+    S_t.rows[k][10] = zg[k];
+    S_t.rows[k][11] = zp[k];
+  }
+  // Fits.
+  const auto [w0, w1] = fitWindow(o, t_series);
+  const PowerLawFitResult fit_g = fitPowerLaw(t_series, Sg, w0, w1), fit_p = fitPowerLaw(t_series, Sp, w0, w1);
+  PowerLawFitResult fit_q;
+  if (have_q) {
+    const auto [tr, rate] = chargingRate(t_series, mean_q);
+    fit_q = fitPowerLaw(tr, rate, o.charge_fit_t_min, o.charge_fit_t_max);
+  }
+  Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
+  fits.ensemble = false;
+  fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, r.kappa, o.charge_fit_t_min, o.charge_fit_t_max, 1));
+
+  r.tables.push_back(std::move(S_t));
+  if (o.grid_clusters) r.tables.push_back(std::move(Ns_grid));
+  if (o.particle_clusters) r.tables.push_back(std::move(Ns_part));
+  r.tables.push_back(std::move(fisher));
+  r.tables.push_back(std::move(thermo));
+  if (!msd.rows.empty()) r.tables.push_back(std::move(msd));
+  if (o.msd_origins != "t0") {
+    if (msd_all.available()) {
+      std::vector<double> lag;
+      const auto m = msd_all.compute(lag);
+      Table ma("msd_all_origins",
+               "lag: time lag [sqrt(m d^2/T0)]; msd = <|r(t0 + lag) - r(t0)|^2> averaged over all time origins t0 "
+               "(FFT method; frames evenly spaced)",
+               {"lag", "msd"});
+      for (std::size_t k = 0; k < m.size(); ++k) ma.add({lag[k], m[k]});
+      r.tables.push_back(std::move(ma));
+    } else if (o.msd_origins == "all") {
+      throw std::invalid_argument("--msd-origins all: not possible for '" + path + "': " + msd_all.reason());
+    } else {
+      r.notes.push_back("all-origins MSD skipped: " + msd_all.reason());
+    }
+  }
+  if (!speed.rows.empty()) r.tables.push_back(std::move(speed));
+  if (!last_q.empty()) {
+    Table sc("charge_speed",
+             "id: particle id; q_tilde = q / <q^2>^{1/2}; v_tilde = |c| / <|c|^2>^{1/2} (last frame analysed, at time t)",
+             {"t", "id", "q_tilde", "v_tilde"});
+    sc.ensemble = false;
+    sc.rows.reserve(last_q.size());
+    for (std::size_t i = 0; i < last_q.size(); ++i)
+      sc.add({last_scatter_t, static_cast<double>(last_ids[i]), last_q[i], last_speeds[i]});
+    r.tables.push_back(std::move(sc));
+  }
+  if (o.particle_clusters && !tracked.empty()) r.tables.push_back(std::move(nstick));
+  r.tables.push_back(std::move(fits));
+  if (r.partial) r.notes.push_back("partial: " + r.partial_reason);
+  return r;
+}
+
+std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const AnalysisOptions& o) {
+  if (runs.empty()) throw std::invalid_argument("analyzeEnsemble needs at least one run.");
+  std::vector<Table> out;
+  // Averages of every per-frame table present in all runs.
+  for (const Table& t : runs.front().tables) {
+    if (!t.ensemble) continue;
+    std::vector<const Table*> same;
+    for (const auto& r : runs)
+      if (r.hasTable(t.name)) same.push_back(&r.table(t.name));
+    if (same.size() != runs.size()) continue;
+    out.push_back(ensembleAverage(same));
+  }
+  // Local slope of the mean S(t) (better than the mean of the local slopes: less noise).
+  for (Table& t : out)
+    if (t.name == "S_t") {
+      const auto tt = t.values("t");
+      const auto zg = localSlope(tt, t.values("S_grid_mean"), o.slope_ratio);
+      const auto zp = localSlope(tt, t.values("S_particle_mean"), o.slope_ratio);
+      t.columns.push_back("z_local_grid_of_mean");
+      t.columns.push_back("z_local_particle_of_mean");
+      for (std::size_t k = 0; k < t.rows.size(); ++k) {
+        t.rows[k].push_back(zg[k]);
+        t.rows[k].push_back(zp[k]);
+      }
+      t.description += "; z_local_*_of_mean: local slope of the ensemble-mean S(t)";
+    }
+  // Pooled Fisher exponents: N_s summed over runs at each time.
+  {
+    Table pooled("fisher_pooled",
+                 "Fisher exponent of N_s summed over all runs at each time (MLE, xmin by KS, as in fisher.csv)",
+                 {"t", "tau_grid", "tau_grid_err", "xmin_grid", "tail_grid", "ks_grid", "tau_particle", "tau_particle_err",
+                  "xmin_particle", "tail_particle", "ks_particle"});
+    std::map<double, std::map<std::uint64_t, std::uint64_t>> g, p;
+    for (const auto& r : runs) {
+      for (const char* name : {"N_s_grid", "N_s_particle"}) {
+        if (!r.hasTable(name)) continue;
+        auto& target = std::string(name) == "N_s_grid" ? g : p;
+        for (const auto& row : r.table(name).rows) {
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%.9g", row[0]);
+          target[std::strtod(buf, nullptr)][static_cast<std::uint64_t>(row[1])] += static_cast<std::uint64_t>(row[2]);
+        }
+      }
+    }
+    std::map<double, bool> times;
+    for (const auto& kv : g) times[kv.first] = true;
+    for (const auto& kv : p) times[kv.first] = true;
+    for (const auto& kv : times) {
+      const double t = kv.first;
+      PowerLawMleResult fg, fp;
+      if (g.count(t)) fg = fitDiscretePowerLawKs(g[t], o.mle_min_tail);
+      if (p.count(t)) fp = fitDiscretePowerLawKs(p[t], o.mle_min_tail);
+      auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
+      pooled.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)), fv(fg, double(fg.n_tail)),
+                  fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err), fv(fp, double(fp.xmin)),
+                  fv(fp, double(fp.n_tail)), fv(fp, fp.ks)});
+    }
+    out.push_back(std::move(pooled));
+  }
+  // Ensemble fits: bootstrap over runs on the frame times common to all runs.
+  {
+    const Table* st = nullptr;
+    for (const Table& t : out)
+      if (t.name == "S_t") st = &t;
+    Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
+    fits.ensemble = false;
+    if (st) {
+      std::vector<double> t;
+      const std::size_t n_runs = st->column("n_runs");
+      for (const auto& row : st->rows)
+        if (row[n_runs] == static_cast<double>(runs.size())) t.push_back(row[0]);  // in every run
+      auto seriesOf = [&](const std::string& col, const std::string& table) {
+        std::vector<std::vector<double>> ys;
+        for (const auto& r : runs) {
+          const Table& tb = r.table(table);
+          const auto tt = tb.values("t"), y = tb.values(col);
+          std::vector<double> v;
+          std::size_t j = 0;
+          for (double tk : t) {
+            while (j < tt.size() && std::fabs(tt[j] - tk) > 1e-9 * std::max(1.0, std::fabs(tk))) ++j;
+            v.push_back(j < tt.size() ? y[j] : NaN);
+          }
+          ys.push_back(std::move(v));
+        }
+        return ys;
+      };
+      const auto [w0, w1] = fitWindow(o, t);
+      auto fitOf = [&](const std::vector<std::vector<double>>& ys, const std::vector<double>& tt, double a, double b) {
+        if (ys.size() >= 2) return bootstrapPowerLaw(tt, ys, a, b, o.bootstrap_replicates, o.bootstrap_seed);
+        return fitPowerLaw(tt, ys.front(), a, b);
+      };
+      const auto fg = fitOf(seriesOf("S_grid", "S_t"), t, w0, w1);
+      const auto fp = fitOf(seriesOf("S_particle", "S_t"), t, w0, w1);
+      // Charging rate per run, then bootstrap of the mean rate.
+      PowerLawFitResult fq;
+      const auto q = seriesOf("mean_abs_q", "thermo");
+      bool have_q = true;
+      for (const auto& v : q)
+        for (double x : v) have_q &= std::isfinite(x);
+      if (have_q && t.size() >= 2) {
+        std::vector<std::vector<double>> rates;
+        std::vector<double> tr;
+        for (const auto& v : q) {
+          auto [tm, rate] = chargingRate(t, v);
+          tr = tm;
+          rates.push_back(rate);
+        }
+        fq = fitOf(rates, tr, o.charge_fit_t_min, o.charge_fit_t_max);
+      }
+      fits.add(fitColumns(fg, fp, w0, w1, fq, runs.front().kappa, o.charge_fit_t_min, o.charge_fit_t_max,
+                          static_cast<double>(runs.size())));
+    }
+    out.push_back(std::move(fits));
+  }
+  return out;
+}
+
+}  // namespace granagg::analysis

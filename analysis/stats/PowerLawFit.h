@@ -1,0 +1,40 @@
+#pragma once
+/// \file PowerLawFit.h
+/// Growth exponents: y = A t^z fitted by least squares of ln y on ln t over a window, with a
+/// Student-t confidence interval (one run) or a bootstrap over independent runs (ensembles), and
+/// the local slope z(t) = ln[S(t) / S(t/p)] / ln p (design.md section 3).
+#include <cstdint>
+#include <vector>
+
+namespace granagg::analysis {
+
+struct PowerLawFitResult {
+  bool valid = false;
+  double exponent = 0.0;   ///< z
+  double amplitude = 0.0;  ///< A
+  double stderr_z = 0.0;   ///< standard error of z from the residuals (n - 2 degrees of freedom)
+  double low = 0.0;        ///< lower end of the confidence interval of z
+  double high = 0.0;       ///< upper end
+  std::size_t points = 0;  ///< points used (t in [t_min, t_max], t > 0, y > 0, finite)
+};
+
+/// Ordinary least squares of ln y on ln t over t_min <= t <= t_max; the interval is
+/// z +- t_{n-2, (1+confidence)/2} * stderr (GSL's Student-t quantile). Needs 3 points.
+/// Throws std::invalid_argument when t and y differ in length or confidence is not in (0, 1).
+PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<double>& y, double t_min,
+                              double t_max, double confidence = 0.95);
+
+/// Bootstrap over runs: `runs[r][k]` is run r's y at time t[k]. Each replicate draws the runs with
+/// replacement (std::mt19937_64 seeded with `seed`, so results are reproducible), averages y over
+/// them and fits the power law; the interval is the percentile interval of the replicate
+/// exponents. `exponent` is the fit to the mean over all runs. Needs 2 runs.
+PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t, const std::vector<std::vector<double>>& runs,
+                                    double t_min, double t_max, int replicates = 2000, std::uint64_t seed = 20091,
+                                    double confidence = 0.95);
+
+/// Local slope z(t_k) = ln[y(t_k) / y(t_k/p)] / ln p, y(t_k/p) interpolated linearly in
+/// (ln t, ln y) between the bracketing samples (exact for a power law). NaN where t_k/p lies
+/// before the first positive time or a y involved is not positive. t must increase. p > 1.
+std::vector<double> localSlope(const std::vector<double>& t, const std::vector<double>& y, double p);
+
+}  // namespace granagg::analysis
