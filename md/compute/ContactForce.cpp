@@ -65,8 +65,9 @@ struct ContactForceFunctor {
                    rz = box.minimumImageWrapped(zi_ - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
       if (COULOMB) {
-        if (r2 < rc2) {
-          const double fr = ewaldRealForceOverR(ri.w * rj.w, sqrt(r2), alpha, K);
+        const double qq = ri.w * rj.w;
+        if (r2 < rc2 && qq != 0.0) {  // (an exchanging gas starts neutral)
+          const double fr = ewaldRealForceOverRFast(qq, sqrt(r2), alpha, K);
           f0 += fr * rx;
           f1 += fr * ry;
           f2 += fr * rz;

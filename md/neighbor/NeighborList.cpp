@@ -174,6 +174,7 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
   const int nc = cellsPerSide(box);
   const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
   m_count.resize(N);
+  m_capacity = m_next_capacity;
   if (nc >= 3) computeCellOrder(p, box);
   for (;;) {
     m_list.resize(static_cast<std::size_t>(N) * m_capacity);
@@ -193,11 +194,12 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
     const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
     if (most <= m_capacity) {
       // rows much wider than needed cost a cache line per particle per step for nothing: the next
-      // build uses a tighter capacity (a later overflow is caught above)
-      if (2 * (most + most / 4 + 4) < m_capacity) m_capacity = most + most / 4 + 4;
+      // build uses a tighter capacity (a later overflow is caught above). Not this one: its rows
+      // are laid out with the current stride.
+      m_next_capacity = 2 * (most + most / 4 + 4) < m_capacity ? most + most / 4 + 4 : m_capacity;
       break;
     }
-    m_capacity = most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
+    m_capacity = m_next_capacity = most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
   }
   m_built_n = p.size();
   ++m_builds;

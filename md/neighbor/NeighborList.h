@@ -41,7 +41,8 @@ class NeighborList {
  private:
   int cellsPerSide(const common::Box& box) const;
   double m_cutoff, m_skin;
-  int m_capacity = 16;  // grows on overflow, shrinks when rows are mostly empty
+  int m_capacity = 16;       // row stride of the current list
+  int m_next_capacity = 16;  // for the next build: grows on overflow, shrinks when rows are mostly empty
   std::int64_t m_builds = 0;
   DVec<int> m_list, m_count;
   std::size_t m_built_n = 0;  // N at the last build

@@ -104,6 +104,19 @@ TEST_CASE("Ewald real-space pair term: closed form and F = -dE/dr", "[md][coulom
   CHECK(ewaldRealForceOverR(1.0, 2.0, 1e-12, 3.0) * 2.0 == Approx(3.0 / 4.0).epsilon(1e-12));
 }
 
+TEST_CASE("fast real-space force (Abramowitz-Stegun erfc) within 1.5e-7 K qq / r^2 of the exact one", "[md][coulomb]") {
+  // A&S 7.1.26 bounds the absolute erfc error by 1.5e-7; the force term erfc(alpha r) / r^2 then
+  // errs by at most 1.5e-7 / r^2 per unit K qq.
+  const double K = 5.0;
+  for (double alpha : {0.3, 0.58, 1.2})
+    for (double r = 0.05; r < 8.0; r += 0.01) {
+      const double exact = ewaldRealForceOverR(-1.0, r, alpha, K) * r;  // force magnitude
+      const double fast = ewaldRealForceOverRFast(-1.0, r, alpha, K) * r;
+      INFO("alpha " << alpha << ", r " << r);
+      REQUIRE(std::fabs(fast - exact) <= 1.5e-7 * K / (r * r) * 1.0001);
+    }
+}
+
 TEST_CASE("Ewald parameter choice meets the requested estimate and rejects unphysical input", "[md][coulomb]") {
   for (double acc : {1e-3, 1e-5, 1e-8}) {
     const EwaldParams p = chooseEwaldParams(acc, 1000, 19.0, 1000.0);
