@@ -327,6 +327,17 @@ struct Engine::Impl {
         ++shown;
       }
     msg << "; the time step dt = " << dt << " may be too large for these impacts";
+    if (coulomb && hertz && worst == 2) {
+      // An attractive pair has an equilibrium overlap only if K |q_i q_j| / (1 - xi)^2 = E xi^{3/2}
+      // has a root: max over xi of E xi^{3/2} (1 - xi)^2 is 0.0916 E (at xi = 3/7).
+      const double hold = 0.0916 * hertz_params.E;
+      double worst_qq = 0.0;
+      for (std::size_t i = 0; i < bad.size(); ++i)
+        if (bad[i] == 2) worst_qq = std::max(worst_qq, pos[i].w * pos[i].w);
+      msg << ", or an attractive Coulomb pair beyond what the Hertz contact can hold (K |q_i q_j| > 0.0916 E = "
+          << hold << " has no equilibrium overlap; here K q^2 = " << cfg.coulomb.K * worst_qq
+          << " for the largest flagged charge): lower coulomb.K or charging.Q";
+    }
     throw RunAborted(msg.str());
   }
 

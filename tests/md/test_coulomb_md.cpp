@@ -117,3 +117,42 @@ TEST_CASE("monopolar charges cool more slowly than Haff's law", "[md][coulomb]")
   // with charges: clearly hotter (a test that fails if the charges are ignored: T1 == T0 then)
   CHECK(T1 > 1.5 * T0);
 }
+
+TEST_CASE("an oppositely charged pair settles at the equilibrium overlap of Coulomb and Hertz forces", "[md][coulomb]") {
+  // Two particles, charges +1 and -1, released near contact in a large box, K = 5 (the paper's
+  // strongest coupling), default Hertz E and D, auto dt: they collide, the damping takes the energy
+  // out, and the pair comes to rest where E xi^{3/2} balances the attraction. That balance is the
+  // independent reference: the root of E xi^{3/2} = K / (1 - xi)^2 + (periodic-image and Ewald
+  // corrections, negligible at L = 40: the images are 40 diameters away), found by bisection.
+  MdConfig c;
+  c.system.N = 2;
+  c.charging.mode = "fixed";  // the frame's charges are kept
+  c.coulomb.K = 5.0;
+  c.coulomb.method = "ewald";   // exact up to its accuracy; two charges: cheap
+  c.coulomb.accuracy = 1e-6;
+  Frame f;
+  f.box = 40.0;
+  f.x = {19.4, 20.6};
+  f.y = {20.0, 20.0};
+  f.z = {20.0, 20.0};
+  f.vx = {0.0, 0.0};
+  f.vy = {0.0, 0.0};
+  f.vz = {0.0, 0.0};
+  f.charge = {1.0, -1.0};
+  Engine e(c, f);
+  double max_overlap = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    e.run(100);
+    max_overlap = std::max(max_overlap, e.observables().max_overlap);
+  }
+  const double overlap = e.observables().max_overlap;
+  auto g = [&](double xi) { return c.contact.E * std::pow(xi, 1.5) - c.coulomb.K / ((1 - xi) * (1 - xi)); };
+  double lo = 1e-6, hi = 3.0 / 7.0;  // g(lo) < 0 < g(hi) for K < 0.0916 E
+  REQUIRE(g(lo) < 0.0);
+  REQUIRE(g(hi) > 0.0);
+  for (int it = 0; it < 200; ++it) (g(0.5 * (lo + hi)) < 0.0 ? lo : hi) = 0.5 * (lo + hi);
+  INFO("equilibrium overlap " << lo << ", MD " << overlap << ", largest during the approach " << max_overlap);
+  CHECK(overlap == Approx(lo).epsilon(1e-3));
+  CHECK(max_overlap < 0.5);                         // stable at the default dt
+  CHECK(e.observables().temperature < 1e-8);        // at rest
+}
