@@ -66,6 +66,19 @@ std::vector<std::int64_t> frameSteps(const md::MdConfig& c, double dt, std::int6
   return {s.begin(), s.end()};
 }
 
+/// The frame to write: the engine's state, with its per-particle forces when output.write_forces.
+md::Frame outputFrame(const md::Engine& engine, const md::MdConfig& cfg) {
+  md::Frame f = engine.frame();
+  if (cfg.output.write_forces) {
+    const std::vector<double> all = engine.forces();
+    const std::size_t N = engine.size();
+    f.fx.assign(all.begin(), all.begin() + N);
+    f.fy.assign(all.begin() + N, all.begin() + 2 * N);
+    f.fz.assign(all.begin() + 2 * N, all.end());
+  }
+  return f;
+}
+
 std::vector<std::pair<std::string, double>> observableRow(const md::Observables& o) {
   return {{"temperature", o.temperature},
           {"kinetic_energy", o.kinetic_energy},
@@ -191,7 +204,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   std::unique_ptr<md::H5mdWriter> writer;
   if (restart) {
     writer = std::make_unique<md::H5mdWriter>(md::H5mdWriter::reopen(traj.string(), engine.size(), engine.step(),
-                                                                     cfg.output.write_velocities));
+                                                                     cfg.output.write_velocities, cfg.output.write_forces));
   } else {
     auto params = md::flatten(cfg);
     params.emplace_back("version", common::versionString());
@@ -209,13 +222,13 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
       params.emplace_back("coulomb_sum_q2_design", common::formatReal(cs->sum_q2_design));
     }
     writer = std::make_unique<md::H5mdWriter>(traj.string(), engine.size(), params, md::toToml(cfg), a.force,
-                                              cfg.output.write_velocities);
+                                              cfg.output.write_velocities, cfg.output.write_forces);
   }
   const auto frames = frameSteps(cfg, dt, last);
   auto nextFrame = std::upper_bound(frames.begin(), frames.end(), engine.step());
   if (!restart) {
     writer->writeObservables(0, 0.0, observableRow(engine.observables()));
-    writer->writeFrame(engine.frame());
+    writer->writeFrame(outputFrame(engine, cfg));
   }
 
   const fs::path cpath = out / "checkpoint.h5";
@@ -255,7 +268,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
       const auto o = engine.observables();
       if (engine.step() % obs_every == 0 || engine.step() == last) writer->writeObservables(o.step, o.time, observableRow(o));
       if (nextFrame != frames.end() && engine.step() == *nextFrame) {
-        writer->writeFrame(engine.frame());
+        writer->writeFrame(outputFrame(engine, cfg));
         ++nextFrame;
       }
       const bool by_steps = cfg.output.checkpoint_interval > 0 && engine.step() % cfg.output.checkpoint_interval == 0;

@@ -81,7 +81,8 @@ const std::vector<Section>& schema() {
       {"output",
        {GRANAGG_KEY(output, frames_per_decade), GRANAGG_KEY(output, frame_interval),
         GRANAGG_KEY(output, observable_interval), GRANAGG_KEY(output, checkpoint_interval),
-        GRANAGG_KEY(output, checkpoint_wall_seconds), GRANAGG_KEY(output, write_velocities)}},
+        GRANAGG_KEY(output, checkpoint_wall_seconds), GRANAGG_KEY(output, write_velocities),
+        GRANAGG_KEY(output, write_forces)}},
   };
   return s;
 }

@@ -18,7 +18,7 @@
 ///                   kspace_every
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
-///                   checkpoint_wall_seconds, write_velocities
+///                   checkpoint_wall_seconds, write_velocities, write_forces
 #include <cstdint>
 #include <string>
 
@@ -96,6 +96,7 @@ struct OutputConfig {
   long checkpoint_interval = 0;     ///< steps between checkpoints (0: only at the end)
   double checkpoint_wall_seconds = 600.0;  ///< wall-clock seconds between checkpoints (0: off)
   bool write_velocities = true;
+  bool write_forces = false;        ///< per-particle total forces in every frame (/particles/all/force), for checks
 };
 
 struct MdConfig {

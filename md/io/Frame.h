@@ -16,6 +16,8 @@ struct Frame {
   std::vector<double> vx, vy, vz;   ///< velocities
   std::vector<double> charge;       ///< charges (zero for a neutral gas)
   std::vector<std::int32_t> ix, iy, iz;  ///< image counts
+  /// per-particle forces (optional: filled for output with output.write_forces, else empty)
+  std::vector<double> fx, fy, fz;
   std::size_t size() const { return x.size(); }
 };
 

@@ -61,9 +61,10 @@ struct H5mdWriter::Impl {
   std::string path, xdmf_path;
   std::size_t n = 0;
   bool velocities = true;
+  bool forces = false;
   bool closed = false;
 
-  h5::Handle pos, vel, charge, image, edges, step, time;
+  h5::Handle pos, vel, force, charge, image, edges, step, time;
   std::size_t frames = 0;
   bool have_last_step = false;
   std::int64_t last_step = 0;
@@ -116,6 +117,7 @@ struct H5mdWriter::Impl {
     };
     pos = series("position", H5T_IEEE_F64LE, {N, 3});
     if (velocities) vel = series("velocity", H5T_IEEE_F64LE, {N, 3});
+    if (forces) force = series("force", H5T_IEEE_F64LE, {N, 3});
     charge = series("charge", H5T_IEEE_F64LE, {N});
     image = series("image", H5T_STD_I32LE, {N, 3});
     {
@@ -133,6 +135,7 @@ struct H5mdWriter::Impl {
       time = h5::createExtendible(g.get(), "time", H5T_IEEE_F64LE, {}, STEP_CHUNK, c + " position");
       std::vector<std::string> others{"charge", "image", "box/edges"};
       if (velocities) others.push_back("velocity");
+      if (forces) others.push_back("force");
       for (const auto& o : others) {
         for (const char* what : {"step", "time"}) {
           const std::string src = pg + "/position/" + what, dst = pg + "/" + o + "/" + what;
@@ -166,6 +169,11 @@ struct H5mdWriter::Impl {
       throw std::invalid_argument(c + (has_vel ? " has" : " has no") +
                                   " velocities but write_velocities = " + (velocities ? "true" : "false"));
     if (velocities) vel = open(pg + "/velocity/value");
+    const bool has_force = h5::exists(file.get(), pg + "/force/value");
+    if (has_force != forces)
+      throw std::invalid_argument(c + (has_force ? " has" : " has no") + " forces but write_forces = " +
+                                  (forces ? "true" : "false"));
+    if (forces) force = open(pg + "/force/value");
     const auto d = h5::datasetDims(pos.get(), c);
     if (d.size() != 3 || d[1] != n || d[2] != 3)
       throw std::invalid_argument(c + " holds " + (d.size() == 3 ? std::to_string(d[1]) : std::string("?")) +
@@ -205,7 +213,7 @@ struct H5mdWriter::Impl {
     // them are leftovers of a killed run and are cut as well.
     const std::size_t nt = std::min<std::size_t>(h5::datasetDims(step.get(), c)[0], h5::datasetDims(time.get(), c)[0]);
     frames = std::min<std::size_t>(keepRows(step.get()), nt);
-    for (hid_t d : {pos.get(), vel.get(), charge.get(), image.get(), edges.get(), step.get(), time.get()})
+    for (hid_t d : {pos.get(), vel.get(), force.get(), charge.get(), image.get(), edges.get(), step.get(), time.get()})
       if (d >= 0) shrink(d, frames);
     frame_times = h5::readAll<double>(time.get(), H5T_NATIVE_DOUBLE, c + " time");
     if (frames > 0) {
@@ -344,7 +352,7 @@ H5mdWriter::H5mdWriter(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
 
 H5mdWriter::H5mdWriter(const std::string& path, std::size_t N,
                        const std::vector<std::pair<std::string, std::string>>& parameters,
-                       const std::string& config_toml, bool overwrite, bool write_velocities)
+                       const std::string& config_toml, bool overwrite, bool write_velocities, bool write_forces)
     : m_impl(std::make_unique<Impl>()) {
   if (path.empty()) throw std::invalid_argument("H5mdWriter requires a file name.");
   if (N == 0) throw std::invalid_argument("H5mdWriter requires N >= 1 particles, got N = 0.");
@@ -361,6 +369,7 @@ H5mdWriter::H5mdWriter(const std::string& path, std::size_t N,
   m.xdmf_path = xdmfPathFor(path);
   m.n = N;
   m.velocities = write_velocities;
+  m.forces = write_forces;
   m.file = h5::check(H5Fcreate(path.c_str(), overwrite ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT),
                      "cannot create H5MD file '" + path + "'");
   try {
@@ -376,7 +385,7 @@ H5mdWriter::H5mdWriter(const std::string& path, std::size_t N,
 }
 
 H5mdWriter H5mdWriter::reopen(const std::string& path, std::size_t N, std::int64_t restart_step,
-                              bool write_velocities) {
+                              bool write_velocities, bool write_forces) {
   h5::silenceErrors();
   auto impl = std::make_unique<Impl>();
   Impl& m = *impl;
@@ -384,6 +393,7 @@ H5mdWriter H5mdWriter::reopen(const std::string& path, std::size_t N, std::int64
   m.xdmf_path = xdmfPathFor(path);
   m.n = N;
   m.velocities = write_velocities;
+  m.forces = write_forces;
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     h5::lastError();
     throw std::invalid_argument("cannot reopen '" + path + "': no such HDF5 file");
@@ -440,6 +450,11 @@ void H5mdWriter::writeFrame(const Frame& f) {
     need(f.vz.size(), "vz");
   }
   if (!f.charge.empty()) need(f.charge.size(), "charge");
+  if (m.forces) {
+    need(f.fx.size(), "fx");
+    need(f.fy.size(), "fy");
+    need(f.fz.size(), "fz");
+  }
   if (!(f.box > 0.0) || !std::isfinite(f.box))
     throw std::invalid_argument(where + "box edge must be positive and finite, got " + common::formatReal(f.box));
   if (!std::isfinite(f.time)) throw std::invalid_argument(where + "time is not finite");
@@ -471,6 +486,14 @@ void H5mdWriter::writeFrame(const Frame& f) {
       xyz[3 * i + 2] = f.vz[i];
     }
     h5::writeRows(m.vel.get(), row, 1, H5T_NATIVE_DOUBLE, xyz.data(), c + " velocity");
+  }
+  if (m.forces) {
+    for (std::size_t i = 0; i < N; ++i) {
+      xyz[3 * i] = f.fx[i];
+      xyz[3 * i + 1] = f.fy[i];
+      xyz[3 * i + 2] = f.fz[i];
+    }
+    h5::writeRows(m.force.get(), row, 1, H5T_NATIVE_DOUBLE, xyz.data(), c + " force");
   }
   if (f.charge.empty()) {
     const std::vector<double> zeros(N, 0.0);
@@ -545,7 +568,7 @@ void H5mdWriter::close() {
   } catch (...) {
     pending = std::current_exception();  // still close the file below
   }
-  for (h5::Handle* h : {&m.pos, &m.vel, &m.charge, &m.image, &m.edges, &m.step, &m.time, &m.obs_step, &m.obs_time})
+  for (h5::Handle* h : {&m.pos, &m.vel, &m.force, &m.charge, &m.image, &m.edges, &m.step, &m.time, &m.obs_step, &m.obs_time})
     h->reset();
   m.obs_value.clear();
   const bool closed_ok = m.file.reset();

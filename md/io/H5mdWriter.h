@@ -69,19 +69,21 @@ class H5mdWriter {
   /// \param config_toml TOML text of the resolved configuration (/parameters/config_toml).
   /// \param overwrite   replace an existing file; otherwise std::invalid_argument names it.
   /// \param write_velocities  write particles/all/velocity (default true).
+  /// \param write_forces  write particles/all/force from Frame::fx, fy, fz (default false).
   /// The XDMF sidecar is (re)written next to it regardless of `overwrite` (it holds no data).
   /// Throws std::invalid_argument for bad arguments, std::runtime_error if HDF5 fails.
   H5mdWriter(const std::string& path, std::size_t N,
              const std::vector<std::pair<std::string, std::string>>& parameters,
-             const std::string& config_toml, bool overwrite, bool write_velocities = true);
+             const std::string& config_toml, bool overwrite, bool write_velocities = true, bool write_forces = false);
 
   /// Reopens a trajectory written by H5mdWriter to continue a run restarted from a checkpoint
   /// taken at `restart_step`: frames and observable samples with step > restart_step (written
   /// after that checkpoint by the interrupted run) are discarded so that the restarted run
   /// rewrites them, and the file ends exactly as an uninterrupted run's would. N and
-  /// write_velocities must match the file (std::invalid_argument otherwise). /parameters is kept.
+  /// write_velocities and write_forces must match the file (std::invalid_argument otherwise).
+  /// /parameters is kept.
   static H5mdWriter reopen(const std::string& path, std::size_t N, std::int64_t restart_step,
-                           bool write_velocities = true);
+                           bool write_velocities = true, bool write_forces = false);
 
   /// Closes the file (as close(), but errors are swallowed: call close() to see them).
   ~H5mdWriter();
