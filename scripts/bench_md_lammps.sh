@@ -8,7 +8,7 @@
 #
 #   usage: bash scripts/bench_md_lammps.sh [GRANAGG_BINARY]      (default build/bin/granagg)
 #   environment: SIZES="10000 100000"  STEPS_10000="200 2000"  STEPS_100000="100 500"
-#                DT=0.002  REPEATS=3  THREADS="1 2"  LMP_RANKS="1 2"  SKIP_TWO_BODY=1 (skip the mapping check)
+#                DT=0.002  SKIN=0.3  REPEATS=3  THREADS="1 2"  LMP_RANKS="1 2"  SKIP_TWO_BODY=1 (skip the mapping check)
 #
 # Installs Debian's `lammps` (29 Sep 2021 stable, binary lmp) if it is missing; builds nothing.
 #
@@ -36,7 +36,7 @@ DT=${DT:-0.002}
 REPEATS=${REPEATS:-3}
 THREADS=${THREADS:-"1 2"}        # granagg OpenMP threads
 LMP_RANKS=${LMP_RANKS:-"1 2"}    # LAMMPS MPI ranks (1 = serial, no mpirun)
-E=278.6; D=27.7; PHI=0.076; SKIN=0.3
+E=278.6; D=27.7; PHI=0.076; SKIN=${SKIN:-0.3}   # SKIN: Verlet skin of both codes
 calc() { awk "BEGIN {printf \"%.10g\", $1}"; }
 KN=$(calc "2 * $E"); GN=$(calc "4 * $D")
 
@@ -166,6 +166,8 @@ clamp = true
 dt = $DT
 [neighbor]
 skin = $SKIN
+[charging]
+mode = "fixed"          # the neutral model, as in LAMMPS (no charge bookkeeping)
 [run]
 t_end = $(calc "$n * $DT")
 [output]
