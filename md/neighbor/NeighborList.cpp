@@ -31,19 +31,30 @@ struct CellIndex {
   }
 };
 
-/// Inserts slot j into the row kept sorted by particle id (insertion sort; rows are short) if there
-/// is room; counts always.
-HD inline void insertSorted(int* row, int& n, int cap, int j, const int* id) {
-  if (n < cap) {
-    int k = n;
-    const int key = id[j];
-    while (k > 0 && id[row[k - 1]] > key) {
-      row[k] = row[k - 1];
-      --k;
-    }
-    row[k] = j;
-  }
+/// Appends slot j to the row if there is room; counts always (an overflow is detected by the
+/// caller from the count).
+HD inline void append(int* row, int& n, int cap, int j) {
+  if (n < cap) row[n] = j;
   ++n;
+}
+
+/// Sorts a row of slots by particle id: insertion sort for the short rows of contact-only lists,
+/// Shell sort (Ciura's gaps) for the long rows of Coulomb real-space lists, where insertion while
+/// scanning was quadratic in the row length.
+HD inline void sortRowById(int* row, int n, const int* id) {
+  const int gaps[6] = {132, 57, 23, 10, 4, 1};
+  for (int g = n <= 16 ? 5 : 0; g < 6; ++g) {
+    const int gap = gaps[g];
+    for (int k = gap; k < n; ++k) {
+      const int v = row[k], key = id[v];
+      int m = k;
+      while (m >= gap && id[row[m - gap]] > key) {
+        row[m] = row[m - gap];
+        m -= gap;
+      }
+      row[m] = v;
+    }
+  }
 }
 
 /// First slot (in the cell-sorted order) of every cell, as lower bounds: start[c] = first s with
@@ -78,7 +89,7 @@ struct BuildCells {
       const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(xi - rj.x), ry = box.minimumImageWrapped(yi - rj.y),
                    rz = box.minimumImageWrapped(zi - rj.z);
-      if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
+      if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
     }
   }
 
@@ -109,6 +120,7 @@ struct BuildCells {
           scan(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n);
         }
       }
+    sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
   }
 };
@@ -128,8 +140,9 @@ struct BuildAllPairs {
       const Scalar4 ri = pos[i], rj = pos[j];
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
-      if (rx * rx + ry * ry + rz * rz < r2) insertSorted(row, n, cap, j, id);
+      if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
     }
+    sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
   }
 };
