@@ -22,7 +22,11 @@ void registerSmolCommand(CLI::App& app, const CliContext& ctx);
 void registerMdCommand(CLI::App& app, const CliContext& ctx);
 /// Registers `granagg kinetic ...` (cli/KineticCommand.cpp).
 void registerKineticCommand(CLI::App& app, const CliContext& ctx);
+/// Registers `granagg fit-beta ...` (cli/FitBetaCommand.cpp).
+void registerFitBetaCommand(CLI::App& app, const CliContext& ctx);
 /// Registers `granagg analyze ...` (cli/AnalyzeCommand.cpp).
 void registerAnalyzeCommand(CLI::App& app, const CliContext& ctx);
+/// Registers `granagg pair ...` (cli/PairCommand.cpp).
+void registerPairCommand(CLI::App& app, const CliContext& ctx);
 
 }  // namespace granagg::cli

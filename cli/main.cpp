@@ -27,7 +27,9 @@ int main(int argc, char** argv) {
   cli::registerMdCommand(app, ctx);
   cli::registerSmolCommand(app, ctx);
   cli::registerKineticCommand(app, ctx);
+  cli::registerFitBetaCommand(app, ctx);
   cli::registerAnalyzeCommand(app, ctx);
+  cli::registerPairCommand(app, ctx);
 
   // CLI11 reports an unknown first word only as "A subcommand is required": name it instead.
   if (argc >= 2 && argv[1][0] != '-') {

@@ -1,0 +1,394 @@
+#!/usr/bin/python3
+"""The paper's figures (Singh & Mazza 2018, Figs. 1-8) from a `granagg pair` results folder.
+
+usage: /usr/bin/python3 scripts/plot_figures.py PAIR_DIR
+
+Reads PAIR_DIR/summary.json, analysis/K<K>/*.csv (docs/analysis.md), meanfield/*.csv,
+fit/K<K>/fit_curve.csv and runs/K<K>/run0/traj.h5, and writes one figure per file into
+PAIR_DIR/figures/ (figN_<name>.png and .pdf):
+
+  fig1_temperature   T_g(t) of each ensemble with Haff's law and the viscoelastic cooling law
+  fig2_snapshots     projected slab (|z - L/2| < 2 d) of run 0 at three times, neutral and charged
+  fig3_nstick        N_stick of the tracked particles (contacts within 1 + tolerance)
+  fig4_charge        mean |q|(t), its rate against the t^(-a(1/2+kappa)) law, N_s(s) at three times
+  fig5_growth        S(t) with power-law fits (and the fitted mean field), local-slope inset
+  fig6_meanfield     MD against mean-field S(t) (fit-beta's fitted curve), MSD inset
+  fig7_speed         f(v~) against the Maxwellian at the first and last frames
+  fig8_charge_speed  (q~, v~) scatter of the last analysed frame, charged ensembles
+
+A missing input (no charged ensemble, no fit-beta output...) leaves a note in that panel; the
+script does not fail for it. Exit status 1 only when a figure failed for another reason (the
+figure then holds the error). Debian's python3-matplotlib, python3-numpy and python3-h5py only.
+"""
+import io
+import json
+import os
+import sys
+import traceback
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.collections import EllipseCollection  # noqa: E402
+import numpy as np  # noqa: E402
+
+FAILED = []
+
+
+def read(path):
+    """A granagg CSV table as a numpy structured array (None if absent or empty); '#' lines dropped."""
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        lines = [line for line in f if not line.startswith("#")]
+    if len(lines) < 2:
+        return None
+    a = np.genfromtxt(io.StringIO("".join(lines)), delimiter=",", names=True)
+    return np.atleast_1d(a)
+
+
+def note(ax, text):
+    """Marks a panel whose input is missing."""
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", fontsize=9, color="0.3", wrap=True)
+
+
+def col(tab, name):
+    return tab[name] if tab is not None and name in tab.dtype.names else None
+
+
+class Study:
+    def __init__(self, d):
+        self.d = d
+        self.summary = {}
+        if os.path.exists(f"{d}/summary.json"):
+            with open(f"{d}/summary.json") as f:
+                self.summary = json.load(f)
+        ens = self.summary.get("ensembles", [])
+        if ens:
+            self.ks = [(e["name"], float(e["K"])) for e in ens]
+        else:  # no summary: the analysis folders
+            names = sorted(os.listdir(f"{d}/analysis")) if os.path.isdir(f"{d}/analysis") else []
+            self.ks = [(n, float(n[1:])) for n in names if n.startswith("K") and os.path.isdir(f"{d}/analysis/{n}")]
+
+    def table(self, name, kname):
+        return read(f"{self.d}/analysis/{kname}/{name}.csv")
+
+    def neutral(self):
+        return [k for k in self.ks if k[1] == 0]
+
+    def charged(self):
+        return [k for k in self.ks if k[1] > 0]
+
+    def label(self, k):
+        return "neutral (K = 0)" if k[1] == 0 else f"charged (K = {k[1]:g})"
+
+
+def colors(i):
+    return ["C0", "C3", "C2", "C1", "C4", "C5"][i % 6]
+
+
+def save(fig, out, name):
+    os.makedirs(out, exist_ok=True)
+    fig.savefig(f"{out}/{name}.png", dpi=130, bbox_inches="tight")
+    fig.savefig(f"{out}/{name}.pdf", bbox_inches="tight")
+    plt.close(fig)
+
+
+def fig1(st, fig):
+    ax = fig.add_subplot(111)
+    cool = read(f"{st.d}/meanfield/cooling.csv")
+    any_md = False
+    for i, k in enumerate(st.ks):
+        th = st.table("thermo", k[0])
+        if th is None:
+            continue
+        m = th["t"] > 0
+        ax.errorbar(th["t"][m], th["T_g_mean"][m], yerr=th["T_g_se"][m], fmt="o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
+        any_md = True
+    if cool is not None:
+        m = cool["t"] > 0
+        ax.plot(cool["t"][m], cool["T"][m], "k-", label="kinetic theory, viscoelastic e(g)")
+        ax.plot(cool["t"][m], cool["T_haff"][m], "k--", label="Haff's law (same initial rate)")
+        tail = m & np.isfinite(cool["T_asymptote"]) & (cool["T_asymptote"] < 2)
+        ax.plot(cool["t"][tail], cool["T_asymptote"][tail], "k:", label=r"$t^{-5/3}$ asymptote")
+    else:
+        note(ax, "meanfield/cooling.csv missing (granagg kinetic cooling)")
+    if not any_md:
+        note(ax, "no analysis/K*/thermo.csv: no MD ensemble analysed")
+    ax.set(xscale="log", yscale="log", xlabel="t", ylabel=r"$T_g$", title="Fig. 1: granular temperature")
+    ax.legend(fontsize=8)
+
+
+def load_frames(path, wanted):
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        pos = f["particles/all/position"]
+        times = pos["time"][:]
+        edges = f["particles/all/box/edges"]
+        box = edges["value"][0] if isinstance(edges, h5py.Group) else edges[()]
+        L = float(np.atleast_1d(box).ravel()[0])
+        charge = f["particles/all/charge/value"] if "charge" in f["particles/all"] else None
+        out = []
+        for t in wanted:
+            i = int(np.argmin(np.abs(times - t)))
+            q = charge[i] if charge is not None and charge.ndim == 2 and i < charge.shape[0] else None
+            out.append((times[i], pos["value"][i], q))
+        return L, out
+
+
+def fig2(st, fig):
+    rows = [k for k in (st.neutral()[:1] + st.charged()[-1:])]
+    if not rows:
+        note(fig.add_subplot(111), "no ensembles")
+        return
+    for r, k in enumerate(rows):
+        path = f"{st.d}/runs/{k[0]}/run0/traj.h5"
+        if not os.path.exists(path):
+            note(fig.add_subplot(len(rows), 1, r + 1), f"{path} missing")
+            continue
+        import h5py
+
+        with h5py.File(path, "r") as f:
+            times = f["particles/all/position/time"][:]
+        tt = times[times > 0]
+        wanted = [tt[0], np.sqrt(tt[0] * tt[-1]), tt[-1]] if len(tt) else [times[0]]
+        L, frames = load_frames(path, wanted)
+        for c, (t, x, q) in enumerate(frames):
+            ax = fig.add_subplot(len(rows), 3, 3 * r + c + 1)
+            slab = np.abs(x[:, 2] - L / 2) < 2.0
+            # particles drawn at their true size (diameter 1 in data units)
+            ec = EllipseCollection(np.ones(slab.sum()), np.ones(slab.sum()), np.zeros(slab.sum()), units="xy",
+                                   offsets=x[slab, :2], offset_transform=ax.transData, edgecolors="k", linewidths=0.3)
+            if q is not None and k[1] > 0:
+                qs = np.max(np.abs(q)) or 1.0
+                ec.set_array(q[slab])
+                ec.set_cmap("coolwarm")
+                ec.set_clim(-qs, qs)
+            else:
+                ec.set_facecolor("0.6")
+            ax.add_collection(ec)
+            ax.set(xlim=(0, L), ylim=(0, L), aspect="equal", title=f"{st.label(k)}, t = {t:.3g}")
+            ax.tick_params(labelsize=7)
+    fig.suptitle(f"Fig. 2: slab |z - L/2| < 2 d projected on (x, y), run 0 (charged: colour = q)")
+
+
+def fig3(st, fig):
+    ax = fig.add_subplot(111)
+    drawn = False
+    for i, k in enumerate(st.ks):
+        ns = st.table("nstick", k[0])
+        if ns is None:
+            continue
+        ids = [n for n in ns.dtype.names if n.startswith("n_stick_id") and n.endswith("_mean")]
+        for j, n in enumerate(ids):
+            ax.plot(ns["t"], ns[n], "-", color=colors(i), alpha=0.25, lw=0.8, label=f"tracked particles, {st.label(k)}" if j == 0 else None)
+        if "n_stick_mean_mean" in ns.dtype.names:
+            ax.plot(ns["t"], ns["n_stick_mean_mean"], "o-", ms=3, color=colors(i), label=f"mean over tracked, {st.label(k)}")
+        drawn = True
+    if not drawn:
+        note(ax, "no analysis/K*/nstick.csv")
+    ax.set(xscale="log", xlabel="t", ylabel=r"$N_{stick}$", title="Fig. 3: contacts of tracked particles")
+    ax.legend(fontsize=8)
+
+
+def fig4(st, fig):
+    ax1, ax2, ax3 = fig.add_subplot(131), fig.add_subplot(132), fig.add_subplot(133)
+    ch = read(f"{st.d}/meanfield/charging.csv")
+    expo = float(ch["charging_rate_exponent"][0]) if ch is not None else None
+    drawn = False
+    for i, k in enumerate(st.charged()):
+        th = st.table("thermo", k[0])
+        if th is None:
+            continue
+        m = th["t"] > 0
+        t, q = th["t"][m], th["mean_abs_q_mean"][m]
+        ax1.errorbar(t, q, yerr=th["mean_abs_q_se"][m], fmt="o-", ms=3, color=colors(i + 1), label=st.label(k))
+        rate = np.diff(q) / np.diff(t)
+        tm = np.sqrt(t[1:] * t[:-1])
+        good = rate > 0
+        ax2.loglog(tm[good], rate[good], "o", ms=3, color=colors(i + 1), label=f"MD, {st.label(k)}")
+        if expo is not None and good.sum() > 1:
+            ref = tm[good][len(tm[good]) // 2]
+            c = np.interp(ref, tm[good], rate[good]) / ref**expo
+            tl = np.geomspace(tm[good].min(), tm[good].max(), 50)
+            ax2.loglog(tl, c * tl**expo, "k--", label=rf"$t^{{{expo:.3g}}}$ rate law")
+        drawn = True
+    if not drawn:
+        note(ax1, "no charged ensemble (K > 0)")
+        note(ax2, "no charged ensemble (K > 0)")
+    ax1.set(xscale="log", xlabel="t", ylabel=r"$\langle|q|\rangle$", title="mean |q|")
+    ax2.set(xlabel="t", ylabel=r"d$\langle|q|\rangle$/dt", title="charging rate")
+    ax1.legend(fontsize=8)
+    ax2.legend(fontsize=8)
+    drawn = False
+    for i, k in enumerate(st.ks):
+        ng = st.table("N_s_grid", k[0])
+        if ng is None:
+            continue
+        ts = np.unique(ng["t"][ng["t"] > 0])
+        if len(ts) == 0:
+            continue
+        pick = sorted(set([ts[0], ts[len(ts) // 2], ts[-1]]))
+        for j, t in enumerate(pick):
+            m = (ng["t"] == t) & (ng["N_s_mean"] > 0)
+            ax3.loglog(ng["s"][m], ng["N_s_mean"][m], "o-"[0] + ["-", "--", ":"][j % 3], ms=3, color=colors(i),
+                       label=f"{st.label(k)}, t = {t:.3g}")
+        drawn = True
+    if not drawn:
+        note(ax3, "no analysis/K*/N_s_grid.csv")
+    ax3.set(xlabel="s (grid sites)", ylabel=r"$N_s$", title="cluster-size distribution")
+    ax3.legend(fontsize=7)
+    fig.suptitle("Fig. 4: charge build-up and N_s(s) at three times")
+
+
+def powerfit(t, S, lo, hi):
+    m = (t >= lo) & (t <= hi) & (S > 0) & np.isfinite(S)
+    if m.sum() < 2:
+        return None
+    z, c = np.polyfit(np.log(t[m]), np.log(S[m]), 1)
+    return z, c, t[m]
+
+
+def fig5(st, fig):
+    ax = fig.add_subplot(111)
+    ins = ax.inset_axes([0.58, 0.08, 0.38, 0.32])
+    drawn = False
+    ens = {e["name"]: e for e in st.summary.get("ensembles", [])}
+    for i, k in enumerate(st.ks):
+        S = st.table("S_t", k[0])
+        if S is None:
+            continue
+        m = (S["t"] > 0) & np.isfinite(S["S_grid_mean"])
+        t, s = S["t"][m], S["S_grid_mean"][m]
+        ax.errorbar(t, s, yerr=S["S_grid_se"][m], fmt="o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
+        e = ens.get(k[0], {})
+        win = e.get("z_analyze_window") or [t[-1] / 10, t[-1]]
+        if win[0] is not None:
+            f = powerfit(t, s, win[0], win[1])
+            if f:
+                z, c, tw = f
+                zi = e.get("z_analyze", {})
+                lab = f"fit z = {z:.3g}" + (f" [{zi['low']:.3g}, {zi['high']:.3g}]" if zi.get("low") is not None else "")
+                ax.plot(tw, np.exp(c) * tw**z, "-", color=colors(i), lw=2, label=lab)
+        fc = read(f"{st.d}/fit/{k[0]}/fit_curve.csv")
+        if fc is not None and col(fc, "S_mf_fitted") is not None:
+            b = e.get("beta_fit", {}).get("value")
+            ax.plot(fc["t"], fc["S_mf_fitted"], "--", color=colors(i), label="mean field, fitted beta" + (f" = {b:.3g}" if b else ""))
+        zl = col(S, "z_local_grid_of_mean")
+        if zl is not None:
+            ins.plot(S["t"], zl, ".-", color=colors(i), ms=3)
+        drawn = True
+    if not drawn:
+        note(ax, "no analysis/K*/S_t.csv")
+    ins.axhline(1.21, color="C0", ls=":", lw=0.8)
+    ins.axhline(1.49, color="C3", ls=":", lw=0.8)
+    ins.set(xscale="log", xlabel="t", ylabel="z(t)")
+    ins.tick_params(labelsize=7)
+    ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S (grid sites)",
+           title="Fig. 5: mean cluster size; inset: local slope (paper: 1.21 neutral, 1.49 charged)")
+    ax.legend(fontsize=8, loc="upper left")
+
+
+def fig6(st, fig):
+    ax = fig.add_subplot(111)
+    ins = ax.inset_axes([0.6, 0.08, 0.36, 0.3])
+    drawn = False
+    for i, k in enumerate(st.ks):
+        fc = read(f"{st.d}/fit/{k[0]}/fit_curve.csv")
+        S = st.table("S_t", k[0])
+        if fc is not None and col(fc, "S_md") is not None:
+            ax.plot(fc["t"], fc["S_md"], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
+            ax.plot(fc["t"], fc["S_mf_fitted"], "-", color=colors(i), label="mean field (fitted beta, S_c, tau_c)")
+            drawn = True
+        elif S is not None:
+            m = S["t"] > 0
+            ax.plot(S["t"][m], S["S_grid_mean"][m], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)} (no fit-beta output)")
+        msd = st.table("msd", k[0])
+        if msd is not None:
+            m = msd["t"] > 0
+            ins.loglog(msd["t"][m], msd["msd_mean"][m], "-", color=colors(i))
+    ax2 = None
+    for b, ls in ((2, ":"), (3, "-.")):
+        mf = read(f"{st.d}/meanfield/S_beta{b}.csv")
+        if mf is not None and not drawn:
+            ax2 = ax2 or ax.twiny()
+            m = (mf["t"] > 0) & (mf["S"] < 1e4)
+            ax2.loglog(mf["t"][m], mf["S"][m], "k" + ls, label=f"mean field beta = {b} (top axis: t in 1/(K0 n1(0)))")
+            ax2.legend(fontsize=7, loc="lower right")
+    if not drawn:
+        note(ax, "fit/K*/fit_curve.csv missing (granagg fit-beta not run):\nMD and mean field shown on their own time axes")
+    ins.set(xlabel="t", ylabel="MSD")
+    ins.tick_params(labelsize=7)
+    ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S", title="Fig. 6: MD against mean-field S(t); inset: MSD")
+    ax.legend(fontsize=8, loc="upper left")
+
+
+def fig7(st, fig):
+    ax = fig.add_subplot(111)
+    drawn = False
+    for i, k in enumerate(st.ks):
+        sp = st.table("speed_dist", k[0])
+        if sp is None:
+            continue
+        ts = np.unique(sp["t"])
+        for j, t in enumerate([ts[0], ts[-1]] if len(ts) > 1 else ts):
+            m = sp["t"] == t
+            v = 0.5 * (sp["v_low"][m] + sp["v_high"][m])
+            ax.plot(v, sp["f_mean"][m], "o" if j else "s", ms=3, mfc="none" if j == 0 else colors(i), color=colors(i),
+                    label=f"{st.label(k)}, t = {t:.3g}")
+            if not drawn:
+                ax.plot(v, sp["f_maxwell_mean"][m], "k-", label="Maxwellian")
+            drawn = True
+    if not drawn:
+        note(ax, "no analysis/K*/speed_dist.csv")
+    ax.set(yscale="log", ylim=(1e-4, 2), xlabel=r"$\tilde v = v/\langle v^2\rangle^{1/2}$", ylabel=r"$f(\tilde v)$",
+           title="Fig. 7: speed distribution against the Maxwellian")
+    ax.legend(fontsize=8)
+
+
+def fig8(st, fig):
+    ax = fig.add_subplot(111)
+    drawn = False
+    for i, k in enumerate(st.charged()):
+        cs = read(f"{st.d}/analysis/{k[0]}/per_run/charge_speed.csv")
+        if cs is None:
+            continue
+        ax.scatter(cs["q_tilde"], cs["v_tilde"], s=4, alpha=0.5, color=colors(i + 1), linewidths=0,
+                   label=f"{st.label(k)}, t = {np.max(cs['t']):.3g}, all runs")
+        drawn = True
+    if not drawn:
+        note(ax, "no charged ensemble (K > 0): no charge-speed data")
+    ax.set(xlabel=r"$\tilde q = q/\langle q^2\rangle^{1/2}$", ylabel=r"$\tilde v$", title="Fig. 8: charge-speed scatter")
+    if drawn:
+        ax.legend(fontsize=8)
+
+
+FIGURES = [("fig1_temperature", fig1, (7, 5)), ("fig2_snapshots", fig2, (12, 8)), ("fig3_nstick", fig3, (7, 5)),
+           ("fig4_charge", fig4, (16, 4.8)), ("fig5_growth", fig5, (7.5, 5.5)), ("fig6_meanfield", fig6, (7.5, 5.5)),
+           ("fig7_speed", fig7, (7, 5)), ("fig8_charge_speed", fig8, (6, 5))]
+
+
+def main():
+    if len(sys.argv) != 2 or not os.path.isdir(sys.argv[1]):
+        sys.exit("usage: plot_figures.py PAIR_DIR (a `granagg pair` results folder)")
+    st = Study(sys.argv[1])
+    out = f"{st.d}/figures"
+    for name, fn, size in FIGURES:
+        fig = plt.figure(figsize=size)
+        try:
+            fn(st, fig)
+        except Exception as e:  # draw what failed into the figure, go on with the others
+            FAILED.append(name)
+            traceback.print_exc()
+            fig.clf()
+            note(fig.add_subplot(111), f"{name} failed: {type(e).__name__}: {e}")
+        save(fig, out, name)
+        print(f"plot_figures: wrote {out}/{name}.png")
+    if FAILED:
+        sys.exit(f"plot_figures: {len(FAILED)} figure(s) failed: {', '.join(FAILED)}")
+
+
+if __name__ == "__main__":
+    main()
