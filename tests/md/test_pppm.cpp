@@ -15,52 +15,17 @@
 #include <stdexcept>
 #include <vector>
 
+#include "CoulombFixtures.h"
 #include "md/coulomb/Ewald.h"
 #include "md/coulomb/EwaldParams.h"
 #include "md/coulomb/Pppm.h"
 
 using namespace granagg::md;
+using granagg::md::testing::Charges;
+using granagg::md::testing::cscl;
+using granagg::md::testing::nacl;
 
 namespace {
-
-struct Charges {
-  std::vector<double> x, y, z, q;
-  double L = 0.0;
-  void add(double a, double b, double c, double charge) {
-    x.push_back(a);
-    y.push_back(b);
-    z.push_back(c);
-    q.push_back(charge);
-  }
-  double sumQ2() const {
-    double s = 0.0;
-    for (double v : q) s += v * v;
-    return s;
-  }
-};
-
-Charges nacl(int cells) {  // nearest-neighbour distance 1
-  Charges c;
-  const int n = 2 * cells;
-  c.L = n;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) c.add(i, j, k, (i + j + k) % 2 ? -1.0 : 1.0);
-  return c;
-}
-
-Charges cscl(int cells) {  // nearest-neighbour distance 1
-  Charges c;
-  const double a = 2.0 / std::sqrt(3.0);
-  c.L = cells * a;
-  for (int i = 0; i < cells; ++i)
-    for (int j = 0; j < cells; ++j)
-      for (int k = 0; k < cells; ++k) {
-        c.add(i * a, j * a, k * a, 1.0);
-        c.add((i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a, -1.0);
-      }
-  return c;
-}
 
 /// N unit spheres at filling fraction 0.076 (the paper's gas), random and non-overlapping, with
 /// charges +-1 alternating (neutral) or all +1.
