@@ -55,8 +55,8 @@ struct CoulombSetup {
   double sum_q2_design = 0.0;      ///< sum q^2 the parameters were chosen for
 };
 
-/// Thrown when a run must stop (NaN, overlap beyond the bound): the state before the failing step
-/// is intact, and the message names the step and the particles.
+/// Thrown when a run must stop (NaN, overlap beyond the bound); the message names the step and the
+/// particles (and, for a Coulomb collapse, the criterion). The last checkpoint is the good state.
 class RunAborted : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -83,7 +83,9 @@ class Engine {
   /// RNG_INIT_CHARGE) or "file" (kept; throws if the state has none).
   static void assignInitialCharges(const MdConfig& config, Frame& state);
 
-  /// Advances `steps` velocity-Verlet steps. Throws RunAborted (state of the last good step kept).
+  /// Advances `steps` velocity-Verlet steps. Throws RunAborted when a step fails its checks; the
+  /// engine is then mid-step and must not be advanced further (a run restarts from its last
+  /// checkpoint, as `granagg md` does).
   void run(std::int64_t steps);
 
   /// Host copy of the current state (wrapped positions, images, velocities, charges).
