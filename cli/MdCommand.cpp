@@ -124,9 +124,7 @@ class Progress {
 
 void runMd(const MdArgs& a, const CliContext& ctx) {
   if (a.threads < 0) throw std::invalid_argument("--threads must be >= 1.");
-#if !defined(GRANAGG_CUDA)
-  if (a.threads > 0) setenv("OMP_NUM_THREADS", std::to_string(a.threads).c_str(), 1);
-#endif
+  if (a.threads > 0) md::Engine::setThreads(a.threads);
   const bool restart = !a.restart.empty();
   md::MdConfig cfg;
   md::Checkpoint ck;

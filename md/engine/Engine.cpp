@@ -548,6 +548,13 @@ void Engine::useCoulombDesign(double sum_q2_design) {
   d.rebuildList(false);
 }
 
+void Engine::setThreads(int n) {
+  if (n < 1) throw std::invalid_argument("the number of threads must be >= 1 (got " + std::to_string(n) + ")");
+#if !defined(__CUDACC__)
+  omp_set_num_threads(n);
+#endif
+}
+
 std::string Engine::backendDescription() {
 #if defined(__CUDACC__)
   int dev = 0;

@@ -108,6 +108,9 @@ class Engine {
   /// Re-chooses the Coulomb parameters for sum_q2_design (a restart passes the stored value, so
   /// that it continues with the same parameters as the uninterrupted run). No-op without Coulomb.
   void useCoulombDesign(double sum_q2_design);
+  /// OpenMP threads for the CPU backend (the OpenMP runtime reads OMP_NUM_THREADS only at start-up,
+  /// so a command-line option must go through here); no-op on the CUDA backend.
+  static void setThreads(int n);
   /// "OpenMP (2 threads)" or "CUDA (device name)": printed at start-up and stored in outputs.
   static std::string backendDescription();
   /// The time step chosen for a configuration (fixed, or auto from the contact time) and why.

@@ -152,3 +152,15 @@ TEST_CASE("md --restart continues bit for bit with charging and PPPM, and writes
   }
   fs::remove_all(dir);
 }
+
+TEST_CASE("md --threads sets the OpenMP thread count", "[cli][md]") {
+  // The OpenMP runtime reads OMP_NUM_THREADS once at start-up: the option must set the count
+  // through the runtime (an environment variable set later would be ignored).
+  const fs::path dir = tempDir("threads");
+  const std::string cfg = writeConfig(dir, SMALL);
+  const Run r = runGranagg("md --config " + cfg + " --set run.t_end=0.05 --threads 1 --out " + (dir / "a").string());
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  if (r.output.find("OpenMP backend") != std::string::npos) CHECK_THAT(r.output, Catch::Contains("1 thread(s)"));
+  fs::remove_all(dir);
+}
