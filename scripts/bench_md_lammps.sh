@@ -97,57 +97,7 @@ fi
 gen_state() {  # N -> $TMP/state_N.csv (granagg) and $TMP/state_N.data (LAMMPS): random non-overlapping
   # positions (random sequential addition, cell list) and Gaussian velocities with zero momentum
   # rescaled to T_g = (1/3N) sum v^2 = 1 exactly, like granagg's own random state.
-  /usr/bin/python3 - "$1" "$PHI" "$TMP" <<'EOF'
-import math, random, sys
-N, phi, tmp = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
-L = (N * math.pi / (6 * phi)) ** (1 / 3)
-rng = random.Random(12345)
-nc = int(L)            # cells of edge >= 1 (= diameter)
-cl = L / nc
-cells = {}
-pos = []
-while len(pos) < N:
-    p = (rng.random() * L, rng.random() * L, rng.random() * L)
-    c = [int(p[k] / cl) % nc for k in range(3)]
-    ok = True
-    for dx in (-1, 0, 1):
-        for dy in (-1, 0, 1):
-            for dz in (-1, 0, 1):
-                for j in cells.get(((c[0] + dx) % nc, (c[1] + dy) % nc, (c[2] + dz) % nc), ()):
-                    q = pos[j]
-                    r2 = 0.0
-                    for k in range(3):
-                        d = p[k] - q[k]
-                        d -= L * round(d / L)
-                        r2 += d * d
-                    if r2 < 1.0:
-                        ok = False; break
-                if not ok: break
-            if not ok: break
-        if not ok: break
-    if ok:
-        cells.setdefault(tuple(c), []).append(len(pos))
-        pos.append(p)
-vel = [[rng.gauss(0, 1) for _ in range(3)] for _ in range(N)]
-mean = [sum(v[k] for v in vel) / N for k in range(3)]
-vel = [[v[k] - mean[k] for k in range(3)] for v in vel]
-s = math.sqrt(1.0 / (sum(v[0]**2 + v[1]**2 + v[2]**2 for v in vel) / (3 * N)))
-vel = [[x * s for x in v] for v in vel]
-with open(f"{tmp}/state_{N}.csv", "w") as f:
-    f.write("x,y,z,vx,vy,vz\n")
-    for p, v in zip(pos, vel):
-        f.write(",".join(repr(x) for x in (*p, *v)) + "\n")
-with open(f"{tmp}/state_{N}.data", "w") as f:
-    f.write(f"granagg benchmark state, N = {N}, phi = {phi}\n\n{N} atoms\n1 atom types\n\n")
-    for a in "xyz":
-        f.write(f"0.0 {L!r} {a}lo {a}hi\n")
-    f.write("\nAtoms # sphere\n\n")
-    for i, p in enumerate(pos):
-        f.write(f"{i + 1} 1 1.0 {6 / math.pi!r} {p[0]!r} {p[1]!r} {p[2]!r}\n")
-    f.write("\nVelocities\n\n")
-    for i, v in enumerate(vel):
-        f.write(f"{i + 1} {v[0]!r} {v[1]!r} {v[2]!r} 0 0 0\n")
-EOF
+  /usr/bin/python3 "$ROOT/scripts/lammps/make_state.py" "$1" "$PHI" "$TMP"
 }
 
 granagg_time() {  # N steps threads -> wall seconds of the whole process
