@@ -68,9 +68,9 @@ std::vector<std::int64_t> frameSteps(const md::MdConfig& c, double dt, std::int6
 
 /// The frame to write: the engine's state, with its per-particle forces when output.write_forces.
 md::Frame outputFrame(const md::Engine& engine, const md::MdConfig& cfg) {
-  md::Frame f = engine.frame();
+  md::Frame f = engine.frame(md::StateKind::Physical);
   if (cfg.output.write_forces) {
-    const std::vector<double> all = engine.forces();
+    const std::vector<double> all = engine.forces(md::StateKind::Physical);
     const std::size_t N = engine.size();
     f.fx.assign(all.begin(), all.begin() + N);
     f.fy.assign(all.begin() + N, all.begin() + 2 * N);
@@ -173,7 +173,11 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     const auto it = ck.extra.int_scalars.find("collisions");
     const auto design = ck.extra.real_scalars.find("coulomb_sum_q2_design");
     if (design != ck.extra.real_scalars.end()) engine.useCoulombDesign(design->second);
-    engine.restore(ck.state, f, it == ck.extra.int_scalars.end() ? 0 : it->second);
+    md::EngineExtra extra;
+    extra.arrays = ck.extra.arrays;
+    extra.ints = ck.extra.int_scalars;
+    extra.reals = ck.extra.real_scalars;
+    engine.restore(ck.state, f, it == ck.extra.int_scalars.end() ? 0 : it->second, extra);
   }
   std::string dt_reason;
   md::Engine::chooseTimeStep(cfg, &dt_reason);
@@ -194,6 +198,9 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                   cs->method == "pppm" ? ("mesh " + std::to_string(cs->mesh) + "^3, order " + std::to_string(cs->order)).c_str()
                                        : ("k_max " + std::to_string(cs->k_max)).c_str(),
                   cs->estimated_error, cs->sum_q2_design);
+    if (const md::CoulombSetup* cs = engine.coulombSetup(); cs && cs->r_fast > 0.0)
+      std::printf("md: multiple time stepping: slow Coulomb part every %d steps; pair force within r_fast = %g every step\n",
+                  cfg.coulomb.every, cs->r_fast);
     if (restart) std::printf("md: restarting from step %lld of %s\n", static_cast<long long>(engine.step()), out.c_str());
   }
 
@@ -218,6 +225,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
       params.emplace_back("coulomb_k_max", std::to_string(cs->k_max));
       params.emplace_back("coulomb_estimated_error", common::formatReal(cs->estimated_error));
       params.emplace_back("coulomb_sum_q2_design", common::formatReal(cs->sum_q2_design));
+      params.emplace_back("coulomb_r_fast_used", common::formatReal(cs->r_fast));
     }
     writer = std::make_unique<md::H5mdWriter>(traj.string(), engine.size(), params, md::toToml(cfg), a.force,
                                               cfg.output.write_velocities, cfg.output.write_forces);
@@ -246,6 +254,10 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     c.next_frame_index = static_cast<std::uint64_t>(nextFrame - frames.begin());
     c.int_scalars["collisions"] = engine.observables().collisions;
     if (const md::CoulombSetup* cs = engine.coulombSetup()) c.real_scalars["coulomb_sum_q2_design"] = cs->sum_q2_design;
+    md::EngineExtra extra = engine.extraState();
+    c.arrays = std::move(extra.arrays);
+    c.int_scalars.insert(extra.ints.begin(), extra.ints.end());
+    c.real_scalars.insert(extra.reals.begin(), extra.reals.end());
     md::writeCheckpoint(cpath.string(), state, c);
   };
   auto lastCheckpoint = std::chrono::steady_clock::now();

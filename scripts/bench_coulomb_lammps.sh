@@ -10,12 +10,14 @@
 # particle-steps/s and the ratio granagg / LAMMPS on the same number of cores.
 #
 #   usage: bash scripts/bench_coulomb_lammps.sh [GRANAGG_BINARY]      (default build/bin/granagg)
-#   environment: SIZES="10000 100000"  STEPS_10000="20 120"  STEPS_100000="5 25"  DT=0.002
+#   environment: SIZES="10000 100000"  STEPS_10000="24 120"  STEPS_100000="8 48"  DT=0.002
 #                REPEATS=2  THREADS="1 2"  LMP_RANKS="1 2"  K=5  ACC=1e-4
 #                RC_ISSUE=8 (the issue's LAMMPS cutoff)  RC_SCAN="3 4 5 6" (LAMMPS cutoffs tried on
 #                one rank; the fastest is then also run on every rank count)
 #                STATE_DIR=dir (keep the generated initial states there and reuse them)
-#                KSPACE_EVERY="4" (also time granagg with the mesh part every 4 steps; not LAMMPS-equivalent)
+#                EVERY_ALSO="1" (also time granagg with coulomb.every = 1: the total force at every
+#                step, as LAMMPS integrates; the default rows use granagg's default multiple time
+#                stepping, coulomb.every = 8, whose accuracy the tests check)
 #                LMP_ACC (default ACC*K, see below)  ISSUE_LITERAL=1 (also time the issue's literal
 #                `kspace_style pppm 1e-4` at cutoff 8 on one rank)  SKIP_CHECKS=1
 #
@@ -51,7 +53,7 @@ K=${K:-5}
 ACC=${ACC:-1e-4}
 RC_ISSUE=${RC_ISSUE:-8}
 RC_SCAN=${RC_SCAN-"3 4 5 6"}
-KSPACE_EVERY=${KSPACE_EVERY:-}  # e.g. "4": also time granagg with coulomb.kspace_every = 4 (multiple time stepping)
+EVERY_ALSO=${EVERY_ALSO-1}  # also time granagg with these coulomb.every values (default: 1)
 E=278.6; D=27.7; PHI=0.076; SKIN=0.3
 calc() { awk "BEGIN {printf \"%.10g\", $1}"; }
 KN=$(calc "2 * $E"); GN=$(calc "4 * $D")
@@ -71,7 +73,7 @@ trap 'rm -rf "$TMP"' EXIT
 
 steps_for() {  # N -> "n1 n2"
   local var="STEPS_$1"
-  if [ -n "${!var:-}" ]; then echo "${!var}"; elif [ "$1" -le 2000 ]; then echo "20 120"; elif [ "$1" -le 20000 ]; then echo "20 120"; else echo "5 25"; fi
+  if [ -n "${!var:-}" ]; then echo "${!var}"; elif [ "$1" -le 20000 ]; then echo "24 120"; else echo "8 48"; fi  # windows of whole multiples of coulomb.every = 8
 }
 now() { date +%s.%N; }
 mins() { printf '%s\n' "$@" | sort -g | head -n 1; }
@@ -199,8 +201,8 @@ EOF
 fi
 
 # ---------------------------------------------------------------------------------------------
-granagg_time() {  # N steps threads [kspace_every] -> wall seconds of the whole process
-  local N=$1 n=$2 th=$3 every=${4:-1}
+granagg_time() {  # N steps threads [coulomb.every] -> wall seconds of the whole process
+  local N=$1 n=$2 th=$3 every=${4:-8}
   cat > "$TMP/g.toml" <<EOF
 [system]
 N = $N
@@ -222,7 +224,7 @@ initial = "file"
 K = $K
 method = "pppm"
 accuracy = $ACC
-kspace_every = $every
+every = $every
 [run]
 t_end = $(calc "$n * $DT")
 [output]
@@ -297,7 +299,7 @@ for N in $SIZES; do
     for th in $THREADS; do
       ta=$(granagg_time "$N" "$n1" "$th"); tb=$(granagg_time "$N" "$n2" "$th")
       T[a$th]+="$ta "; T[b$th]+="$tb "; R[g$th]+="$(calc "$N * ($n2 - $n1) / ($tb - $ta)") "
-      for ev in $KSPACE_EVERY; do
+      for ev in $EVERY_ALSO; do
         ta=$(granagg_time "$N" "$n1" "$th" "$ev"); tb=$(granagg_time "$N" "$n2" "$th" "$ev")
         T[a${th}_$ev]+="$ta "; T[b${th}_$ev]+="$tb "; R[g${th}_$ev]+="$(calc "$N * ($n2 - $n1) / ($tb - $ta)") "
       done
@@ -327,9 +329,9 @@ for N in $SIZES; do
       [ -z "${LR[${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[${th}_$rc]}" | xargs printf '%.2f') (cutoff $rc); "
     done
     # shellcheck disable=SC2086
-    ROWS+=("| $N | granagg pppm $ACC, own choice | $(sed 's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' "$rate") | ${ratios%; } | $(range ${R[g$th]}) |")
+    ROWS+=("| $N | granagg pppm $ACC, own choice, coulomb.every = 8 (default) | $(sed 's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' "$rate") | ${ratios%; } | $(range ${R[g$th]}) |")
   done
-  for ev in $KSPACE_EVERY; do
+  for ev in $EVERY_ALSO; do
     for th in $THREADS; do
       # shellcheck disable=SC2086
       rate=$(calc "$N * ($n2 - $n1) / ($(mins ${T[b${th}_$ev]}) - $(mins ${T[a${th}_$ev]}))")
@@ -338,7 +340,7 @@ for N in $SIZES; do
         [ -z "${LR[${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[${th}_$rc]}" | xargs printf '%.2f') (cutoff $rc); "
       done
       # shellcheck disable=SC2086
-      ROWS+=("| $N | granagg pppm $ACC, mesh part every $ev steps (coulomb.kspace_every = $ev) | $(sed 's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' "$rate") | ${ratios%; } | $(range ${R[g${th}_$ev]}) |")
+      ROWS+=("| $N | granagg pppm $ACC, coulomb.every = $ev | $(sed 's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' "$rate") | ${ratios%; } | $(range ${R[g${th}_$ev]}) |")
     done
   done
   NOTES+=("- N = $N, granagg: $(cat "$TMP/g_coulomb_$N.txt")")

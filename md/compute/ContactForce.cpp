@@ -1,5 +1,6 @@
 #include "md/compute/ContactForce.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -23,7 +24,7 @@ void ContactWork::resize(std::size_t n) {
 
 namespace {
 
-template <class Potential, bool COULOMB>
+template <class Potential, bool EXT, bool FAST_COULOMB>
 struct ContactForceFunctor {
   const Scalar4* pos;
   const double *vx, *vy, *vz;        // drift velocities u = v(t - dt/2) of the step just taken
@@ -39,14 +40,25 @@ struct ContactForceFunctor {
   ChargeExchange::Params charging;
   std::int64_t step;
   double* dq;
-  double K, alpha, rc2;  // Coulomb real space (COULOMB only)
+  // slow forces (EXT only; ContactStep): weight in this step's force, and in the predicted velocity
   const double *ext_fx, *ext_fy, *ext_fz;
+  double ext_force_scale, ext_predict_scale;
+  // fast part of the Coulomb force (FAST_COULOMB only): S(r) K q_i q_j / r^2, tabulated, zero
+  // from fast_r2sq = r2^2 on
+  double K, fast_r2sq;
+  PairTable fast_table;
 
-  /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old
+  /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old, corrected for
+  /// a multiple-time-step impulse given or about to be given (ContactStep::ext_predict_scale)
   HD void predicted(int k, double& a, double& b, double& c) const {
     a = vx[k] + h_pred * fx_old[k];
     b = vy[k] + h_pred * fy_old[k];
     c = vz[k] + h_pred * fz_old[k];
+    if (EXT && ext_predict_scale != 0.0) {
+      a += ext_predict_scale * ext_fx[k];
+      b += ext_predict_scale * ext_fy[k];
+      c += ext_predict_scale * ext_fz[k];
+    }
   }
 
   /// returns the collisions of pairs (i, j > i) that started this step and the check flag of i
@@ -64,14 +76,11 @@ struct ContactForceFunctor {
       const double rx = box.minimumImageWrapped(xi_ - rj.x), ry = box.minimumImageWrapped(yi_ - rj.y),
                    rz = box.minimumImageWrapped(zi_ - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
-      if (COULOMB) {
-        const double qq = ri.w * rj.w;
-        if (r2 < rc2 && qq != 0.0) {  // (an exchanging gas starts neutral)
-          const double fr = ewaldRealForceOverRFast(qq, sqrt(r2), alpha, K);
-          f0 += fr * rx;
-          f1 += fr * ry;
-          f2 += fr * rz;
-        }
+      if (FAST_COULOMB) {  // branch-free (most list entries lie inside r2, not all)
+        const double fr = K * ri.w * rj.w * fast_table(r2 < fast_r2sq ? r2 : fast_r2sq);
+        f0 += fr * rx;
+        f1 += fr * ry;
+        f2 += fr * rz;
       }
       if (r2 >= 1.0) continue;
       const double r = sqrt(r2);
@@ -100,10 +109,10 @@ struct ContactForceFunctor {
                                             static_cast<std::uint32_t>(id[j]), xi_dot);
       }
     }
-    if (ext_fx) {
-      f0 += ext_fx[i];
-      f1 += ext_fy[i];
-      f2 += ext_fz[i];
+    if (EXT && ext_force_scale != 0.0) {
+      f0 += ext_force_scale * ext_fx[i];
+      f1 += ext_force_scale * ext_fy[i];
+      f2 += ext_force_scale * ext_fz[i];
     }
     fx[i] = f0;
     fy[i] = f1;
@@ -139,8 +148,6 @@ struct SummaryFunctor {
   int cap;
   common::Box box;
   typename Potential::Params params;
-  bool coulomb;
-  double K, alpha, rc2;
   HD ContactSummary operator()(int i) const {
     ContactSummary s;
     const int* row = rows + static_cast<long>(i) * cap;
@@ -150,7 +157,6 @@ struct SummaryFunctor {
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
-      if (coulomb && r2 < rc2) s.coulomb_real_energy += 0.5 * ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);
       if (r2 >= 1.0) continue;
       const double xi = 1.0 - sqrt(r2);
       s.elastic_energy += 0.5 * Potential::elasticEnergy(xi, params);  // half per partner
@@ -168,7 +174,6 @@ struct CombineSummary {
     r.overlap_sum = a.overlap_sum + b.overlap_sum;
     r.max_overlap = a.max_overlap > b.max_overlap ? a.max_overlap : b.max_overlap;
     r.contacts = a.contacts + b.contacts;
-    r.coulomb_real_energy = a.coulomb_real_energy + b.coulomb_real_energy;
     return r;
   }
 };
@@ -180,17 +185,17 @@ struct MaxOverlapOf {
 
 }  // namespace
 
-template <class Potential, bool COULOMB>
+template <class Potential, bool EXT, bool FAST_COULOMB>
 ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const common::Box& box,
                             const typename Potential::Params& params, const ContactStep& st, ContactWork& w) {
   const int N = static_cast<int>(p.size());
   const double dt = st.dt, half_dt = 0.5 * dt;
   if (w.fx.size() != p.size()) w.resize(p.size());
-  ContactForceFunctor<Potential, COULOMB> f{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz),
-                                            nl.rows(), nl.counts(), nl.capacity(), box, params, st.max_overlap, half_dt, dt,
-                                            raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id), st.charging, st.step, st.dq,
-                                            st.coulomb_K, st.coulomb_alpha, st.coulomb_r_cut * st.coulomb_r_cut,
-                                            st.ext_fx, st.ext_fy, st.ext_fz};
+  ContactForceFunctor<Potential, EXT, FAST_COULOMB> f{
+      raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), nl.rows(), nl.counts(),
+      nl.capacity(), box, params, st.max_overlap, half_dt, dt, raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id),
+      st.charging, st.step, st.dq, st.ext_fx, st.ext_fy, st.ext_fz, st.ext_force_scale, st.ext_predict_scale,
+      st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table};
   // forces and, per block, collisions (sum) and the worst flag (max); then one reduction over blocks
   const int block = blockSizeFor(N);
   w.block_flags.resize(blockCount(N, block));
@@ -205,18 +210,19 @@ template <class Potential>
 ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
                                        const typename Potential::Params& params, const ContactStep& st,
                                        ContactWork& w) {
-  if (st.coulomb_real && nl.listRange() < st.coulomb_r_cut)
-    throw std::logic_error("neighbour list range below the Coulomb real-space cutoff");
-  return st.coulomb_real ? forcePass<Potential, true>(p, nl, box, params, st, w)
-                         : forcePass<Potential, false>(p, nl, box, params, st, w);
+  const bool fast = st.fast.r2 > 0.0;
+  if (fast && (nl.listRange() < st.fast.r2 || !st.fast_table.data))
+    throw std::logic_error("neighbour list range below the fast Coulomb range");
+  if (fast) return forcePass<Potential, true, true>(p, nl, box, params, st, w);
+  return st.ext_fx ? forcePass<Potential, true, false>(p, nl, box, params, st, w)
+                   : forcePass<Potential, false, false>(p, nl, box, params, st, w);
 }
 
 template <class Potential>
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                              const typename Potential::Params& params, const ContactStep& st) {
+                              const typename Potential::Params& params) {
   const int N = static_cast<int>(p.size());
-  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params,
-                              st.coulomb_real, st.coulomb_K, st.coulomb_alpha, st.coulomb_r_cut * st.coulomb_r_cut};
+  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
   return thrust::transform_reduce(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), s, ContactSummary{},
                                   CombineSummary{});
 }
@@ -226,7 +232,7 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
                            const typename Potential::Params& params, DVec<double>& out) {
   const int N = static_cast<int>(p.size());
   out.resize(p.size());
-  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params, false, 0.0, 0.0, 0.0};
+  SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
   thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), out.begin(),
                     MaxOverlapOf<Potential>{s});
 }
@@ -236,7 +242,7 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
   template ContactStepResult computeContactForces<P>(ParticleData&, const NeighborList&, const common::Box&,      \
                                                      const P::Params&, const ContactStep&, ContactWork&);        \
   template ContactSummary contactSummary<P>(const ParticleData&, const NeighborList&, const common::Box&,          \
-                                            const P::Params&, const ContactStep&);                                \
+                                            const P::Params&);                                                    \
   template void maxOverlapPerParticle<P>(const ParticleData&, const NeighborList&, const common::Box&,             \
                                          const P::Params&, DVec<double>&);
 GRANAGG_CONTACT_MODEL(HertzViscoelastic)

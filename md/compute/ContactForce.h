@@ -21,6 +21,7 @@
 #include <cstdint>
 
 #include "common/Box.h"
+#include "md/coulomb/RealSpace.h"
 #include "md/engine/ParticleData.h"
 #include "md/neighbor/NeighborList.h"
 #include "md/potentials/ChargeExchange.h"
@@ -50,13 +51,23 @@ struct ContactStep {
   /// Charging on: per-particle charge gained this step, written where nonzero (the caller applies
   /// and clears it before the next pass: kickDrift / closeKick). Null: no charging.
   double* dq = nullptr;
-  /// Coulomb real-space (Ewald-split) pair force K q_i q_j [erfc(alpha r)/r^2 + ...] for pairs
-  /// closer than coulomb_r_cut (md/coulomb/RealSpace.h); the neighbour list must reach that far.
-  bool coulomb_real = false;
-  double coulomb_K = 0.0, coulomb_alpha = 0.0, coulomb_r_cut = 0.0;
-  /// Forces computed elsewhere (the mesh part of PPPM, or a whole plain-Ewald evaluation), added
-  /// to each particle's total; null: none.
+  /// Slow forces computed elsewhere (the Coulomb force: real space + mesh, or a plain-Ewald
+  /// evaluation), per slot; null: none. The step's force is f_contact + ext_force_scale * ext, and
+  /// the predicted velocities of the dissipative term get ext_predict_scale * ext added. For the
+  /// engine's impulse multiple-time-step integrator (Engine.h) with slow weight w_n = k at slow
+  /// steps and 0 between: ext_force_scale = w_n and ext_predict_scale = (dt/2)(w_n - w_{n-1}),
+  /// because f_old holds w_{n-1} ext (the impulse of the previous step is not part of the
+  /// velocity trend) and this step's half impulse belongs to v(t). With every step slow (k = 1)
+  /// the weight is 1 and the prediction needs no correction.
   const double *ext_fx = nullptr, *ext_fy = nullptr, *ext_fz = nullptr;
+  double ext_force_scale = 1.0, ext_predict_scale = 0.0;
+  /// Fast part of the Coulomb force, added at every step: the bare pair force S(r) K q_i q_j / r^2
+  /// for r < fast.r2 <= the real-space cutoff (md/coulomb/RealSpace.h; the slow part is the Ewald
+  /// total minus this), from fast_table (fastPairTableValues on [0, fast.r2^2]); fast.r2 = 0: none.
+  /// The list must reach that range.
+  RealSpaceSwitch fast{};
+  PairTable fast_table{};
+  double coulomb_K = 0.0;
 };
 
 /// Contact forces of the current positions into p.fx, p.fy, p.fz (state as described above),
@@ -72,12 +83,10 @@ struct ContactSummary {
   double overlap_sum = 0.0;     ///< sum of overlaps over pairs in contact (each pair once)
   double max_overlap = 0.0;
   std::int64_t contacts = 0;    ///< sum over particles of partners in contact (2 x pairs)
-  double coulomb_real_energy = 0.0;  ///< real-space Ewald energy (0 unless `step` has coulomb_real)
 };
-/// \param step only its Coulomb fields are used (the real-space energy).
 template <class Potential>
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                              const typename Potential::Params& params, const ContactStep& step = {});
+                              const typename Potential::Params& params);
 /// Largest overlap of each particle (storage order), for error messages.
 template <class Potential>
 void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const common::Box& box,

@@ -15,7 +15,7 @@
 ///     [charging]    mode ("exchange" | "fixed"), initial ("neutral" | "monopolar" | "bipolar" | "file"),
 ///                   q0, Q, kappa, psi1_min, psi1_max, psi2_fraction
 ///     [coulomb]     K, method ("pppm" | "ewald"), accuracy, r_cut, mesh, order ("auto" or numbers),
-///                   kspace_every
+///                   every, skin, r_fast
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
 ///                   checkpoint_wall_seconds, write_velocities, write_forces
@@ -78,7 +78,11 @@ struct CoulombConfig {
   double r_cut = 0.0;              ///< real-space cutoff; 0 = "auto"
   int mesh = 0;                    ///< mesh points per side (pppm); 0 = "auto"
   int order = 0;                   ///< charge-assignment order 2..7 (pppm); 0 = "auto"
-  int kspace_every = 1;            ///< evaluate the mesh (k-space) part every this many steps
+  /// Multiple time stepping (Engine.h): the slow Coulomb force is evaluated every this many steps
+  /// and applied as an impulse; 1 = every step (plain velocity Verlet with the total force).
+  int every = 8;
+  double skin = 0.0;               ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or neighbor.skin when every = 1)
+  double r_fast = 0.0;             ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (3.5)
 };
 
 struct RunConfig {

@@ -12,6 +12,7 @@
 /// Units: reduced (d = 1); K = l_B / d is the coupling constant (force between two unit charges
 /// at unit distance), charges in units of q_ref, energies in T0, forces in T0 / d.
 #include <cmath>
+#include <vector>
 
 #include "common/HostDevice.h"
 
@@ -50,6 +51,81 @@ HD inline double ewaldRealForceOverRFast(double qiqj, double r, double alpha, do
   const double erfc_ar = t * (A1 + t * (A2 + t * (A3 + t * (A4 + t * A5)))) * e;
   const double inv_r = 1.0 / r;
   return K * qiqj * (erfc_ar * inv_r + TWO_OVER_SQRT_PI * alpha * e) * inv_r * inv_r;
+}
+
+/// Splitting of the Coulomb force between the two levels of the multiple-time-step integrator
+/// (Engine.h): the fast (every-step) part is the bare pair force S(r) K q_i q_j / r^2 and the slow
+/// part the Ewald total minus it, which is smooth at short range (there the real-space term minus
+/// the bare force is minus the pair's smooth erf part; the mesh carries the same, so they cancel),
+/// with
+/// S = 1 for r <= r1, S = 0 for r >= r2 and the quintic smoothstep in between, S(x) = 1 - x^3 (10 -
+/// 15 x + 6 x^2) with x = (r - r1) / (r2 - r1): continuous with two continuous derivatives, so
+/// neither level sees a kink (the RESPA split of Zhou, Harder, Xu & Berne, J. Chem. Phys. 115,
+/// 2348 (2001)).
+struct RealSpaceSwitch {
+  double r1 = 0.0, r2 = 0.0;  ///< r2 = 0: no fast part (S = 0 everywhere)
+  HD double fastFraction(double r) const {
+    if (r >= r2) return 0.0;
+    if (r <= r1) return 1.0;
+    const double x = (r - r1) / (r2 - r1);
+    return 1.0 - x * x * x * (10.0 - 15.0 * x + 6.0 * x * x);
+  }
+};
+
+/// The slow pair force of a split with r1 >= 1 (every contact entirely fast), divided by K q_i q_j
+/// and by r: g(r) = [erfc(alpha r)/r + (2 alpha/sqrt pi) exp(-alpha^2 r^2)] / r^2 - S(r) / r^3.
+/// Where S = 1 this is minus the pair's smooth erf part, finite at r = 0 (-4 alpha^3 / (3 sqrt pi)),
+/// so it is evaluated in that form there (no cancellation of two large terms).
+inline double slowPairForceOverR(double r, double alpha, const RealSpaceSwitch& sw) {
+  const double ar = alpha * r;
+  if (r <= sw.r1) {
+    if (ar < 1e-3)  // series: erf(x)/x - 2/sqrt(pi) exp(-x^2) = (2/sqrt(pi)) (2 x^2/3 - 4 x^4/5 + ...)
+      return -TWO_OVER_SQRT_PI * alpha * alpha * alpha * (2.0 / 3.0 - 0.8 * ar * ar);
+    return -(std::erf(ar) / r - TWO_OVER_SQRT_PI * alpha * std::exp(-ar * ar)) / (r * r);
+  }
+  return (std::erfc(ar) / r + TWO_OVER_SQRT_PI * alpha * std::exp(-ar * ar)) / (r * r) - sw.fastFraction(r) / (r * r * r);
+}
+
+/// Linear interpolation in r^2 of a table of a smooth function g (here slowPairForceOverR) on
+/// [0, r2_max]: entry k holds g(k h) and g((k+1) h) - g(k h), h = r2_max / n. Tabulating in r^2
+/// needs no square root; LAMMPS tabulates its coul/long force the same way (pair_modify table).
+struct PairTable {
+  const double* data = nullptr;  ///< 2 (n + 1) values (device pointer)
+  double inv_h = 0.0;
+  HD double operator()(double r2) const {
+    const double x = r2 * inv_h;
+    const int k = static_cast<int>(x);
+    const double* e = data + 2 * k;
+    return e[0] + (x - k) * e[1];
+  }
+};
+/// The fast pair force of the split divided by K q_i q_j and by r: S(r) / r^3, held at its value at
+/// r = 0.3 below that (no pair gets that close: an overlap of 0.7 aborts a run long before).
+inline double fastPairForceOverR(double r, const RealSpaceSwitch& sw) {
+  const double rr = r < 0.3 ? 0.3 : r;
+  return sw.fastFraction(rr) / (rr * rr * rr);
+}
+/// Host values of a PairTable of g with n intervals on [0, r2_max] (g of r^2 at the nodes).
+template <class G>
+std::vector<double> pairTableValues(G g_of_r2, double r2_max, int n) {
+  const double h = r2_max / n;
+  std::vector<double> g(n + 2), out(2 * (n + 1));
+  for (int k = 0; k <= n + 1; ++k) g[k] = g_of_r2(k * h, k);
+  for (int k = 0; k <= n; ++k) {
+    out[2 * k] = g[k];
+    out[2 * k + 1] = g[k + 1] - g[k];
+  }
+  return out;
+}
+/// Table of fastPairForceOverR on [0, r2^2]; entries from r2^2 on are 0 (S(r2) = 0), so a lookup
+/// at min(r^2, r2^2) is the force for any r.
+inline std::vector<double> fastPairTableValues(const RealSpaceSwitch& sw, int n) {
+  return pairTableValues([&](double r2, int k) { return k >= n ? 0.0 : fastPairForceOverR(std::sqrt(r2), sw); },
+                         sw.r2 * sw.r2, n);
+}
+/// Table of slowPairForceOverR on [0, r2_max].
+inline std::vector<double> slowPairTableValues(double alpha, const RealSpaceSwitch& sw, double r2_max, int n) {
+  return pairTableValues([&](double r2, int) { return slowPairForceOverR(std::sqrt(r2), alpha, sw); }, r2_max, n);
 }
 
 }  // namespace granagg::md

@@ -16,6 +16,7 @@
 #include <thrust/sequence.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/reduce.h>
+#include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
 #if defined(__CUDACC__)
@@ -27,6 +28,7 @@
 #include "common/Box.h"
 #include "common/Csv.h"
 #include "md/compute/ContactForce.h"
+#include "md/compute/CoulombRealSpace.h"
 #include "md/coulomb/Ewald.h"
 #include "md/coulomb/EwaldParams.h"
 #include "md/coulomb/Pppm.h"
@@ -41,6 +43,9 @@ namespace granagg::md {
 
 namespace {
 constexpr double M_EFF = 0.5;  // reduced mass of two unit masses
+// intervals of the tables of the fast and slow Coulomb pair forces (PairTable): interpolation
+// errors ~1e-7 relative to K (tests)
+constexpr int PAIR_TABLE_INTERVALS = 1 << 13;
 
 template <class T>
 std::vector<T> toHost(const DVec<T>& d) {
@@ -84,6 +89,10 @@ struct CombineCharges {
     return ChargeSums{a.total + b.total, a.abs_sum + b.abs_sum, a.abs_max > b.abs_max ? a.abs_max : b.abs_max};
   }
 };
+struct Axpy {  // v + a f
+  double a;
+  HD double operator()(double v, double f) const { return v + a * f; }
+};
 struct Abs3 {
   const double *vx, *vy, *vz;
   HD double operator()(int i) const { return sqrt(vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]); }
@@ -109,20 +118,29 @@ struct Engine::Impl {
   bool exchange = false;           // collisional charging on (charging.mode = "exchange")
   ChargeExchange::Params charging{};
   DVec<double> dq;                 // charge gained at the last force pass, per slot (exchange only)
-  // Coulomb (coulomb.K > 0): mesh part (PPPM) or a whole plain-Ewald evaluation into ext_f*
+  // Coulomb (coulomb.K > 0): the slow force of the impulse multiple-time-step integrator
+  // (Engine.h), evaluated every coulomb.every steps into ext_f*: PPPM's real space over its own
+  // neighbour list nl_coul plus its mesh part, or a whole plain-Ewald evaluation
   bool coulomb = false;
+  int every = 1;                            // coulomb.every
   CoulombSetup csetup;
   std::unique_ptr<Pppm> pppm;
   std::unique_ptr<EwaldReference> ewald;
-  DVec<double> ext_fx, ext_fy, ext_fz;
+  std::unique_ptr<NeighborList> nl_coul;    // pppm: reaches r_cut + coulomb.skin
+  RealSpaceSwitch fast_switch{};            // pppm with every > 1: the real space within r_fast is fast
+  DVec<double> slow_table, fast_table;      // ... and the slow and fast pair forces tabulated (PairTable)
+  double drift_since_coul_build = 0.0;      // as drift_since_build, for nl_coul
+  DVec<double> ext_fx, ext_fy, ext_fz;      // the Coulomb force at the last evaluation, per slot
   double coulomb_ext_energy = 0.0;          // pppm: mesh + self + background; ewald: everything
-  std::int64_t kspace_step = -1;            // step of the last mesh evaluation (-1: none yet)
+  std::int64_t kspace_step = -1;            // step of the last Coulomb evaluation (-1: none yet)
   bool hertz = true;
   HertzViscoelastic::Params hertz_params{};
   SpringDashpot::Params sd_params{};
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
     exchange = c.charging.mode == "exchange";
+    // multiple time stepping with PPPM only: the plain-Ewald reference has no fast/slow split
+    every = c.coulomb.method == "pppm" ? c.coulomb.every : 1;
     charging.seed = c.system.seed;
     charging.Q = c.charging.Q;
     charging.kappa = c.charging.kappa;
@@ -156,17 +174,40 @@ struct Engine::Impl {
     if (order.size() != p.size()) return;  // all-pairs builds: nothing to sort
     permute(p.pos, order, scratch4);  // (dq is all zero here: applied by the kick pass before)
     for (auto* v : {&p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz}) permute(*v, order, scratch_d);
-    if (coulomb)  // mesh forces reused between evaluations (coulomb.kspace_every > 1) follow their particles
+    if (coulomb)  // the Coulomb forces, used until the next evaluation, follow their particles
       for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) permute(*v, order, scratch_d);
     for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
   }
 
-  /// Builds the neighbour list for the current positions (storage first re-sorted by cell: the
+  /// Builds the neighbour lists for the current positions (storage first re-sorted by cell: the
   /// cost is a gather per array, far less than the cache misses of neighbours scattered in memory).
+  /// A re-sort moves slots, so it rebuilds every list.
   void rebuildList(bool sort) {
     if (sort) sortByCell();
-    nl.build(p, box);
+    if (nl_coul) {
+      nl_coul->build(p, box);
+      drift_since_coul_build = 0.0;
+      nl.buildFrom(*nl_coul, p, box);
+    } else {
+      nl.build(p, box);
+    }
     drift_since_build = 0.0;
+  }
+  /// Contact list only, when it alone is out of date. With a Coulomb list the storage is not
+  /// re-sorted here (that would invalidate the Coulomb list's slots; it is re-sorted when the
+  /// Coulomb list is rebuilt, often enough for locality), and the contact list is filtered from
+  /// the Coulomb list's rows while that still holds every pair within the contact list's range:
+  /// a pair within R now was within R + 2 d when the Coulomb list was built, d bounding every
+  /// displacement since.
+  void rebuildContactList() {
+    if (!nl_coul) {
+      rebuildList(true);
+    } else if (nl.listRange() <= nl_coul->listRange() - 2.0 * drift_since_coul_build) {
+      nl.buildFrom(*nl_coul, p, box);
+      drift_since_build = 0.0;
+    } else {
+      rebuildList(true);
+    }
   }
 
   /// Chooses the Coulomb method's parameters for the configured accuracy (docs/coulomb.md) and
@@ -183,17 +224,24 @@ struct Engine::Impl {
     csetup.sum_q2_design = sum_q2_design;
     pppm.reset();
     ewald.reset();
-    double list_cutoff = 1.0;
+    nl_coul.reset();
+    fast_switch = RealSpaceSwitch{};
+    slow_table.clear();
+    fast_table.clear();
+    nl = NeighborList(1.0, skin);
     if (cc.method == "pppm") {
-      const double rc_max = 0.5 * L - skin;  // the list must reach r_cut + skin within L/2
+      // "auto": a longer skin than the contact list's when the list is used every k-th step only
+      // (fewer builds of a long list; measured optimum at N = 1e4, K = 5: docs/benchmarks-coulomb.md)
+      const double coul_skin = cc.skin > 0.0 ? cc.skin : (every > 1 ? 0.8 : skin);
+      const double rc_max = 0.5 * L - coul_skin;  // the list must reach r_cut + skin within L/2
       if (cc.r_cut > rc_max)
-        throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) + " exceeds L/2 - neighbor.skin = " +
+        throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) + " exceeds L/2 - coulomb.skin = " +
                                     common::formatReal(rc_max) + " for this box (L = " + common::formatReal(L) + ")");
       PppmParams prm;
       if (cc.r_cut > 0.0) {
         prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut, cc.order > 0 ? cc.order : 5);
       } else {
-        if (!(rc_max >= 1.0)) throw std::invalid_argument("box too small for PPPM with this neighbor.skin (L/2 - skin < 1)");
+        if (!(rc_max >= 1.0)) throw std::invalid_argument("box too small for PPPM with this coulomb.skin (L/2 - skin < 1)");
         prm = optimizePppmParams(cc.accuracy, N, L, sum_q2_design, 1.0, rc_max);
         if (cc.order > 0 && cc.order != prm.order)
           prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, prm.r_cut, cc.order);
@@ -208,7 +256,24 @@ struct Engine::Impl {
       csetup.mesh = prm.mesh;
       csetup.order = prm.order;
       csetup.estimated_error = prm.estimatedError();
-      list_cutoff = std::max(1.0, prm.r_cut);
+      nl_coul = std::make_unique<NeighborList>(prm.r_cut, coul_skin);
+      // multiple time stepping: the near real space, which changes as fast as pairs approach, is
+      // computed at every step in the contact pass (its list then reaches r_fast), the rest is slow
+      fast_switch = RealSpaceSwitch{};
+      if (every > 1) {
+        const double r2 = std::min(cc.r_fast > 0.0 ? cc.r_fast : 3.5, prm.r_cut);
+        if (r2 < 2.0)
+          throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(prm.r_cut) + " leaves coulomb.r_fast = " +
+                                      common::formatReal(r2) + " < 2 for the multiple time stepping (coulomb.every > 1): "
+                                      "use a larger r_cut or coulomb.every = 1");
+        fast_switch = RealSpaceSwitch{std::max(0.0, r2 - 1.0), r2};
+        csetup.r_fast = r2;
+        const auto t = slowPairTableValues(prm.alpha, fast_switch, prm.r_cut * prm.r_cut, PAIR_TABLE_INTERVALS);
+        slow_table.assign(t.begin(), t.end());
+        const auto f = fastPairTableValues(fast_switch, PAIR_TABLE_INTERVALS);
+        fast_table.assign(f.begin(), f.end());
+      }
+      nl = NeighborList(std::max(1.0, fast_switch.r2), skin);
     } else {
       const EwaldParams prm = chooseEwaldParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut);
       ewald = std::make_unique<EwaldReference>(prm, L, cc.K);
@@ -219,20 +284,24 @@ struct Engine::Impl {
     }
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(N, 0.0);
     kspace_step = -1;
-    nl = NeighborList(list_cutoff, skin);
   }
 
-  /// Coulomb forces computed outside the force pass into ext_f*: PPPM's mesh part (every
-  /// kspace_every steps, reused in between), or everything for plain Ewald (host, O(N^2) real space).
-  void computeCoulombExternal() {
-    const int every = cfg.coulomb.kspace_every;
+  CoulombRealParams realParams() const {
+    CoulombRealParams prm{cfg.coulomb.K, csetup.alpha, csetup.r_cut, fast_switch};
+    if (!slow_table.empty()) prm.table = PairTable{raw(slow_table), PAIR_TABLE_INTERVALS / (csetup.r_cut * csetup.r_cut)};
+    return prm;
+  }
+
+  /// The Coulomb force of the current positions into ext_f* (and the energy of everything but the
+  /// PPPM real space into coulomb_ext_energy): PPPM real space over nl_coul plus the mesh part, or
+  /// everything for plain Ewald (host, O(N^2) real space).
+  void evaluateCoulomb() {
     const std::size_t N = p.size();
+    kspace_step = step;
     if (pppm) {
-      if (kspace_step >= 0 && step - kspace_step < every && step % every != 0) return;
-      for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) thrust::fill(v->begin(), v->end(), 0.0);
+      coulombRealForces(p, *nl_coul, box, realParams(), ext_fx, ext_fy, ext_fz);
       coulomb_ext_energy = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), N, raw(ext_fx), raw(ext_fy),
                                          raw(ext_fz), raw(p.id));
-      kspace_step = step;
       return;
     }
     const auto pos = toHost(p.pos);
@@ -245,32 +314,48 @@ struct Engine::Impl {
     coulomb_ext_energy = r.energy;
   }
 
-  ContactStep makeStep(double dt_taken) const {
+  /// Weight of the Coulomb force in the force of step `at` (Engine.h): k at evaluation steps, 0
+  /// between (1 at every step when k = 1).
+  double slowWeight(std::int64_t at) const { return at == kspace_step ? static_cast<double>(every) : 0.0; }
+
+  /// \param slow_weight weight of ext_f* in this step's force (0: not added)
+  ContactStep makeStep(double dt_taken, double slow_weight, double prev_weight) const {
     ContactStep st;
     st.dt = dt_taken;
     st.max_overlap = cfg.run.max_overlap;
     st.step = step;
     st.charging = charging;
     if (coulomb) {
-      st.coulomb_real = pppm != nullptr;  // plain Ewald: all in ext_f*
-      st.coulomb_K = cfg.coulomb.K;
-      st.coulomb_alpha = csetup.alpha;
-      st.coulomb_r_cut = csetup.r_cut;
       st.ext_fx = raw(ext_fx);
       st.ext_fy = raw(ext_fy);
       st.ext_fz = raw(ext_fz);
+      st.ext_force_scale = slow_weight;
+      // f_old holds prev_weight ext (ContactStep); with k = 1 both weights are 1 and f_old's
+      // Coulomb part is the trend itself
+      st.ext_predict_scale = every > 1 ? 0.5 * dt_taken * (slow_weight - prev_weight) : 0.0;
+      st.fast = fast_switch;
+      st.coulomb_K = cfg.coulomb.K;
+      if (!fast_table.empty())
+        st.fast_table = PairTable{raw(fast_table), PAIR_TABLE_INTERVALS / (fast_switch.r2 * fast_switch.r2)};
     }
     return st;
   }
 
   /// Forces of the current positions into p.f (state as in ContactForce.h; dt_taken = 0 for a
-  /// state given at full step); counts collisions; aborts on NaN / deep overlap.
+  /// state given at full step); counts collisions; aborts on NaN / deep overlap. With Coulomb, at
+  /// every `every`-th step (counted from the last evaluation) the Coulomb force is evaluated first
+  /// and enters p.f with weight `every` (the impulse), and between evaluations not at all.
   void computeForces(double dt_taken) {
     // Displacements since the last build are at most the sum of dt max|u| over the steps (a
     // rigorous bound that needs no stored reference positions).
-    if (nl.needsRebuild(p, drift_since_build * drift_since_build)) rebuildList(true);
-    if (coulomb) computeCoulombExternal();
-    ContactStep st = makeStep(dt_taken);
+    const bool slow = coulomb && (kspace_step < 0 || step - kspace_step >= every);
+    const double prev_weight = coulomb && kspace_step == step - 1 ? static_cast<double>(every) : 0.0;
+    if (slow && nl_coul && nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build))
+      rebuildList(true);
+    else if (nl.needsRebuild(p, drift_since_build * drift_since_build))
+      rebuildContactList();
+    if (slow) evaluateCoulomb();
+    ContactStep st = makeStep(dt_taken, coulomb ? slowWeight(step) : 0.0, prev_weight);
     st.dq = dqOrNull();
     const ContactStepResult r = hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
                                       : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
@@ -294,9 +379,51 @@ struct Engine::Impl {
   }
 
   ContactSummary summary() const {
-    const ContactStep st = makeStep(0.0);
-    return hertz ? contactSummary<HertzViscoelastic>(p, nl, box, hertz_params, st)
-                 : contactSummary<SpringDashpot>(p, nl, box, sd_params, st);
+    return hertz ? contactSummary<HertzViscoelastic>(p, nl, box, hertz_params)
+                 : contactSummary<SpringDashpot>(p, nl, box, sd_params);
+  }
+
+  /// Velocity offset of the impulse integrator against the smooth trajectory, per unit Coulomb
+  /// force: (k/2 - j) dt at j = 1..k-1 steps after an evaluation, 0 at the evaluation step itself
+  /// (whose v(t) holds half the impulse) and with k = 1 (Engine.h).
+  double velocityOffset() const {
+    if (!coulomb || every == 1 || kspace_step < 0) return 0.0;
+    const std::int64_t j = step - kspace_step;
+    return j == 0 ? 0.0 : (0.5 * every - static_cast<double>(j)) * dt;
+  }
+  /// v - velocityOffset() * F_coulomb, per slot.
+  void smoothVelocities(DVec<double>& sx, DVec<double>& sy, DVec<double>& sz) const {
+    const double c = velocityOffset();
+    const std::pair<const DVec<double>*, const DVec<double>*> in[3] = {{&p.vx, &ext_fx}, {&p.vy, &ext_fy}, {&p.vz, &ext_fz}};
+    DVec<double>* out[3] = {&sx, &sy, &sz};
+    for (int a = 0; a < 3; ++a) {
+      out[a]->resize(p.size());
+      thrust::transform(in[a].first->begin(), in[a].first->end(), in[a].second->begin(), out[a]->begin(), Axpy{-c});
+    }
+  }
+
+  /// The Coulomb energy of the current positions: from the last evaluation when it was at this
+  /// step, otherwise evaluated afresh (observables between evaluations; the forces of the run are
+  /// not touched, and re-building the Coulomb list changes no result: rows are in id order).
+  double coulombEnergyNow() {
+    if (!coulomb) return 0.0;
+    if (pppm) {
+      if (nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build)) {
+        nl_coul->build(p, box);
+        drift_since_coul_build = 0.0;
+      }
+      double ext = coulomb_ext_energy;
+      if (kspace_step != step) {
+        DVec<double> gx(p.size(), 0.0), gy(p.size(), 0.0), gz(p.size(), 0.0);
+        ext = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), p.size(), raw(gx), raw(gy), raw(gz), raw(p.id));
+      }
+      return coulombRealEnergy(p, *nl_coul, box, realParams()) + ext;
+    }
+    if (kspace_step == step) return coulomb_ext_energy;
+    const auto pos = toHost(p.pos);
+    std::vector<double> x(p.size()), y(p.size()), z(p.size()), q(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) x[i] = pos[i].x, y[i] = pos[i].y, z[i] = pos[i].z, q[i] = pos[i].w;
+    return ewald->compute(x, y, z, q).energy;
   }
 
   [[noreturn]] void abort(int worst) {
@@ -347,6 +474,7 @@ struct Engine::Impl {
     const double max_u2 = kickDrift(p, 0.5 * dt, dt, box, close_pending, dqOrNull(), block_max);
     close_pending = false;
     drift_since_build += dt * std::sqrt(max_u2);
+    drift_since_coul_build += dt * std::sqrt(max_u2);
     ++step;
     time = step * dt;  // no accumulated round-off in t
     computeForces(dt);
@@ -447,7 +575,7 @@ void Engine::run(std::int64_t steps) {
   m_impl->finishStep();  // callers see full-step velocities
 }
 
-Frame Engine::frame() const {
+Frame Engine::frame(StateKind kind) const {
   const Impl& d = *m_impl;
   const DVec<int>& id = d.p.id;
   Frame f;
@@ -466,25 +594,56 @@ Frame Engine::frame() const {
     f.z[i] = pos[i].z;
     f.charge[i] = pos[i].w;
   }
-  f.vx = toHostById(d.p.vx, id);
-  f.vy = toHostById(d.p.vy, id);
-  f.vz = toHostById(d.p.vz, id);
+  if (kind == StateKind::Physical && d.velocityOffset() != 0.0) {
+    DVec<double> sx, sy, sz;
+    d.smoothVelocities(sx, sy, sz);
+    f.vx = toHostById(sx, id);
+    f.vy = toHostById(sy, id);
+    f.vz = toHostById(sz, id);
+  } else {
+    f.vx = toHostById(d.p.vx, id);
+    f.vy = toHostById(d.p.vy, id);
+    f.vz = toHostById(d.p.vz, id);
+  }
   f.ix = toHostById(d.p.ix, id);
   f.iy = toHostById(d.p.iy, id);
   f.iz = toHostById(d.p.iz, id);
   return f;
 }
 
-std::vector<double> Engine::forces() const {
+std::vector<double> Engine::forces(StateKind kind) const {
   const Impl& d = *m_impl;
-  std::vector<double> out = toHostById(d.p.fx, d.p.id);
-  const auto fy = toHostById(d.p.fy, d.p.id), fz = toHostById(d.p.fz, d.p.id);
+  const DVec<double>* f[3] = {&d.p.fx, &d.p.fy, &d.p.fz};
+  DVec<double> g[3];
+  const double w = d.coulomb ? 1.0 - d.slowWeight(d.step) : 0.0;  // physical: contact + Coulomb once
+  if (kind == StateKind::Physical && w != 0.0) {
+    const DVec<double>* ext[3] = {&d.ext_fx, &d.ext_fy, &d.ext_fz};
+    for (int a = 0; a < 3; ++a) {
+      g[a].resize(d.p.size());
+      thrust::transform(f[a]->begin(), f[a]->end(), ext[a]->begin(), g[a].begin(), Axpy{w});
+      f[a] = &g[a];
+    }
+  }
+  std::vector<double> out = toHostById(*f[0], d.p.id);
+  const auto fy = toHostById(*f[1], d.p.id), fz = toHostById(*f[2], d.p.id);
   out.insert(out.end(), fy.begin(), fy.end());
   out.insert(out.end(), fz.begin(), fz.end());
   return out;
 }
 
-void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions) {
+EngineExtra Engine::extraState() const {
+  const Impl& d = *m_impl;
+  EngineExtra e;
+  if (!d.coulomb) return e;
+  e.arrays["coulomb_fx"] = toHostById(d.ext_fx, d.p.id);
+  e.arrays["coulomb_fy"] = toHostById(d.ext_fy, d.p.id);
+  e.arrays["coulomb_fz"] = toHostById(d.ext_fz, d.p.id);
+  e.ints["coulomb_eval_step"] = d.kspace_step;
+  e.reals["coulomb_energy_ext"] = d.coulomb_ext_energy;
+  return e;
+}
+
+void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions, const EngineExtra& extra) {
   Impl& d = *m_impl;
   const std::size_t N = d.p.size();
   if (s.size() != N || forces.size() != 3 * N || s.charge.size() != N || s.ix.size() != N)
@@ -497,6 +656,29 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
   d.time = s.step * d.dt;
   d.collisions = collisions;
   d.close_pending = false;
+  if (d.coulomb) {
+    // the Coulomb force of the last evaluation: the impulse integrator uses it until the next one
+    const auto fx = extra.arrays.find("coulomb_fx"), fy = extra.arrays.find("coulomb_fy"),
+               fz = extra.arrays.find("coulomb_fz");
+    const auto at = extra.ints.find("coulomb_eval_step");
+    const auto en = extra.reals.find("coulomb_energy_ext");
+    const bool have = fx != extra.arrays.end() && fy != extra.arrays.end() && fz != extra.arrays.end() &&
+                      at != extra.ints.end() && en != extra.reals.end();
+    if (have) {
+      for (const auto* a : {&fx->second, &fy->second, &fz->second})
+        if (a->size() != N) throw std::invalid_argument("checkpoint: Coulomb force arrays have the wrong length");
+      toDevice(fx->second, d.ext_fx);
+      toDevice(fy->second, d.ext_fy);
+      toDevice(fz->second, d.ext_fz);
+      d.kspace_step = at->second;
+      d.coulomb_ext_energy = en->second;
+    } else if (d.every == 1) {
+      d.kspace_step = -1;  // evaluated afresh at the next step, as every step
+    } else {
+      throw std::invalid_argument("checkpoint lacks the Coulomb forces of the multiple-time-step integrator "
+                                  "(coulomb.every > 1): it was written by an older granagg; restart with coulomb.every = 1");
+    }
+  }
   d.rebuildList(false);
 }
 
@@ -506,7 +688,13 @@ Observables Engine::observables() const {
   Observables o;
   o.step = d.step;
   o.time = d.time;
+  // velocities of the smooth trajectory between Coulomb impulses (Engine.h)
+  DVec<double> sx, sy, sz;
   const DVec<double>* v[3] = {&d.p.vx, &d.p.vy, &d.p.vz};
+  if (d.velocityOffset() != 0.0) {
+    d.smoothVelocities(sx, sy, sz);
+    v[0] = &sx, v[1] = &sy, v[2] = &sz;
+  }
   double sum2 = 0.0;
   for (int c = 0; c < 3; ++c) {
     o.momentum[c] = thrust::reduce(v[c]->begin(), v[c]->end(), 0.0);
@@ -517,9 +705,10 @@ Observables Engine::observables() const {
   o.temperature = (sum2 - p2 / N) / (3.0 * N);  // (1/3N) sum (v - <v>)^2, unit mass
   o.momentum_abs_sum = thrust::transform_reduce(thrust::counting_iterator<int>(0),
                                                 thrust::counting_iterator<int>(static_cast<int>(N)),
-                                                Abs3{raw(d.p.vx), raw(d.p.vy), raw(d.p.vz)}, 0.0, thrust::plus<double>());
+                                                Abs3{raw(*v[0]), raw(*v[1]), raw(*v[2])}, 0.0, thrust::plus<double>());
   const ContactSummary c = d.summary();
-  o.coulomb_energy = d.coulomb ? c.coulomb_real_energy + d.coulomb_ext_energy : 0.0;
+  // (a cache: re-evaluating the energy, or re-building the Coulomb list, changes no trajectory)
+  o.coulomb_energy = const_cast<Impl&>(d).coulombEnergyNow();
   o.elastic_energy = c.elastic_energy;
   o.contacts_per_particle = static_cast<double>(c.contacts) / N;
   o.collisions = d.collisions;

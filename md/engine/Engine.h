@@ -14,7 +14,22 @@
 /// particle id, so every sum runs in the same order whatever the thread count, the storage order,
 /// the neighbour-list rebuild schedule, or a restart from a checkpoint: the same build gives
 /// bit-identical trajectories.
+///
+/// Coulomb forces (coulomb.K > 0) are the slow force of an impulse multiple-time-step integrator
+/// (r-RESPA; Tuckerman, Berne & Martyna, J. Chem. Phys. 97, 1990 (1992); Grubmueller et al., Mol.
+/// Sim. 6, 121 (1991)): with k = coulomb.every, the slow Coulomb force F_C (mesh + the real space
+/// beyond r_fast over a list of its own; plain Ewald: everything) is evaluated at every k-th step
+/// and applied there as the impulse k dt F_C, split in velocity Verlet's two half kicks (plain
+/// Ewald, the reference, has no split and is evaluated at every step whatever k). Contact
+/// forces and the real space within r_fast (smoothly switched over [r_fast - 1, r_fast],
+/// md/coulomb/RealSpace.h) act at every step, in one pass over the contact list.
+/// This is time-reversible and symplectic like velocity Verlet itself, and its error is second
+/// order in k dt for forces that vary slowly on that scale (the accuracy tests bound it; docs/
+/// coulomb.md). k = 1 is plain velocity Verlet with the total force. Between evaluations the
+/// integrator's velocities differ from the smooth trajectory's by (k/2 - j) dt F_C (j steps after
+/// the evaluation); output uses the smooth ones (StateKind::Physical).
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -53,6 +68,28 @@ struct CoulombSetup {
   int k_max = 0;                   ///< plain Ewald reciprocal cutoff
   double estimated_error = 0.0;    ///< estimated relative RMS force error at sum_q2_design
   double sum_q2_design = 0.0;      ///< sum q^2 the parameters were chosen for
+  double r_fast = 0.0;             ///< multiple time stepping: real space within this is fast (switched over 1 d); 0: none
+};
+
+/// Which velocities and forces a host copy holds. They differ only with Coulomb forces on a
+/// multiple-time-step schedule (coulomb.every = k > 1; see Engine), and there only between
+/// Coulomb evaluations.
+enum class StateKind {
+  /// The integrator's state: what a checkpoint stores. Velocities v(t) = u + (dt/2) f(t); forces
+  /// f(t) = contact + w Coulomb with the impulse weight w (k at an evaluation step, 0 between).
+  Integrator,
+  /// For output and observables: the velocities of the smooth trajectory that the impulses
+  /// approximate, v - (k/2 - j) dt F_C at j = 1..k-1 steps after an evaluation, and forces
+  /// contact + F_C (F_C from the last evaluation).
+  Physical,
+};
+
+/// Engine state besides particles and forces that a bit-for-bit restart needs (checkpoint
+/// datasets and scalars; see CheckpointExtra).
+struct EngineExtra {
+  std::map<std::string, std::vector<double>> arrays;  ///< per particle, in id order
+  std::map<std::string, std::int64_t> ints;
+  std::map<std::string, double> reals;
 };
 
 /// Thrown when a run must stop (NaN, overlap beyond the bound); the message names the step and the
@@ -89,11 +126,15 @@ class Engine {
   void run(std::int64_t steps);
 
   /// Host copy of the current state (wrapped positions, images, velocities, charges).
-  Frame frame() const;
-  /// Forces of the current state (needed for a bit-for-bit restart): fx, fy, fz concatenated.
-  std::vector<double> forces() const;
-  /// Restores a checkpointed state with its forces and collision counter (same N).
-  void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions);
+  Frame frame(StateKind kind = StateKind::Integrator) const;
+  /// Forces of the current state, fx, fy, fz concatenated: the integrator's (a bit-for-bit restart
+  /// needs them) or the physical ones (output).
+  std::vector<double> forces(StateKind kind = StateKind::Integrator) const;
+  /// What else a bit-for-bit restart needs (the Coulomb force of the last evaluation).
+  EngineExtra extraState() const;
+  /// Restores a checkpointed state with its forces, collision counter and extraState() (same N).
+  void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions,
+               const EngineExtra& extra = {});
 
   Observables observables() const;
   double dt() const;

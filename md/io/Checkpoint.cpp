@@ -96,6 +96,10 @@ void writeFile(const std::string& file_path, const Frame& s, const CheckpointExt
     h5::Handle gr = h5::createGroup(f, "scalars/real", c);
     for (const auto& [k, v] : e.real_scalars) h5::writeAttribute(gr.get(), k, v, c + " /scalars/real");
   }
+  if (!e.arrays.empty()) {
+    h5::Handle g = h5::createGroup(f, "arrays", c);
+    for (const auto& [k, v] : e.arrays) writeArray(g.get(), k, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v.data(), n, c);
+  }
   if (!file.reset()) h5::fail("cannot close " + c + " (disk full?)");
 }
 
@@ -127,6 +131,11 @@ void validate(const Frame& s, const CheckpointExtra& e) {
     if (kv.first.empty()) throw std::invalid_argument("writeCheckpoint: an integer scalar has an empty name.");
   for (const auto& kv : e.real_scalars)
     if (kv.first.empty()) throw std::invalid_argument("writeCheckpoint: a real scalar has an empty name.");
+  for (const auto& kv : e.arrays) {
+    if (kv.first.empty() || kv.first.find('/') != std::string::npos)
+      throw std::invalid_argument("writeCheckpoint: an array name is empty or contains '/'.");
+    need(kv.second.size(), kv.first.c_str());
+  }
 }
 
 }  // namespace
@@ -261,6 +270,20 @@ Checkpoint readCheckpoint(const std::string& path) {
     };
     readAll("int", true);
     readAll("real", false);
+  }
+  if (h5::objectType(f, "arrays") == H5I_GROUP) {
+    h5::Handle g = h5::check(H5Gopen2(f, "arrays", H5P_DEFAULT), c + ": cannot open /arrays");
+    for (const auto& name : h5::datasetNames(g.get(), c + ": /arrays")) {
+      const std::string dc = c + ": dataset '/arrays/" + name + "'";
+      h5::Handle d = h5::check(H5Dopen2(g.get(), name.c_str(), H5P_DEFAULT), dc + ": cannot open");
+      const auto dims = h5::datasetDims(d.get(), dc);
+      if (dims.size() != 1 || dims[0] != static_cast<hsize_t>(n))
+        throw std::runtime_error(dc + " does not hold N = " + std::to_string(n) + " entries");
+      std::vector<double>& out = e.arrays[name];
+      out.resize(static_cast<std::size_t>(n));
+      h5::checkStatus(H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
+                      dc + ": cannot read (corrupt: checksum mismatch?)");
+    }
   }
   return cp;
 }

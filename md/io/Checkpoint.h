@@ -15,6 +15,8 @@
 ///         config_toml   string
 ///     /scalars/int      +-- one int64 attribute per entry of CheckpointExtra::int_scalars
 ///     /scalars/real     +-- one double attribute per entry of CheckpointExtra::real_scalars
+///     /arrays           one double[N] dataset per entry of CheckpointExtra::arrays (optional:
+///                       files without the group read back with no arrays)
 ///
 /// Arrays are chunked with HDF5's Fletcher-32 checksum filter, so silent corruption is detected
 /// on reading. Writing is atomic: the file is written as `<path>.tmp`, closed, fsync'ed and
@@ -42,6 +44,7 @@ struct CheckpointExtra {
   std::uint64_t next_frame_index = 0;  ///< index of the next scheduled frame in the output schedule
   std::map<std::string, std::int64_t> int_scalars;  ///< engine-defined counters (e.g. rebuilds)
   std::map<std::string, double> real_scalars;       ///< engine-defined reals (e.g. wall-clock timers)
+  std::map<std::string, std::vector<double>> arrays;  ///< engine-defined per-particle arrays (N each)
 };
 
 /// What readCheckpoint returns.

@@ -391,6 +391,18 @@ inline std::vector<std::string> attributeNames(hid_t obj, const std::string& ctx
   return names;
 }
 
+/// Names of the links (datasets, groups) of a group, in name order.
+inline std::vector<std::string> datasetNames(hid_t group, const std::string& ctx) {
+  std::vector<std::string> names;
+  auto cb = [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
+    static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+    return 0;
+  };
+  hsize_t idx = 0;
+  if (H5Literate(group, H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0) fail(ctx + ": cannot list the datasets");
+  return names;
+}
+
 /// Writes rows [row, row + count) of a dataset whose first dimension is the time index, growing
 /// it to at least row + count rows first. `data` holds count * (product of inner dims) values of
 /// `mem_type`.

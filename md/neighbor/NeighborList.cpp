@@ -43,6 +43,27 @@ HD inline void append(int* row, int& n, int cap, int j) {
 /// scanning was quadratic in the row length.
 HD inline void sortRowById(int* row, int n, const int* id) {
   const int gaps[6] = {132, 57, 23, 10, 4, 1};
+  constexpr int LOCAL = 384;
+  if (n > 16 && n <= LOCAL) {
+    // long rows: sort (id, slot) keys held in a local buffer, so that no comparison loads id[]
+    // through the row (an indirect, cache-missing load per comparison dominated the build)
+    std::uint64_t key[LOCAL];
+    for (int k = 0; k < n; ++k) key[k] = (static_cast<std::uint64_t>(id[row[k]]) << 32) | static_cast<std::uint32_t>(row[k]);
+    for (int g = 0; g < 6; ++g) {
+      const int gap = gaps[g];
+      for (int k = gap; k < n; ++k) {
+        const std::uint64_t v = key[k];
+        int m = k;
+        while (m >= gap && key[m - gap] > v) {
+          key[m] = key[m - gap];
+          m -= gap;
+        }
+        key[m] = v;
+      }
+    }
+    for (int k = 0; k < n; ++k) row[k] = static_cast<int>(key[k] & 0xffffffffu);
+    return;
+  }
   for (int g = n <= 16 ? 5 : 0; g < 6; ++g) {
     const int gap = gaps[g];
     for (int k = gap; k < n; ++k) {
@@ -121,6 +142,31 @@ struct BuildCells {
         }
       }
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
+    count[i] = n;
+  }
+};
+
+/// Row i of a longer list filtered to the pairs within range.
+struct FilterRows {
+  const Scalar4* pos;
+  const int *super_rows, *super_count;
+  int super_cap;
+  int *list, *count;
+  common::Box box;
+  double r2;
+  int cap;
+  HD void operator()(int i) const {
+    const Scalar4 ri = pos[i];
+    const int* in = super_rows + static_cast<long>(i) * super_cap;
+    int* row = list + static_cast<long>(i) * cap;
+    int n = 0;
+    for (int k = 0; k < super_count[i]; ++k) {
+      const int j = in[k];
+      const Scalar4 rj = pos[j];
+      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+                   rz = box.minimumImageWrapped(ri.z - rj.z);
+      if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
+    }
     count[i] = n;
   }
 };
@@ -204,16 +250,38 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
                        BuildAllPairs{raw(p.pos), raw(p.id), raw(m_list), raw(m_count), box, range * range, N,
                                      m_capacity});
     }
-    const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
-    if (most <= m_capacity) {
-      // rows much wider than needed cost a cache line per particle per step for nothing: the next
-      // build uses a tighter capacity (a later overflow is caught above). Not this one: its rows
-      // are laid out with the current stride.
-      m_next_capacity = 2 * (most + most / 4 + 4) < m_capacity ? most + most / 4 + 4 : m_capacity;
-      break;
-    }
-    m_capacity = m_next_capacity = most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
+    if (fitCapacity(N)) break;
   }
+  m_built_n = p.size();
+  ++m_builds;
+}
+
+bool NeighborList::fitCapacity(int N) {
+  const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
+  if (most <= m_capacity) {
+    // rows much wider than needed cost a cache line per particle per step for nothing: the next
+    // build uses a tighter capacity (a later overflow is caught by the caller). Not this one: its
+    // rows are laid out with the current stride.
+    m_next_capacity = 2 * (most + most / 4 + 4) < m_capacity ? most + most / 4 + 4 : m_capacity;
+    return true;
+  }
+  m_capacity = m_next_capacity = most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
+  return false;
+}
+
+void NeighborList::buildFrom(const NeighborList& super, const ParticleData& p, const common::Box& box) {
+  const int N = static_cast<int>(p.size());
+  if (super.m_built_n != p.size() || super.listRange() < listRange())
+    throw std::logic_error("NeighborList::buildFrom: the longer list is not built for these particles or is too short");
+  const double range = m_cutoff + m_skin;
+  m_count.resize(N);
+  m_capacity = m_next_capacity;
+  do {
+    m_list.resize(static_cast<std::size_t>(N) * m_capacity);
+    thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+                     FilterRows{raw(p.pos), super.rows(), super.counts(), super.capacity(), raw(m_list), raw(m_count),
+                                box, range * range, m_capacity});
+  } while (!fitCapacity(N));
   m_built_n = p.size();
   ++m_builds;
 }

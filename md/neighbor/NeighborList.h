@@ -31,6 +31,11 @@ class NeighborList {
   const DVec<int>& computeCellOrder(const ParticleData& p, const common::Box& box);
   /// Unconditional rebuild.
   void build(const ParticleData& p, const common::Box& box);
+  /// Unconditional rebuild from a longer list that is valid for the current positions out to at
+  /// least this list's range (every pair closer than listRange() is in `super`): each row keeps
+  /// the entries of super's row within range, already in id order. Much cheaper than a cell
+  /// search when super is the Coulomb list and this the short contact list (Engine).
+  void buildFrom(const NeighborList& super, const ParticleData& p, const common::Box& box);
 
   const int* rows() const { return raw(m_list); }     ///< row i at rows()[i * capacity()]
   const int* counts() const { return raw(m_count); }  ///< entries in row i
@@ -40,6 +45,8 @@ class NeighborList {
 
  private:
   int cellsPerSide(const common::Box& box) const;
+  /// Finishes a build: checks the rows against the capacity (true: they fit) and plans the next one.
+  bool fitCapacity(int N);
   double m_cutoff, m_skin;
   int m_capacity = 16;       // row stride of the current list
   int m_next_capacity = 16;  // for the next build: grows on overflow, shrinks when rows are mostly empty

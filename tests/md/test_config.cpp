@@ -414,7 +414,7 @@ TEST_CASE("flatten lists every key with round-trip numbers", "[md][config]") {
   MdConfig c;
   c.system.phi = 0.1 + 0.2;
   const auto f = flatten(c);
-  REQUIRE(f.size() == 40);
+  REQUIRE(f.size() == 42);
   CHECK(f.front() == std::make_pair(std::string("input.version"), std::string("1")));
   CHECK(f[1] == std::make_pair(std::string("system.N"), std::string("1000")));
   CHECK(f[2] == std::make_pair(std::string("system.phi"), std::string("0.30000000000000004")));

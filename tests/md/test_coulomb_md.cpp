@@ -10,6 +10,7 @@
 #include "md/config/MdConfig.h"
 #include "md/coulomb/Ewald.h"
 #include "md/coulomb/EwaldParams.h"
+#include "md/coulomb/RealSpace.h"
 #include "md/engine/Engine.h"
 #include "meanfield/kinetic/Cooling.h"
 
@@ -39,7 +40,7 @@ TEST_CASE("engine forces with PPPM equal converged plain Ewald plus contacts", "
   MdConfig c0 = c;
   c0.coulomb.K = 0.0;
   Engine contacts(c0, init);
-  const auto f = pppm.forces(), f0 = contacts.forces();
+  const auto f = pppm.forces(StateKind::Physical), f0 = contacts.forces();
   const std::size_t N = init.size();
   double sum_q2 = 0.0;
   for (double q : init.charge) sum_q2 += q * q;
@@ -155,4 +156,123 @@ TEST_CASE("an oppositely charged pair settles at the equilibrium overlap of Coul
   CHECK(overlap == Approx(lo).epsilon(1e-3));
   CHECK(max_overlap < 0.5);                         // stable at the default dt
   CHECK(e.observables().temperature < 1e-8);        // at rest
+}
+
+TEST_CASE("multiple time stepping: the fast and slow pair forces sum to the Ewald real-space force, and their tables are accurate", "[md][coulomb]") {
+  const double alpha = 0.58, rc = 5.0;
+  const RealSpaceSwitch sw{2.5, 3.5};
+  // the split is exact: S K/r^2 + (Ewald real - S K/r^2) = Ewald real (per unit K q_i q_j, over r)
+  for (double r = 1.0; r < rc; r += 0.0137) {
+    const double total = ewaldRealForceOverR(1.0, r, alpha, 1.0);
+    CHECK(slowPairForceOverR(r, alpha, sw) + fastPairForceOverR(r, sw) == Approx(total).epsilon(1e-12).margin(1e-15));
+  }
+  // the switch: 1 inside, 0 outside, continuous with zero slope at both ends
+  CHECK(sw.fastFraction(2.4) == 1.0);
+  CHECK(sw.fastFraction(3.6) == 0.0);
+  CHECK(sw.fastFraction(3.0) == Approx(0.5).epsilon(1e-14));
+  CHECK(std::fabs(sw.fastFraction(2.5 + 1e-6) - 1.0) < 1e-14);  // 10 x^3: flat to third order
+  CHECK(std::fabs(sw.fastFraction(3.5 - 1e-6)) < 1e-14);
+  // the slow part is smooth at short range: minus the pair's erf part, -4 alpha^3 / (3 sqrt pi) at 0
+  CHECK(slowPairForceOverR(1e-5, alpha, sw) == Approx(-4.0 * alpha * alpha * alpha / (3.0 * std::sqrt(M_PI))).epsilon(1e-9));
+  CHECK(slowPairForceOverR(0.01, alpha, sw) == Approx(slowPairForceOverR(0.000999, alpha, sw)).epsilon(1e-3));
+  // the tables the engine interpolates (2^13 intervals in r^2): force errors against the functions,
+  // relative to K (the force of two unit charges at distance 1), for pairs from deep overlap (r = 0.6)
+  const int n = 1 << 13;
+  const auto slow = slowPairTableValues(alpha, sw, rc * rc, n), fast = fastPairTableValues(sw, n);
+  const PairTable ts{slow.data(), n / (rc * rc)}, tf{fast.data(), n / (sw.r2 * sw.r2)};
+  double worst_slow = 0.0, worst_fast = 0.0, worst_fast_apart = 0.0;
+  for (double r = 0.6; r < rc; r += 0.00113) {
+    worst_slow = std::max(worst_slow, std::fabs(ts(r * r) - slowPairForceOverR(r, alpha, sw)) * r);
+    const double rf2 = std::min(r * r, sw.r2 * sw.r2);
+    const double e = std::fabs(tf(rf2) - fastPairForceOverR(std::sqrt(rf2), sw)) * r;
+    worst_fast = std::max(worst_fast, e);
+    if (r >= 1.0) worst_fast_apart = std::max(worst_fast_apart, e);
+  }
+  INFO("largest table force error / K: slow " << worst_slow << ", fast " << worst_fast << " (from r = 1: "
+                                               << worst_fast_apart << ")");
+  CHECK(worst_slow < 1e-7);
+  CHECK(worst_fast < 5e-5);        // the steep 1/r^2 at an overlap of 0.4 (deeper aborts a run)
+  CHECK(worst_fast_apart < 2e-6);  // pairs not in contact
+  CHECK(std::fabs(tf(sw.r2 * sw.r2)) < 1e-12);  // beyond r_fast: no fast force
+}
+
+TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5, and a restart between evaluations", "[md][coulomb]") {
+  // (a) the engine's physical force (contact + fast + slow) equals contacts + converged Ewald,
+  // with the default coulomb.every = 8 (the split must lose nothing)
+  {
+    MdConfig c = chargedConfig(600, 7, 2.0, "pppm");
+    REQUIRE(c.coulomb.every == 8);
+    const Frame init = Engine::randomInitialState(c);
+    Engine pppm(c, init);
+    REQUIRE(pppm.coulombSetup()->r_fast == 3.5);
+    MdConfig c0 = c;
+    c0.coulomb.K = 0.0;
+    Engine contacts(c0, init);
+    const auto f = pppm.forces(StateKind::Physical), f0 = contacts.forces();
+    const auto fi = pppm.forces(StateKind::Integrator);
+    const std::size_t N = init.size();
+    double sum_q2 = 0.0;
+    for (double q : init.charge) sum_q2 += q * q;
+    const EwaldReference ref(chooseEwaldParams(1e-10, N, init.box, sum_q2), init.box, c.coulomb.K);
+    const CoulombResult r = ref.compute(init.x, init.y, init.z, init.charge);
+    double err2 = 0.0, impulse2 = 0.0, ref2 = 0.0;
+    for (std::size_t i = 0; i < 3 * N; ++i) {
+      const double want = i < N ? r.fx[i] : (i < 2 * N ? r.fy[i - N] : r.fz[i - 2 * N]);
+      err2 += (f[i] - f0[i] - want) * (f[i] - f0[i] - want);
+      ref2 += want * want;
+      impulse2 += (fi[i] - f[i]) * (fi[i] - f[i]);  // integrator force at an evaluation step: 7 more slow parts
+    }
+    INFO("RMS force error / K = " << std::sqrt(err2 / N) / c.coulomb.K);
+    CHECK(std::sqrt(err2 / N) / c.coulomb.K <= c.coulomb.accuracy);
+    CHECK(impulse2 > 0.0);
+    CHECK(impulse2 < 49.0 * ref2);  // the slow part is a fraction of the whole
+  }
+  // (b) energy: elastic contacts, fixed +-1 charges at the paper's strongest coupling K = 5 (bound
+  // pairs form; the Coulomb energy falls by a factor ~2.8), 1e4 steps: drift below 1e-4 of the
+  // initial kinetic energy with the default multiple time stepping, as with every = 1
+  for (int every : {8, 1}) {
+    INFO("coulomb.every = " << every);
+    MdConfig c = chargedConfig(250, 11, 5.0, "pppm");
+    c.contact.D = 0.0;
+    c.integrator.dt = 0.002;
+    c.coulomb.every = every;
+    Engine e(c, Engine::randomInitialState(c));
+    const auto o0 = e.observables();
+    const double E0 = totalEnergy(o0), scale = o0.kinetic_energy;
+    double worst = 0.0;
+    for (int s = 0; s < 10000; s += 80) {  // observables at evaluation steps and between (80 = 10 x 8)
+      e.run(s % 160 == 0 ? 77 : 83);
+      worst = std::max(worst, std::fabs(totalEnergy(e.observables()) - E0) / scale);
+    }
+    const auto o = e.observables();
+    INFO("max |E - E0| / E_kin(0) = " << worst << ", Coulomb energy " << o0.coulomb_energy << " -> " << o.coulomb_energy);
+    CHECK(o.coulomb_energy < 2.0 * o0.coulomb_energy);  // strongly coupled: pairs bind
+    CHECK(worst < 1e-4);
+    if (every == 1) break;
+  }
+  // (c) a restart at a step between Coulomb evaluations continues bit for bit (the last slow force
+  // travels with the checkpoint: Engine::extraState)
+  {
+    MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
+    c.charging.mode = "exchange";
+    c.charging.initial = "bipolar";
+    c.charging.q0 = 0.3;
+    c.charging.Q = 0.1;
+    const Frame init = Engine::randomInitialState(c);
+    Engine one(c, init);
+    one.run(403);
+    Engine first(c, init);
+    first.run(203);  // 203 = 25 x 8 + 3
+    const Frame mid = first.frame();
+    Engine resumed(c, mid, /*allow_contacts=*/true);
+    resumed.restore(mid, first.forces(), first.observables().collisions, first.extraState());
+    resumed.run(200);
+    const Frame a = one.frame(), b = resumed.frame();
+    CHECK(a.x == b.x);
+    CHECK(a.vz == b.vz);
+    CHECK(a.charge == b.charge);
+    // without the slow force the restart is refused (it cannot be reconstructed between evaluations)
+    Engine bare(c, mid, true);
+    CHECK_THROWS_AS(bare.restore(mid, first.forces(), 0), std::invalid_argument);
+  }
 }

@@ -1,0 +1,117 @@
+#include "md/compute/CoulombRealSpace.h"
+
+#include <stdexcept>
+
+#include <thrust/functional.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform_reduce.h>
+
+#include "md/coulomb/RealSpace.h"
+#include "md/engine/Launch.h"
+
+namespace granagg::md {
+
+namespace {
+
+template <bool TABLE>
+struct RealForceFunctor {
+  const Scalar4* pos;
+  const int *rows, *counts;
+  int cap;
+  common::Box box;
+  double K, alpha, rc2;
+  RealSpaceSwitch sw;  // the slow part: minus the fast S(r) K q_i q_j / r^2
+  PairTable table;     // TABLE: the same, tabulated
+  double *fx, *fy, *fz;
+  HD int operator()(int i) const {
+    const Scalar4 ri = pos[i];
+    double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+    if (ri.w != 0.0) {  // (an exchanging gas starts neutral)
+      const int* row = rows + static_cast<long>(i) * cap;
+      const int n = counts[i];
+      for (int k = 0; k < n; ++k) {
+        const Scalar4 rj = pos[row[k]];
+        const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+                     rz = box.minimumImageWrapped(ri.z - rj.z);
+        const double r2 = rx * rx + ry * ry + rz * rz;
+        const double qq = ri.w * rj.w;
+        if (TABLE) {  // branch-free: about half of the list's entries lie beyond r_cut, unpredictably
+          const double fr = K * (r2 < rc2 ? qq : 0.0) * table(r2 < rc2 ? r2 : 0.0);
+          f0 += fr * rx;
+          f1 += fr * ry;
+          f2 += fr * rz;
+        } else if (r2 < rc2 && qq != 0.0) {
+          double fr;
+          if (TABLE) {
+            fr = K * qq * table(r2);  // (r2 < rc2: inside the table)
+          } else {
+            const double r = sqrt(r2);
+            fr = ewaldRealForceOverRFast(qq, r, alpha, K) - sw.fastFraction(r) * K * qq / (r2 * r);
+          }
+          f0 += fr * rx;
+          f1 += fr * ry;
+          f2 += fr * rz;
+        }
+      }
+    }
+    fx[i] = f0;
+    fy[i] = f1;
+    fz[i] = f2;
+    return 0;
+  }
+};
+
+struct RealEnergyFunctor {
+  const Scalar4* pos;
+  const int *rows, *counts;
+  int cap;
+  common::Box box;
+  double K, alpha, rc2;
+  HD double operator()(int i) const {
+    const Scalar4 ri = pos[i];
+    double e = 0.0;
+    const int* row = rows + static_cast<long>(i) * cap;
+    for (int k = 0; k < counts[i]; ++k) {
+      const Scalar4 rj = pos[row[k]];
+      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+                   rz = box.minimumImageWrapped(ri.z - rj.z);
+      const double r2 = rx * rx + ry * ry + rz * rz;
+      if (r2 < rc2) e += 0.5 * ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);  // half per partner
+    }
+    return e;
+  }
+};
+
+void checkRange(const NeighborList& nl, const CoulombRealParams& prm) {
+  if (nl.listRange() < prm.r_cut) throw std::logic_error("neighbour list range below the Coulomb real-space cutoff");
+}
+
+}  // namespace
+
+void coulombRealForces(const ParticleData& p, const NeighborList& nl, const common::Box& box, const CoulombRealParams& prm,
+                       DVec<double>& fx, DVec<double>& fy, DVec<double>& fz) {
+  checkRange(nl, prm);
+  const int N = static_cast<int>(p.size());
+  for (auto* v : {&fx, &fy, &fz}) v->resize(p.size());
+  if (prm.table.data)
+    forEachBlocked(N, blockSizeFor(N),
+                   RealForceFunctor<true>{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K, prm.alpha,
+                                          prm.r_cut * prm.r_cut, prm.fast, prm.table, raw(fx), raw(fy), raw(fz)},
+                   NoReduction{}, static_cast<int*>(nullptr));
+  else
+    forEachBlocked(N, blockSizeFor(N),
+                   RealForceFunctor<false>{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K, prm.alpha,
+                                           prm.r_cut * prm.r_cut, prm.fast, prm.table, raw(fx), raw(fy), raw(fz)},
+                   NoReduction{}, static_cast<int*>(nullptr));
+}
+
+double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const common::Box& box, const CoulombRealParams& prm) {
+  checkRange(nl, prm);
+  const int N = static_cast<int>(p.size());
+  return thrust::transform_reduce(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+                                  RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K,
+                                                    prm.alpha, prm.r_cut * prm.r_cut},
+                                  0.0, thrust::plus<double>());
+}
+
+}  // namespace granagg::md
