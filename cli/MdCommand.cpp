@@ -200,7 +200,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                   cs->estimated_error, cs->sum_q2_design);
     if (const md::CoulombSetup* cs = engine.coulombSetup(); cs && cs->r_fast > 0.0)
       std::printf("md: multiple time stepping: slow Coulomb part every %d steps; pair force within r_fast = %g every step\n",
-                  cfg.coulomb.every, cs->r_fast);
+                  cs->every, cs->r_fast);
     if (restart) std::printf("md: restarting from step %lld of %s\n", static_cast<long long>(engine.step()), out.c_str());
   }
 
@@ -226,6 +226,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
       params.emplace_back("coulomb_estimated_error", common::formatReal(cs->estimated_error));
       params.emplace_back("coulomb_sum_q2_design", common::formatReal(cs->sum_q2_design));
       params.emplace_back("coulomb_r_fast_used", common::formatReal(cs->r_fast));
+      params.emplace_back("coulomb_every_used", std::to_string(cs->every));
     }
     writer = std::make_unique<md::H5mdWriter>(traj.string(), engine.size(), params, md::toToml(cfg), a.force,
                                               cfg.output.write_velocities, cfg.output.write_forces);

@@ -76,7 +76,7 @@ const std::vector<Section>& schema() {
         Key{"r_cut", +[](MdConfig& c) -> double& { return c.coulomb.r_cut; }, true},
         Key{"mesh", +[](MdConfig& c) -> int& { return c.coulomb.mesh; }, true},
         Key{"order", +[](MdConfig& c) -> int& { return c.coulomb.order; }, true},
-        GRANAGG_KEY(coulomb, every),
+        Key{"every", +[](MdConfig& c) -> int& { return c.coulomb.every; }, true},
         Key{"skin", +[](MdConfig& c) -> double& { return c.coulomb.skin; }, true},
         Key{"r_fast", +[](MdConfig& c) -> double& { return c.coulomb.r_fast; }, true}}},
       {"run", {GRANAGG_KEY(run, t_end), GRANAGG_KEY(run, max_overlap)}},
@@ -561,7 +561,8 @@ void validateConfig(const MdConfig& c) {
   if (e.mesh < 0) invalid("coulomb.mesh", std::to_string(e.mesh), "be > 0 or \"auto\"");
   if (e.order < 0 || e.order == 1 || e.order > 7)
     invalid("coulomb.order", std::to_string(e.order), "lie in 2..7 or be \"auto\"");
-  if (e.every < 1 || e.every > 100) invalid("coulomb.every", std::to_string(e.every), "lie in 1..100 (steps between Coulomb evaluations)");
+  if (e.every < 0 || e.every > 100)
+    invalid("coulomb.every", std::to_string(e.every), "lie in 1..100 (steps between Coulomb evaluations) or be \"auto\"");
   if (!(e.skin >= 0.0 && e.skin <= 5.0)) invalid("coulomb.skin", formatReal(e.skin), "lie in (0, 5] or be \"auto\"");
   if (!(e.r_fast == 0.0 || (e.r_fast >= 2.0 && finite(e.r_fast))))
     invalid("coulomb.r_fast", formatReal(e.r_fast), "be >= 2 (the switch [r_fast - 1, r_fast] starts beyond contact) or \"auto\"");

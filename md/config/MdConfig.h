@@ -79,8 +79,9 @@ struct CoulombConfig {
   int mesh = 0;                    ///< mesh points per side (pppm); 0 = "auto"
   int order = 0;                   ///< charge-assignment order 2..7 (pppm); 0 = "auto"
   /// Multiple time stepping (Engine.h): the slow Coulomb force is evaluated every this many steps
-  /// and applied as an impulse; 1 = every step (plain velocity Verlet with the total force).
-  int every = 8;
+  /// and applied as an impulse; 1 = every step (plain velocity Verlet with the total force);
+  /// 0 = "auto": every 0.016 time units (Engine::coulombEvery; 8 steps at dt = 0.002)
+  int every = 0;
   double skin = 0.0;               ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or neighbor.skin when every = 1)
   double r_fast = 0.0;             ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (3.5)
 };

@@ -69,6 +69,7 @@ struct CoulombSetup {
   double estimated_error = 0.0;    ///< estimated relative RMS force error at sum_q2_design
   double sum_q2_design = 0.0;      ///< sum q^2 the parameters were chosen for
   double r_fast = 0.0;             ///< multiple time stepping: real space within this is fast (switched over 1 d); 0: none
+  int every = 1;                   ///< multiple time stepping: steps between evaluations of the slow part
 };
 
 /// Which velocities and forces a host copy holds. They differ only with Coulomb forces on a
@@ -154,6 +155,9 @@ class Engine {
   static void setThreads(int n);
   /// "OpenMP (2 threads)" or "CUDA (device name)": printed at start-up and stored in outputs.
   static std::string backendDescription();
+  /// Steps between evaluations of the slow Coulomb part for a configuration and time step
+  /// (coulomb.every, or "auto": every 0.016 time units; 1 for plain Ewald).
+  static int coulombEvery(const MdConfig& config, double dt);
   /// The time step chosen for a configuration (fixed, or auto from the contact time) and why.
   static double chooseTimeStep(const MdConfig& config, std::string* reason = nullptr);
 

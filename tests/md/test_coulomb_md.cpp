@@ -201,9 +201,10 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
   // with the default coulomb.every = 8 (the split must lose nothing)
   {
     MdConfig c = chargedConfig(600, 7, 2.0, "pppm");
-    REQUIRE(c.coulomb.every == 8);
+    c.integrator.dt = 0.002;
     const Frame init = Engine::randomInitialState(c);
     Engine pppm(c, init);
+    REQUIRE(pppm.coulombSetup()->every == 8);  // "auto" at dt = 0.002
     REQUIRE(pppm.coulombSetup()->r_fast == 3.5);
     MdConfig c0 = c;
     c0.coulomb.K = 0.0;
@@ -229,14 +230,15 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
   }
   // (b) energy: elastic contacts, fixed +-1 charges at the paper's strongest coupling K = 5 (bound
   // pairs form; the Coulomb energy falls by a factor ~2.8), 1e4 steps: drift below 1e-4 of the
-  // initial kinetic energy with the default multiple time stepping, as with every = 1
-  for (int every : {8, 1}) {
+  // initial kinetic energy with the default multiple time stepping (every 8 steps), as with every = 1
+  for (int every : {0, 1}) {
     INFO("coulomb.every = " << every);
     MdConfig c = chargedConfig(250, 11, 5.0, "pppm");
     c.contact.D = 0.0;
     c.integrator.dt = 0.002;
     c.coulomb.every = every;
     Engine e(c, Engine::randomInitialState(c));
+    REQUIRE(e.coulombSetup()->every == (every == 0 ? 8 : 1));
     const auto o0 = e.observables();
     const double E0 = totalEnergy(o0), scale = o0.kinetic_energy;
     double worst = 0.0;
@@ -262,7 +264,8 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
     Engine one(c, init);
     one.run(403);
     Engine first(c, init);
-    first.run(203);  // 203 = 25 x 8 + 3
+    REQUIRE(first.coulombSetup()->every == 4);  // "auto" at the automatic dt = 0.00344
+    first.run(203);  // 203 = 50 x 4 + 3
     const Frame mid = first.frame();
     Engine resumed(c, mid, /*allow_contacts=*/true);
     resumed.restore(mid, first.forces(), first.observables().collisions, first.extraState());
