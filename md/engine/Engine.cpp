@@ -293,6 +293,14 @@ struct Engine::Impl {
     return prm;
   }
 
+  /// Plain Ewald (the host reference) of the current positions and charges, per slot.
+  CoulombResult ewaldOnHost() const {
+    const auto pos = toHost(p.pos);
+    std::vector<double> x(pos.size()), y(pos.size()), z(pos.size()), q(pos.size());
+    for (std::size_t i = 0; i < pos.size(); ++i) x[i] = pos[i].x, y[i] = pos[i].y, z[i] = pos[i].z, q[i] = pos[i].w;
+    return ewald->compute(x, y, z, q);
+  }
+
   /// The Coulomb force of the current positions into ext_f* (and the energy of everything but the
   /// PPPM real space into coulomb_ext_energy): PPPM real space over nl_coul plus the mesh part, or
   /// everything for plain Ewald (host, O(N^2) real space).
@@ -305,10 +313,7 @@ struct Engine::Impl {
                                          raw(ext_fz), raw(p.id));
       return;
     }
-    const auto pos = toHost(p.pos);
-    std::vector<double> x(N), y(N), z(N), q(N);
-    for (std::size_t i = 0; i < N; ++i) x[i] = pos[i].x, y[i] = pos[i].y, z[i] = pos[i].z, q[i] = pos[i].w;
-    const CoulombResult r = ewald->compute(x, y, z, q);
+    const CoulombResult r = ewaldOnHost();
     toDevice(r.fx, ext_fx);
     toDevice(r.fy, ext_fy);
     toDevice(r.fz, ext_fz);
@@ -350,7 +355,7 @@ struct Engine::Impl {
     // Displacements since the last build are at most the sum of dt max|u| over the steps (a
     // rigorous bound that needs no stored reference positions).
     const bool slow = coulomb && (kspace_step < 0 || step - kspace_step >= every);
-    const double prev_weight = coulomb && kspace_step == step - 1 ? static_cast<double>(every) : 0.0;
+    const double prev_weight = coulomb ? slowWeight(step - 1) : 0.0;
     if (slow && nl_coul && nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build))
       rebuildList(true);
     else if (nl.needsRebuild(p, drift_since_build * drift_since_build))
@@ -421,10 +426,7 @@ struct Engine::Impl {
       return coulombRealEnergy(p, *nl_coul, box, realParams()) + ext;
     }
     if (kspace_step == step) return coulomb_ext_energy;
-    const auto pos = toHost(p.pos);
-    std::vector<double> x(p.size()), y(p.size()), z(p.size()), q(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) x[i] = pos[i].x, y[i] = pos[i].y, z[i] = pos[i].z, q[i] = pos[i].w;
-    return ewald->compute(x, y, z, q).energy;
+    return ewaldOnHost().energy;
   }
 
   [[noreturn]] void abort(int worst) {
