@@ -24,16 +24,21 @@ void ContactWork::resize(std::size_t n) {
 
 namespace {
 
-template <class Potential, bool EXT, bool FAST_COULOMB>
+/// CHARGING: the charge exchange at new contacts is compiled in (dq non-null); without it the
+/// neutral pass keeps the random-number code out of its registers.
+template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING>
 struct ContactForceFunctor {
+  using value_type = StepAccum;
   const Scalar4* pos;
   const double *vx, *vy, *vz;        // drift velocities u = v(t - dt/2) of the step just taken
   const double *fx_old, *fy_old, *fz_old;  // f(t - dt), which kicked u
   const int *rows, *counts;
   int cap;
+  // the same list compressed (NeighborList::keepFlat), for range(); null: operator() only
+  const int *flat_offsets, *flat_partners, *flat_owners;
   common::Box box;
   typename Potential::Params params;
-  double max_overlap, h_pred, dt_prev;
+  double h_pred, dt_prev;
   double *fx, *fy, *fz;  // f(t), written
   // collisional charging (null dq: off): the charge each particle gains at its new contacts
   const int* id;
@@ -61,54 +66,78 @@ struct ContactForceFunctor {
     }
   }
 
-  /// returns the collisions of pairs (i, j > i) that started this step and the check flag of i
-  HD ContactStepResult operator()(int i) const {
+  /// The contact of pair (i, j) at separation r = (rx, ry, rz), r2 = |r|^2 < 1: adds its force on i
+  /// to (f0, f1, f2), its overlap to the maximum mx, a collision that started this step (counted
+  /// for j > i) to nnew, and with charging the charge i gains to dqi.
+  HD void contact(int i, int j, double rx, double ry, double rz, double r2, double& f0, double& f1, double& f2,
+                  double& mx, int& nnew, double& dqi) const {
+    const double r = sqrt(r2);
+    const double inv_r = 1.0 / r;
+    const double nx = rx * inv_r, ny = ry * inv_r, nz = rz * inv_r;  // unit vector from j to i
+    const double xi = 1.0 - r;                                        // overlap
+    double vi0, vi1, vi2, vj0, vj1, vj2;  // contacts are rare: predicted velocities on demand
+    predicted(i, vi0, vi1, vi2);
+    predicted(j, vj0, vj1, vj2);
+    const double gx = vi0 - vj0, gy = vi1 - vj1, gz = vi2 - vj2;
+    const double xi_dot = -(gx * nx + gy * ny + gz * nz);  // > 0 while approaching
+    const double F = Potential::normalForce(xi, xi_dot, params);
+    f0 += F * nx;
+    f1 += F * ny;
+    f2 += F * nz;
+    mx = xi > mx ? xi : mx;
+    // a collision is the first step at which the pair overlaps after not overlapping; the
+    // separation one step earlier is r - dt (u_i - u_j), the drift undone (antisymmetric in i
+    // and j to the last bit, so both partners agree, as they must for the charge exchange)
+    const double px = rx - dt_prev * (vx[i] - vx[j]), py = ry - dt_prev * (vy[i] - vy[j]),
+                 pz = rz - dt_prev * (vz[i] - vz[j]);
+    if (px * px + py * py + pz * pz >= 1.0) {
+      if (j > i) ++nnew;  // each collision counted once
+      if (CHARGING)       // xi_dot is the same for both partners (g and n both change sign)
+        dqi += ChargeExchange::transferTo(charging, step, static_cast<std::uint32_t>(id[i]),
+                                          static_cast<std::uint32_t>(id[j]), xi_dot);
+    }
+  }
+
+  /// Separation r_i - r_j (minimum image; positions are wrapped into [0, L), so one conditional
+  /// shift per component is enough) and its square.
+  HD double separation(const Scalar4& ri, const Scalar4& rj, double& rx, double& ry, double& rz) const {
+    rx = box.minimumImageWrapped(ri.x - rj.x);
+    ry = box.minimumImageWrapped(ri.y - rj.y);
+    rz = box.minimumImageWrapped(ri.z - rj.z);
+    return rx * rx + ry * ry + rz * rz;
+  }
+
+  /// Particle i over its row: returns the collisions of pairs (i, j > i) that started this step,
+  /// i's largest overlap and a finiteness probe of i's force and position (StepAccum).
+  HD StepAccum operator()(int i) const {
     const Scalar4 ri = pos[i];
-    const double xi_ = ri.x, yi_ = ri.y, zi_ = ri.z;
     double f0 = 0.0, f1 = 0.0, f2 = 0.0, mx = 0.0, dqi = 0.0;
     int nnew = 0;
     const int* row = rows + static_cast<long>(i) * cap;
     const int n = counts[i];
     for (int k = 0; k < n; ++k) {
       const int j = row[k];
-      // positions are wrapped into [0, L): one conditional shift is the minimum image
       const Scalar4 rj = pos[j];
-      const double rx = box.minimumImageWrapped(xi_ - rj.x), ry = box.minimumImageWrapped(yi_ - rj.y),
-                   rz = box.minimumImageWrapped(zi_ - rj.z);
-      const double r2 = rx * rx + ry * ry + rz * rz;
+      double rx, ry, rz;
+      const double r2 = separation(ri, rj, rx, ry, rz);
       if (FAST_COULOMB) {  // branch-free (most list entries lie inside r2, not all)
         const double fr = K * ri.w * rj.w * fast_table(r2 < fast_r2sq ? r2 : fast_r2sq);
         f0 += fr * rx;
         f1 += fr * ry;
         f2 += fr * rz;
       }
-      if (r2 >= 1.0) continue;
-      const double r = sqrt(r2);
-      const double inv_r = 1.0 / r;
-      const double nx = rx * inv_r, ny = ry * inv_r, nz = rz * inv_r;  // unit vector from j to i
-      const double xi = 1.0 - r;                                        // overlap
-      double vi0, vi1, vi2, vj0, vj1, vj2;  // contacts are rare: predicted velocities on demand
-      predicted(i, vi0, vi1, vi2);
-      predicted(j, vj0, vj1, vj2);
-      const double gx = vi0 - vj0, gy = vi1 - vj1, gz = vi2 - vj2;
-      const double xi_dot = -(gx * nx + gy * ny + gz * nz);  // > 0 while approaching
-      const double F = Potential::normalForce(xi, xi_dot, params);
-      f0 += F * nx;
-      f1 += F * ny;
-      f2 += F * nz;
-      mx = xi > mx ? xi : mx;
-      // a collision is the first step at which the pair overlaps after not overlapping; the
-      // separation one step earlier is r - dt (u_i - u_j), the drift undone (antisymmetric in i
-      // and j to the last bit, so both partners agree, as they must for the charge exchange)
-      const double px = rx - dt_prev * (vx[i] - vx[j]), py = ry - dt_prev * (vy[i] - vy[j]),
-                   pz = rz - dt_prev * (vz[i] - vz[j]);
-      if (px * px + py * py + pz * pz >= 1.0) {
-        if (j > i) ++nnew;  // each collision counted once
-        if (dq)             // xi_dot is the same for both partners (g and n both change sign)
-          dqi += ChargeExchange::transferTo(charging, step, static_cast<std::uint32_t>(id[i]),
-                                            static_cast<std::uint32_t>(id[j]), xi_dot);
-      }
+      if (r2 < 1.0) contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
     }
+    if (CHARGING && dqi != 0.0) dq[i] = dqi;  // applied by the next kick pass (charges are read by others now)
+    StepAccum res;
+    res.collisions = nnew;
+    res.max_overlap = mx;
+    finish(i, f0, f1, f2, res);
+    return res;
+  }
+
+  /// Adds the slow force, stores i's force and adds its finiteness probe to res.
+  HD void finish(int i, double f0, double f1, double f2, StepAccum& res) const {
     if (EXT && ext_force_scale != 0.0) {
       f0 += ext_force_scale * ext_fx[i];
       f1 += ext_force_scale * ext_fy[i];
@@ -117,25 +146,67 @@ struct ContactForceFunctor {
     fx[i] = f0;
     fy[i] = f1;
     fz[i] = f2;
-    if (dqi != 0.0) dq[i] = dqi;  // applied by the next kick pass (charges are read by others now)
-    // v - v == 0 exactly for finite v and is NaN for NaN or inf: a finiteness test that needs no
-    // math library in device code
-    const double probe = f0 + f1 + f2 + xi_ + yi_ + zi_;
-    const bool finite = probe - probe == 0.0;
-    ContactStepResult res;
+    const Scalar4 ri = pos[i];
+    res.probe += f0 + f1 + f2 + ri.x + ri.y + ri.z;  // NaN or inf if any term is
+  }
+
+  /// Particles [first, last) at once, as one loop over their entries of the compressed list (no
+  /// fast Coulomb part): the entries are screened in chunks, branch-free, collecting those in
+  /// contact, and only those get the contact work. In a dilute gas a row holds one or two
+  /// entries and few are in contact, so per-row loops spend their time in mispredicted loop exits
+  /// and contact tests; here the loop lengths are those of whole chunks. Each particle's force is
+  /// summed over its contacts in row order, starting from zero, as in operator(): the results are
+  /// identical to the bit.
+  HD StepAccum range(int first, int last) const {
+    StepAccum res;
+    for (int i = first; i < last; ++i) {
+      fx[i] = 0.0;
+      fy[i] = 0.0;
+      fz[i] = 0.0;
+    }
+    constexpr int CHUNK = 64;
+    int hit[CHUNK];
+    const int end = flat_offsets[last];
+    int nnew = 0;
+    double mx = 0.0;
+    for (int c0 = flat_offsets[first]; c0 < end; c0 += CHUNK) {
+      const int c1 = c0 + CHUNK < end ? c0 + CHUNK : end;
+      int nhit = 0;
+      for (int e = c0; e < c1; ++e) {
+        double rx, ry, rz;
+        const double r2 = separation(pos[flat_owners[e]], pos[flat_partners[e]], rx, ry, rz);
+        hit[nhit] = e;
+        nhit += r2 < 1.0;
+      }
+      for (int h = 0; h < nhit; ++h) {
+        const int e = hit[h], i = flat_owners[e], j = flat_partners[e];
+        double rx, ry, rz;
+        const double r2 = separation(pos[i], pos[j], rx, ry, rz);
+        double f0 = fx[i], f1 = fy[i], f2 = fz[i], dqi = 0.0;
+        contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
+        fx[i] = f0;
+        fy[i] = f1;
+        fz[i] = f2;
+        if (CHARGING) dq[i] += dqi;  // dq is zero before the pass (applied and cleared by the kick)
+      }
+    }
     res.collisions = nnew;
-    res.worst = !finite ? 1 : (mx > max_overlap ? 2 : 0);
+    res.max_overlap = mx;
+    for (int i = first; i < last; ++i) finish(i, fx[i], fy[i], fz[i], res);
     return res;
   }
 };
 
-struct CombineStepFlags {
-  using value_type = ContactStepResult;
-  HD static ContactStepResult identity() { return ContactStepResult{}; }
-  HD ContactStepResult operator()(const ContactStepResult& a, const ContactStepResult& b) const {
-    ContactStepResult r;
+/// Block reduction of the force pass: sums and maxima only, so the pass has no per-particle branch
+/// for its checks (a NaN or inf anywhere makes the probe sum NaN or inf).
+struct CombineStepAccum {
+  using value_type = StepAccum;
+  HD static StepAccum identity() { return StepAccum{}; }
+  HD StepAccum operator()(const StepAccum& a, const StepAccum& b) const {
+    StepAccum r;
     r.collisions = a.collisions + b.collisions;
-    r.worst = a.worst > b.worst ? a.worst : b.worst;
+    r.probe = a.probe + b.probe;
+    r.max_overlap = a.max_overlap > b.max_overlap ? a.max_overlap : b.max_overlap;
     return r;
   }
 };
@@ -185,25 +256,35 @@ struct MaxOverlapOf {
 
 }  // namespace
 
-template <class Potential, bool EXT, bool FAST_COULOMB>
+template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING>
 ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const common::Box& box,
                             const typename Potential::Params& params, const ContactStep& st, ContactWork& w) {
   const int N = static_cast<int>(p.size());
   const double dt = st.dt, half_dt = 0.5 * dt;
   if (w.fx.size() != p.size()) w.resize(p.size());
-  ContactForceFunctor<Potential, EXT, FAST_COULOMB> f{
+  const bool flat = !FAST_COULOMB && nl.hasFlat();
+  ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING> f{
       raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), nl.rows(), nl.counts(),
-      nl.capacity(), box, params, st.max_overlap, half_dt, dt, raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id),
+      nl.capacity(), flat ? nl.flatOffsets() : nullptr, flat ? nl.flatPartners() : nullptr,
+      flat ? nl.flatOwners() : nullptr, box, params, half_dt, dt, raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id),
       st.charging, st.step, st.dq, st.ext_fx, st.ext_fy, st.ext_fz, st.ext_force_scale, st.ext_predict_scale,
       st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table};
-  // forces and, per block, collisions (sum) and the worst flag (max); then one reduction over blocks
+  // forces and, per block, collisions, probe sum and largest overlap; then one reduction over blocks
   const int block = blockSizeFor(N);
   w.block_flags.resize(blockCount(N, block));
-  forEachBlocked(N, block, f, CombineStepFlags{}, raw(w.block_flags));
+  if (flat)
+    forEachBlockRange(N, block, f, raw(w.block_flags));
+  else
+    forEachBlocked(N, block, f, CombineStepAccum{}, raw(w.block_flags));
   p.fx.swap(w.fx);  // p.f = f(t); the old forces stay in w until the next pass overwrites them
   p.fy.swap(w.fy);
   p.fz.swap(w.fz);
-  return thrust::reduce(w.block_flags.begin(), w.block_flags.end(), ContactStepResult{}, CombineStepFlags{});
+  const StepAccum a = thrust::reduce(w.block_flags.begin(), w.block_flags.end(), StepAccum{}, CombineStepAccum{});
+  ContactStepResult r;
+  r.collisions = a.collisions;
+  // v - v == 0 exactly for finite v and is NaN for NaN or inf (no math library needed)
+  r.worst = !(a.probe - a.probe == 0.0) ? 1 : (a.max_overlap > st.max_overlap ? 2 : 0);
+  return r;
 }
 
 template <class Potential>
@@ -213,9 +294,14 @@ ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, 
   const bool fast = st.fast.r2 > 0.0;
   if (fast && (nl.listRange() < st.fast.r2 || !st.fast_table.data))
     throw std::logic_error("neighbour list range below the fast Coulomb range");
-  if (fast) return forcePass<Potential, true, true>(p, nl, box, params, st, w);
-  return st.ext_fx ? forcePass<Potential, true, false>(p, nl, box, params, st, w)
-                   : forcePass<Potential, false, false>(p, nl, box, params, st, w);
+  if (st.dq) {
+    if (fast) return forcePass<Potential, true, true, true>(p, nl, box, params, st, w);
+    return st.ext_fx ? forcePass<Potential, true, false, true>(p, nl, box, params, st, w)
+                     : forcePass<Potential, false, false, true>(p, nl, box, params, st, w);
+  }
+  if (fast) return forcePass<Potential, true, true, false>(p, nl, box, params, st, w);
+  return st.ext_fx ? forcePass<Potential, true, false, false>(p, nl, box, params, st, w)
+                   : forcePass<Potential, false, false, false>(p, nl, box, params, st, w);
 }
 
 template <class Potential>

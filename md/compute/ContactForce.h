@@ -34,10 +34,17 @@ struct ContactStepResult {
   int worst = 0;                ///< worst particle: 0 all good, 1 non-finite force or position, 2 overlap beyond the bound
 };
 
+/// Per-block partial result of a force pass (md/engine/Launch.h).
+struct StepAccum {
+  std::int64_t collisions = 0;
+  double probe = 0.0;        ///< sum of forces and positions: not finite iff one of them is not
+  double max_overlap = 0.0;
+};
+
 /// Scratch of the force pass.
 struct ContactWork {
-  DVec<double> fx, fy, fz;              ///< forces being computed (swapped with ParticleData's)
-  DVec<ContactStepResult> block_flags;  ///< per-block partial results (md/engine/Launch.h)
+  DVec<double> fx, fy, fz;       ///< forces being computed (swapped with ParticleData's)
+  DVec<StepAccum> block_flags;   ///< per-block partial results (md/engine/Launch.h)
   void resize(std::size_t n);
 };
 

@@ -140,6 +140,7 @@ struct Engine::Impl {
   SpringDashpot::Params sd_params{};
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
+    nl.keepFlat(true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
     exchange = c.charging.mode == "exchange";
     charging.seed = c.system.seed;
     charging.Q = c.charging.Q;
@@ -169,25 +170,29 @@ struct Engine::Impl {
   /// Stores particles in cell order (memory locality for the neighbour gathers: a particle's
   /// neighbours then sit within a few hundred slots of it). Rows are sorted by particle id, so
   /// forces, and hence trajectories, do not depend on the storage order. The caller rebuilds the list.
-  void sortByCell() {
+  /// Returns false if nothing was sorted (boxes too small for cells).
+  bool sortByCell() {
     const DVec<int>& order = nl.computeCellOrder(p, box);
-    if (order.size() != p.size()) return;  // all-pairs builds: nothing to sort
+    if (order.size() != p.size()) return false;  // all-pairs builds: nothing to sort
     permute(p.pos, order, scratch4);  // (dq is all zero here: applied by the kick pass before)
     for (auto* v : {&p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz}) permute(*v, order, scratch_d);
     if (coulomb)  // the Coulomb forces, used until the next evaluation, follow their particles
       for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) permute(*v, order, scratch_d);
     for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
+    return true;
   }
 
   /// Builds the neighbour lists for the current positions (storage first re-sorted by cell: the
   /// cost is a gather per array, far less than the cache misses of neighbours scattered in memory).
   /// A re-sort moves slots, so it rebuilds every list.
   void rebuildList(bool sort) {
-    if (sort) sortByCell();
+    const bool sorted = sort && sortByCell();
     if (nl_coul) {
       nl_coul->build(p, box);
       drift_since_coul_build = 0.0;
       nl.buildFrom(*nl_coul, p, box);
+    } else if (sorted) {
+      nl.buildSorted(p, box);  // the storage is in nl's cell order now
     } else {
       nl.build(p, box);
     }
@@ -229,6 +234,7 @@ struct Engine::Impl {
     slow_table.clear();
     fast_table.clear();
     nl = NeighborList(1.0, skin);
+    nl.keepFlat(true);
     if (cc.method == "pppm") {
       // "auto": a longer skin than the contact list's when the list is used every k-th step only
       // (fewer builds of a long list; measured optimum at N = 1e4, K = 5: docs/benchmarks-coulomb.md)
@@ -275,6 +281,7 @@ struct Engine::Impl {
         fast_table.assign(f.begin(), f.end());
       }
       nl = NeighborList(std::max(1.0, fast_switch.r2), skin);
+      nl.keepFlat(fast_switch.r2 == 0.0);  // with a fast Coulomb part every entry has work: per-row loops
     } else {
       const EwaldParams prm = chooseEwaldParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut);
       ewald = std::make_unique<EwaldReference>(prm, L, cc.K);

@@ -61,6 +61,26 @@ struct NoReduction {
   HD int operator()(int a, int) const { return a; }
 };
 
+/// body.range(first, last) for the index range of block b, stored in out[b]: for bodies that work
+/// on a block as a whole (e.g. one loop over the neighbour entries of all its particles).
+template <class Body>
+struct BlockRangeLoop {
+  Body body;
+  typename Body::value_type* out;
+  int n, block;
+  HD void operator()(int b) const {
+    const Body f = body;
+    const int first = b * block, last = first + block < n ? first + block : n;
+    out[b] = f.range(first, last);
+  }
+};
+
+template <class Body>
+void forEachBlockRange(int n, int block, const Body& body, typename Body::value_type* out) {
+  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(blockCount(n, block)),
+                   BlockRangeLoop<Body>{body, out, n, block});
+}
+
 template <class Body, class Reduction>
 void forEachBlocked(int n, int block, const Body& body, const Reduction& reduce, typename Reduction::value_type* out) {
   thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(blockCount(n, block)),

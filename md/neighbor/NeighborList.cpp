@@ -9,6 +9,7 @@
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/reduce.h>
+#include <thrust/scan.h>
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
 
@@ -36,6 +37,14 @@ struct CellIndex {
 HD inline void append(int* row, int& n, int cap, int j) {
   if (n < cap) row[n] = j;
   ++n;
+}
+/// Branch-free append of candidate j if `hit`: j is written whatever `hit` -- to row[n], past the
+/// row's entries, or once the row is full to `spill` (never to a row slot: a full row may be exactly
+/// full, and its last entry must survive) -- and n advances by hit. Most candidates of a cell search
+/// miss, at random: a branch on them is mispredicted about as often as it is taken.
+HD inline void appendIf(int* row, int& n, int cap, int j, bool hit, int& spill) {
+  *(n < cap ? row + n : &spill) = j;
+  n += hit;
 }
 
 /// Sorts a row of slots by particle id: insertion sort for the short rows of contact-only lists,
@@ -94,6 +103,9 @@ struct CellStarts {
   }
 };
 
+/// SORTED: the particle storage is in cell order (slot s is the s-th in the order), so candidates
+/// are read straight from consecutive slots instead of through the order.
+template <bool SORTED>
 struct BuildCells {
   const Scalar4* pos;
   const int *order, *cell_start, *id;
@@ -103,14 +115,13 @@ struct BuildCells {
   int nc, cap;
 
   /// Candidates in the slot range [s0, s1) of the cell order.
-  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n) const {
+  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill) const {
     for (int s = s0; s < s1; ++s) {
-      const int j = order[s];
-      if (j == i) continue;
+      const int j = SORTED ? s : order[s];
       const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(xi - rj.x), ry = box.minimumImageWrapped(yi - rj.y),
                    rz = box.minimumImageWrapped(zi - rj.z);
-      if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
+      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
     }
   }
 
@@ -125,20 +136,20 @@ struct BuildCells {
     const int xs[3] = {cx == 0 ? nc - 1 : cx - 1, cx, cx == nc - 1 ? 0 : cx + 1};
     const int ys[3] = {cy == 0 ? nc - 1 : cy - 1, cy, cy == nc - 1 ? 0 : cy + 1};
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0;
+    int n = 0, spill = 0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
         // the three cells cz-1, cz, cz+1 of a column are consecutive in the cell order (one slot
         // range) unless the column wraps through the z faces (two ranges)
         const int base = (xs[a] * nc + ys[b]) * nc;
         if (cz > 0 && cz < nc - 1) {
-          scan(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n);
+          scan(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n, spill);
         } else if (cz == 0) {
-          scan(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n);
-          scan(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n);
+          scan(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill);
+          scan(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill);
         } else {
-          scan(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n);
-          scan(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n);
+          scan(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill);
+          scan(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill);
         }
       }
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
@@ -159,15 +170,30 @@ struct FilterRows {
     const Scalar4 ri = pos[i];
     const int* in = super_rows + static_cast<long>(i) * super_cap;
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0;
+    int n = 0, spill = 0;
     for (int k = 0; k < super_count[i]; ++k) {
       const int j = in[k];
       const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
-      if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
+      appendIf(row, n, cap, j, rx * rx + ry * ry + rz * rz < r2, spill);
     }
     count[i] = n;
+  }
+};
+
+/// Copies row i to its place in the compressed list.
+struct FlattenRow {
+  const int *rows, *count, *offsets;
+  int *partners, *owners;
+  int cap;
+  HD void operator()(int i) const {
+    const int* row = rows + static_cast<long>(i) * cap;
+    const int o = offsets[i];
+    for (int k = 0; k < count[i]; ++k) {
+      partners[o + k] = row[k];
+      owners[o + k] = i;
+    }
   }
 };
 
@@ -227,14 +253,25 @@ const DVec<int>& NeighborList::computeCellOrder(const ParticleData& p, const com
   return m_order;
 }
 
-void NeighborList::build(const ParticleData& p, const common::Box& box) {
+void NeighborList::build(const ParticleData& p, const common::Box& box) { buildImpl(p, box, false); }
+
+void NeighborList::buildSorted(const ParticleData& p, const common::Box& box) {
+  if (m_order.empty()) return buildImpl(p, box, false);  // box too small for cells: all-pairs build
+  if (m_order.size() != p.size() || m_cell.size() != p.size())
+    throw std::logic_error("NeighborList::buildSorted: no cell order computed for these particles");
+  buildImpl(p, box, true);
+}
+
+void NeighborList::buildImpl(const ParticleData& p, const common::Box& box, bool sorted) {
   const int N = static_cast<int>(p.size());
   const double range = m_cutoff + m_skin;
   const int nc = cellsPerSide(box);
   const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
   m_count.resize(N);
   m_capacity = m_next_capacity;
-  if (nc >= 3) computeCellOrder(p, box);
+  // sorted: computeCellOrder ran on these positions and the storage was permuted by its order, so
+  // m_cell (sorted in place with the order) holds the cell of every slot and the order is the identity
+  if (nc >= 3 && !sorted) computeCellOrder(p, box);
   for (;;) {
     m_list.resize(static_cast<std::size_t>(N) * m_capacity);
     if (nc >= 3) {
@@ -242,8 +279,14 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
       const double inv_cell = nc / box.L;
       m_cell_start.resize(ncell + 1);
       thrust::for_each(first, last, CellStarts{raw(m_cell), raw(m_cell_start), N, ncell});
-      thrust::for_each(first, last,
-                       BuildCells{raw(p.pos), raw(m_order), raw(m_cell_start), raw(p.id), raw(m_list), raw(m_count), box, inv_cell, range * range, nc, m_capacity});
+      if (sorted)
+        thrust::for_each(first, last,
+                         BuildCells<true>{raw(p.pos), nullptr, raw(m_cell_start), raw(p.id), raw(m_list), raw(m_count),
+                                          box, inv_cell, range * range, nc, m_capacity});
+      else
+        thrust::for_each(first, last,
+                         BuildCells<false>{raw(p.pos), raw(m_order), raw(m_cell_start), raw(p.id), raw(m_list),
+                                           raw(m_count), box, inv_cell, range * range, nc, m_capacity});
     } else {
       m_order.clear();
       thrust::for_each(first, last,
@@ -256,9 +299,22 @@ void NeighborList::build(const ParticleData& p, const common::Box& box) {
   ++m_builds;
 }
 
+void NeighborList::flatten(int N) {
+  m_flat_offsets.resize(N + 1);
+  thrust::exclusive_scan(m_count.begin(), m_count.end(), m_flat_offsets.begin());
+  const int total = N ? static_cast<int>(m_flat_offsets[N - 1]) + static_cast<int>(m_count[N - 1]) : 0;
+  m_flat_offsets[N] = total;
+  m_flat_partners.resize(total);
+  m_flat_owners.resize(total);
+  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+                   FlattenRow{raw(m_list), raw(m_count), raw(m_flat_offsets), raw(m_flat_partners), raw(m_flat_owners),
+                              m_capacity});
+}
+
 bool NeighborList::fitCapacity(int N) {
   const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
   if (most <= m_capacity) {
+    if (m_keep_flat) flatten(N);
     // rows much wider than needed cost a cache line per particle per step for nothing: the next
     // build uses a tighter capacity (a later overflow is caught by the caller). Not this one: its
     // rows are laid out with the current stride.

@@ -31,11 +31,25 @@ class NeighborList {
   const DVec<int>& computeCellOrder(const ParticleData& p, const common::Box& box);
   /// Unconditional rebuild.
   void build(const ParticleData& p, const common::Box& box);
+  /// Unconditional rebuild right after the storage was permuted into the order computeCellOrder
+  /// returned (positions unchanged since): the cell search then reads candidates from consecutive
+  /// slots and skips sorting the cells again. Same list as build().
+  void buildSorted(const ParticleData& p, const common::Box& box);
   /// Unconditional rebuild from a longer list that is valid for the current positions out to at
   /// least this list's range (every pair closer than listRange() is in `super`): each row keeps
   /// the entries of super's row within range, already in id order. Much cheaper than a cell
   /// search when super is the Coulomb list and this the short contact list (Engine).
   void buildFrom(const NeighborList& super, const ParticleData& p, const common::Box& box);
+
+  /// Also keep the list in compressed form (rows back to back: flatOffsets, flatPartners,
+  /// flatOwners), rebuilt with every build. For passes that walk the entries of many particles as
+  /// one loop (ContactForce.cpp).
+  void keepFlat(bool on) { m_keep_flat = on; }
+  /// Entries of row i are flatPartners()[flatOffsets()[i] .. flatOffsets()[i + 1]) (N + 1 offsets).
+  const int* flatOffsets() const { return raw(m_flat_offsets); }
+  const int* flatPartners() const { return raw(m_flat_partners); }  ///< partner slot of each entry
+  const int* flatOwners() const { return raw(m_flat_owners); }      ///< row (particle slot) of each entry
+  bool hasFlat() const { return m_keep_flat && m_flat_offsets.size() == m_built_n + 1; }
 
   const int* rows() const { return raw(m_list); }     ///< row i at rows()[i * capacity()]
   const int* counts() const { return raw(m_count); }  ///< entries in row i
@@ -45,13 +59,18 @@ class NeighborList {
 
  private:
   int cellsPerSide(const common::Box& box) const;
+  void buildImpl(const ParticleData& p, const common::Box& box, bool sorted);
   /// Finishes a build: checks the rows against the capacity (true: they fit) and plans the next one.
   bool fitCapacity(int N);
+  /// The compressed copy of the rows (keepFlat).
+  void flatten(int N);
   double m_cutoff, m_skin;
   int m_capacity = 16;       // row stride of the current list
   int m_next_capacity = 16;  // for the next build: grows on overflow, shrinks when rows are mostly empty
   std::int64_t m_builds = 0;
   DVec<int> m_list, m_count;
+  bool m_keep_flat = false;
+  DVec<int> m_flat_offsets, m_flat_partners, m_flat_owners;
   std::size_t m_built_n = 0;  // N at the last build
   DVec<int> m_cell, m_order, m_cell_start;
 };

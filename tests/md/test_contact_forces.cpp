@@ -81,12 +81,29 @@ void bruteForce(const std::vector<double>& pos, const std::vector<double>& vel, 
     }
 }
 
+void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L, bool flat,
+                           std::vector<double>& out);
+
+/// Both force passes (per-row loops, and one loop over the compressed list per block) against
+/// the reference, and against each other to the bit.
 void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L) {
+  std::vector<double> forces[2];
+  for (bool flat : {false, true}) {
+    INFO((flat ? "compressed-list pass" : "per-row pass"));
+    compareWithBruteForce(pos, vel, L, flat, forces[flat]);
+  }
+  CHECK(forces[0] == forces[1]);
+}
+
+void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L, bool flat,
+                           std::vector<double>& out) {
   const HertzViscoelastic::Params prm{278.6, 27.7, true};
   ParticleData p = makeParticles(pos, vel);
   common::Box box{L};
   NeighborList nl(1.0, 0.3);
+  nl.keepFlat(flat);
   nl.build(p, box);
+  REQUIRE(nl.hasFlat() == flat);
   ContactWork w;
   // dt = 0: a state at full step, so the predicted velocities equal v, as in the reference. Overlap
   // bound 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite force.
@@ -104,6 +121,9 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   thrust::copy(p.fx.begin(), p.fx.end(), fx.begin());
   thrust::copy(p.fy.begin(), p.fy.end(), fy.begin());
   thrust::copy(p.fz.begin(), p.fz.end(), fz.begin());
+  out = fx;
+  out.insert(out.end(), fy.begin(), fy.end());
+  out.insert(out.end(), fz.begin(), fz.end());
   double worst = 0.0, scale = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double a[3] = {fx[i], fy[i], fz[i]};
@@ -172,6 +192,7 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
   std::mt19937_64 rng(3);
   const double L = 10.0;
   NeighborList nl(1.0, 0.3);
+  nl.keepFlat(true);
   const common::Box box{L};
   auto check = [&](const std::vector<double>& pos) {
     ParticleData p = makeParticles(pos, std::vector<double>(pos.size(), 0.0));
@@ -195,6 +216,20 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
       INFO("particle " << i << ", capacity " << nl.capacity());
       REQUIRE(got == expected);
     }
+    // the compressed copy (keepFlat) holds the same rows back to back
+    REQUIRE(nl.hasFlat());
+    std::vector<int> off(n + 1);
+    thrust::copy(thrust::device_pointer_cast(nl.flatOffsets()), thrust::device_pointer_cast(nl.flatOffsets()) + n + 1, off.begin());
+    std::vector<int> partners(off[n]), owners(off[n]);
+    thrust::copy(thrust::device_pointer_cast(nl.flatPartners()), thrust::device_pointer_cast(nl.flatPartners()) + off[n], partners.begin());
+    thrust::copy(thrust::device_pointer_cast(nl.flatOwners()), thrust::device_pointer_cast(nl.flatOwners()) + off[n], owners.begin());
+    for (std::size_t i = 0; i < n; ++i) {
+      REQUIRE(off[i + 1] - off[i] == counts[i]);
+      for (int k = 0; k < counts[i]; ++k) {
+        CHECK(partners[off[i] + k] == rows[i * nl.capacity() + k]);
+        CHECK(owners[off[i] + k] == static_cast<int>(i));
+      }
+    }
   };
   std::uniform_real_distribution<double> u(0.0, L);
   std::vector<double> sparse;
@@ -206,4 +241,24 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
   for (int k = 0; k < 3 * 200; ++k) dense.push_back(std::fmod(g(rng) + L, L));
   check(dense);   // overflow: capacity grows, list rebuilt
   check(sparse);
+  // A row filled exactly to the capacity, with candidates out of range scanned after its last
+  // entry: the cell search appends without branching (a miss is written past the entries and not
+  // counted) and must never write into a full row. Particle 0 gets `cap` partners at 1.25 (1.3
+  // apart or more from each other), and 14 particles at 1.9-2.0 (in its 27 cells, out of range;
+  // far from each other) are scanned around and after them.
+  check(sparse);  // capacity shrunk again
+  const int cap = nl.capacity();
+  REQUIRE(cap < 16);
+  std::vector<double> full = {5.0, 5.0, 5.0};
+  for (int k = 0; k < cap; ++k) {  // golden-angle spiral on the sphere of radius 1.25
+    const double z = -1.0 + (2.0 * k + 1.0) / cap, phi = 2.39996 * k, s = std::sqrt(1.0 - z * z);
+    for (double c : {s * std::cos(phi), s * std::sin(phi), z}) full.push_back(5.0 + 1.25 * c);
+  }
+  for (int a = 0; a < 3; ++a)
+    for (double sign : {-1.0, 1.0})
+      for (int c = 0; c < 3; ++c) full.push_back(5.0 + (c == a ? 1.9 * sign : 0.0));
+  for (int k = 0; k < 8; ++k)
+    for (int c = 0; c < 3; ++c) full.push_back(5.0 + ((k >> c) & 1 ? 1.155 : -1.155));
+  check(full);
+  CHECK(nl.capacity() == cap);  // the row fitted exactly: no growth
 }
