@@ -22,9 +22,13 @@ struct Box {
   }
   /// Wraps a coordinate into [0, L) and returns the number of box lengths removed
   /// (added to the image count, so that unwrapped = wrapped + image * L).
-  HD int wrap(double& x) const {
+  HD_INLINE int wrap(double& x) const {
+    if (x >= 0.0 && x < L) return 0;  // inside: nearly always (inlined into the drift loops)
+    return wrapOutside(x);
+  }
+  /// wrap() for x outside [0, L).
+  HD int wrapOutside(double& x) const {
     // fast path: a particle crosses at most one face per step (the result is the same as below)
-    if (x >= 0.0 && x < L) return 0;
     if (x >= L && x < 2.0 * L) {  // x - L is exact here (Sterbenz), so it lies in [0, L)
       x -= L;
       return 1;

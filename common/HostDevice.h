@@ -9,3 +9,13 @@
 #else
 #define HD
 #endif
+
+/// HD_INLINE: an HD function that must be inlined into its caller's loop (g++ gives up inlining in
+/// large functors, and a call in a per-particle loop costs more than the work).
+#if defined(__CUDACC__)
+#define HD_INLINE __host__ __device__ __forceinline__
+#elif defined(__GNUC__)
+#define HD_INLINE inline __attribute__((always_inline))
+#else
+#define HD_INLINE inline
+#endif

@@ -22,11 +22,16 @@ void ContactWork::resize(std::size_t n) {
   for (auto* v : {&fx, &fy, &fz}) v->resize(n);
 }
 
+bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step) {
+  return nl.hasFlat() && !(step.fast.r2 > 0.0);
+}
+
 namespace {
 
 /// CHARGING: the charge exchange at new contacts is compiled in (dq non-null); without it the
 /// neutral pass keeps the random-number code out of its registers.
-template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING>
+/// ADVANCE: the pass also advances the step (ContactStep::advance_dt; compressed-list pass only).
+template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING, bool ADVANCE = false>
 struct ContactForceFunctor {
   using value_type = StepAccum;
   const Scalar4* pos;
@@ -52,6 +57,11 @@ struct ContactForceFunctor {
   // from fast_r2sq = r2^2 on
   double K, fast_r2sq;
   PairTable fast_table;
+  // ADVANCE only: where the next positions and drift velocities go, the image counts, dt
+  Scalar4* next_pos;
+  double *next_vx, *next_vy, *next_vz;
+  int *ix, *iy, *iz;
+  double advance_dt;
 
   /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old, corrected for
   /// a multiple-time-step impulse given or about to be given (ContactStep::ext_predict_scale)
@@ -137,7 +147,7 @@ struct ContactForceFunctor {
   }
 
   /// Adds the slow force, stores i's force and adds its finiteness probe to res.
-  HD void finish(int i, double f0, double f1, double f2, StepAccum& res) const {
+  HD_INLINE void finish(int i, double f0, double f1, double f2, StepAccum& res) const {
     if (EXT && ext_force_scale != 0.0) {
       f0 += ext_force_scale * ext_fx[i];
       f1 += ext_force_scale * ext_fy[i];
@@ -148,6 +158,32 @@ struct ContactForceFunctor {
     fz[i] = f2;
     const Scalar4 ri = pos[i];
     res.probe += f0 + f1 + f2 + ri.x + ri.y + ri.z;  // NaN or inf if any term is
+    if (ADVANCE) {  // kickDrift's arithmetic, in the same order (VelocityVerlet.cpp)
+      const double h = 0.5 * advance_dt;
+      double u0 = vx[i], u1 = vy[i], u2 = vz[i];
+      u0 += h * f0;  // closing kick: v(t)
+      u1 += h * f1;
+      u2 += h * f2;
+      u0 += h * f0;  // opening kick: u(t + dt/2)
+      u1 += h * f1;
+      u2 += h * f2;
+      next_vx[i] = u0;
+      next_vy[i] = u1;
+      next_vz[i] = u2;
+      double q = ri.w;
+      if (CHARGING && dq[i] != 0.0) {  // the charge exchanged at this pass's new contacts
+        q += dq[i];
+        dq[i] = 0.0;
+      }
+      double a = ri.x + advance_dt * u0, b = ri.y + advance_dt * u1, c = ri.z + advance_dt * u2;
+      const int sa = box.wrap(a), sb = box.wrap(b), sc = box.wrap(c);
+      if (sa) ix[i] += sa;
+      if (sb) iy[i] += sb;
+      if (sc) iz[i] += sc;
+      next_pos[i] = Scalar4{a, b, c, q};
+      const double u2sum = u0 * u0 + u1 * u1 + u2 * u2;
+      res.max_u2 = u2sum > res.max_u2 ? u2sum : res.max_u2;
+    }
   }
 
   /// Particles [first, last) at once, as one loop over their entries of the compressed list (no
@@ -207,6 +243,7 @@ struct CombineStepAccum {
     r.collisions = a.collisions + b.collisions;
     r.probe = a.probe + b.probe;
     r.max_overlap = a.max_overlap > b.max_overlap ? a.max_overlap : b.max_overlap;
+    r.max_u2 = a.max_u2 > b.max_u2 ? a.max_u2 : b.max_u2;
     return r;
   }
 };
@@ -256,19 +293,23 @@ struct MaxOverlapOf {
 
 }  // namespace
 
-template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING>
+template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING, bool ADVANCE = false>
 ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const common::Box& box,
                             const typename Potential::Params& params, const ContactStep& st, ContactWork& w) {
   const int N = static_cast<int>(p.size());
   const double dt = st.dt, half_dt = 0.5 * dt;
   if (w.fx.size() != p.size()) w.resize(p.size());
+  if (ADVANCE)
+    for (auto* v : {&w.vx, &w.vy, &w.vz}) v->resize(p.size());
+  if (ADVANCE) w.pos.resize(p.size());
   const bool flat = !FAST_COULOMB && nl.hasFlat();
-  ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING> f{
+  ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING, ADVANCE> f{
       raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), nl.rows(), nl.counts(),
       nl.capacity(), flat ? nl.flatOffsets() : nullptr, flat ? nl.flatPartners() : nullptr,
       flat ? nl.flatOwners() : nullptr, box, params, half_dt, dt, raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id),
       st.charging, st.step, st.dq, st.ext_fx, st.ext_fy, st.ext_fz, st.ext_force_scale, st.ext_predict_scale,
-      st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table};
+      st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table, raw(w.pos), raw(w.vx), raw(w.vy), raw(w.vz), raw(p.ix),
+      raw(p.iy), raw(p.iz), st.advance_dt};
   // forces and, per block, collisions, probe sum and largest overlap; then one reduction over blocks
   const int block = blockSizeFor(N);
   w.block_flags.resize(blockCount(N, block));
@@ -284,6 +325,13 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
   r.collisions = a.collisions;
   // v - v == 0 exactly for finite v and is NaN for NaN or inf (no math library needed)
   r.worst = !(a.probe - a.probe == 0.0) ? 1 : (a.max_overlap > st.max_overlap ? 2 : 0);
+  r.max_u2 = a.max_u2;
+  if (ADVANCE && r.worst == 0) {  // the next positions and drift velocities take over
+    p.pos.swap(w.pos);
+    p.vx.swap(w.vx);
+    p.vy.swap(w.vy);
+    p.vz.swap(w.vz);
+  }
   return r;
 }
 
@@ -294,6 +342,15 @@ ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, 
   const bool fast = st.fast.r2 > 0.0;
   if (fast && (nl.listRange() < st.fast.r2 || !st.fast_table.data))
     throw std::logic_error("neighbour list range below the fast Coulomb range");
+  if (st.advance_dt > 0.0) {
+    if (!canAdvanceInForcePass(nl, st) || st.advance_dt != st.dt)
+      throw std::logic_error("computeContactForces: this pass cannot advance the step (ContactStep::advance_dt)");
+    if (st.dq)
+      return st.ext_fx ? forcePass<Potential, true, false, true, true>(p, nl, box, params, st, w)
+                       : forcePass<Potential, false, false, true, true>(p, nl, box, params, st, w);
+    return st.ext_fx ? forcePass<Potential, true, false, false, true>(p, nl, box, params, st, w)
+                     : forcePass<Potential, false, false, false, true>(p, nl, box, params, st, w);
+  }
   if (st.dq) {
     if (fast) return forcePass<Potential, true, true, true>(p, nl, box, params, st, w);
     return st.ext_fx ? forcePass<Potential, true, false, true>(p, nl, box, params, st, w)

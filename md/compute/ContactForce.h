@@ -32,6 +32,7 @@ namespace granagg::md {
 struct ContactStepResult {
   std::int64_t collisions = 0;  ///< pairs whose contact started at this step
   int worst = 0;                ///< worst particle: 0 all good, 1 non-finite force or position, 2 overlap beyond the bound
+  double max_u2 = 0.0;          ///< with ContactStep::advance_dt: largest |u|^2 of the new drift velocities
 };
 
 /// Per-block partial result of a force pass (md/engine/Launch.h).
@@ -39,11 +40,14 @@ struct StepAccum {
   std::int64_t collisions = 0;
   double probe = 0.0;        ///< sum of forces and positions: not finite iff one of them is not
   double max_overlap = 0.0;
+  double max_u2 = 0.0;
 };
 
 /// Scratch of the force pass.
 struct ContactWork {
   DVec<double> fx, fy, fz;       ///< forces being computed (swapped with ParticleData's)
+  DVec<Scalar4> pos;             ///< advance_dt: the next positions (swapped with ParticleData's)
+  DVec<double> vx, vy, vz;       ///< advance_dt: the next drift velocities (swapped likewise)
   DVec<StepAccum> block_flags;   ///< per-block partial results (md/engine/Launch.h)
   void resize(std::size_t n);
 };
@@ -75,7 +79,21 @@ struct ContactStep {
   RealSpaceSwitch fast{};
   PairTable fast_table{};
   double coulomb_K = 0.0;
+  /// > 0: the pass also completes the step and opens the next one (velocity Verlet, VelocityVerlet.h)
+  /// for each particle as soon as its force f(t) is known: closing kick v(t) = u + (dt/2) f(t),
+  /// opening kick u' = v(t) + (dt/2) f(t), drift x' = x + dt u' (wrapped, images counted), and
+  /// with charging q' = q + dq. The same arithmetic as kickDrift() after the pass, in one sweep
+  /// over the particles instead of two; the new positions and velocities go to ContactWork and are
+  /// swapped in after the pass, so every partner's x and u stay those of t while others read them.
+  /// dt must equal this value (fixed step). Needs the compressed list and no fast Coulomb part
+  /// (canAdvanceInForcePass). On a non-finite force or deep overlap nothing is advanced (the forces
+  /// are stored, positions and velocities stay those of t, for the error report; image counts may
+  /// already have moved).
+  double advance_dt = 0.0;
 };
+
+/// Whether computeContactForces can advance the step (ContactStep::advance_dt) with this list and step.
+bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step);
 
 /// Contact forces of the current positions into p.fx, p.fy, p.fz (state as described above),
 /// collisions, and with charging the charge each particle gains at its new contacts.

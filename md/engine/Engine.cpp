@@ -358,7 +358,9 @@ struct Engine::Impl {
   /// state given at full step); counts collisions; aborts on NaN / deep overlap. With Coulomb, at
   /// every `every`-th step (counted from the last evaluation) the Coulomb force is evaluated first
   /// and enters p.f with weight `every` (the impulse), and between evaluations not at all.
-  void computeForces(double dt_taken) {
+  /// \param advance also complete this step and open the next in the same pass (ContactStep::
+  /// advance_dt): afterwards the state is as after openStep(), one step on.
+  void computeForces(double dt_taken, bool advance = false) {
     // Displacements since the last build are at most the sum of dt max|u| over the steps (a
     // rigorous bound that needs no stored reference positions).
     const bool slow = coulomb && (kspace_step < 0 || step - kspace_step >= every);
@@ -370,11 +372,16 @@ struct Engine::Impl {
     if (slow) evaluateCoulomb();
     ContactStep st = makeStep(dt_taken, coulomb ? slowWeight(step) : 0.0, prev_weight);
     st.dq = dqOrNull();
+    if (advance) st.advance_dt = dt;
     const ContactStepResult r = hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
                                       : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
     if (r.worst != 0) abort(r.worst);
     collisions += r.collisions;
+    if (advance) driftTaken(r.max_u2);
   }
+
+  /// Whether the force pass can also advance the step (no fast Coulomb part; compressed list).
+  bool canAdvanceInForcePass() const { return nl.keepsFlat() && !(fast_switch.r2 > 0.0); }
 
   /// Forces of a state given at full step (initial or restored state without forces): the
   /// predicted velocities are v itself and no pair counts as a new collision.
@@ -478,15 +485,39 @@ struct Engine::Impl {
     throw RunAborted(msg.str());
   }
 
-  /// One velocity-Verlet step in two passes (VelocityVerlet.h): [previous closing kick +] opening
-  /// kick + drift, then forces; the closing kick stays pending.
-  void doStep() {
-    const double max_u2 = kickDrift(p, 0.5 * dt, dt, box, close_pending, dqOrNull(), block_max);
-    close_pending = false;
+  /// A drift with drift velocities of largest |u|^2 = max_u2 was taken: bounds and step count.
+  void driftTaken(double max_u2) {
     drift_since_build += dt * std::sqrt(max_u2);
     drift_since_coul_build += dt * std::sqrt(max_u2);
     ++step;
     time = step * dt;  // no accumulated round-off in t
+  }
+
+  /// [Previous closing kick +] opening kick + drift (VelocityVerlet.h).
+  void openStep() {
+    driftTaken(kickDrift(p, 0.5 * dt, dt, box, close_pending, dqOrNull(), block_max));
+    close_pending = false;
+  }
+
+  /// `steps` velocity-Verlet steps; afterwards the forces are those of the new positions and the
+  /// closing kick is pending. A step is two passes over the particles: the opening pass (kick +
+  /// drift) and the force pass. Where the force pass can also complete the step and open the next
+  /// (ContactStep::advance_dt; not with a fast Coulomb part), the steps in between take one pass
+  /// each: open, then (forces + close + open) steps - 1 times, then forces -- the same operations
+  /// in the same order.
+  void advance(std::int64_t steps) {
+    if (steps <= 0) return;
+    openStep();
+    const bool fused = canAdvanceInForcePass();
+    for (std::int64_t s = 1; s < steps; ++s) {
+      if (fused) {
+        computeForces(dt, true);
+      } else {
+        computeForces(dt);
+        close_pending = true;
+        openStep();
+      }
+    }
     computeForces(dt);
     close_pending = true;
   }
@@ -591,7 +622,7 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
 Engine::~Engine() = default;
 
 void Engine::run(std::int64_t steps) {
-  for (std::int64_t s = 0; s < steps; ++s) m_impl->doStep();
+  m_impl->advance(steps);
   m_impl->finishStep();  // callers see full-step velocities
 }
 

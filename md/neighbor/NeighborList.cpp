@@ -125,6 +125,21 @@ struct BuildCells {
     }
   }
 
+  /// SORTED: the slots of the range [s0, s1) go to the candidate buffer without a loop -- four
+  /// consecutive slots are written whatever the length and the first min(length, 4) kept -- and
+  /// the rest (dense cells only) is scanned at once. In a dilute gas a range holds about one
+  /// particle: a loop per range costs a mispredicted exit each, here the candidates of all ranges
+  /// are screened in one loop. Unsorted: scanned at once.
+  HD void range(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int* cand,
+                int& m) const {
+    if (!SORTED) return scan(s0, s1, i, xi, yi, zi, row, n, spill);
+    const int len = s1 - s0;
+    for (int k = 0; k < GATHER; ++k) cand[m + k] = s0 + k;
+    m += len < GATHER ? len : GATHER;
+    if (len > GATHER) scan(s0 + GATHER, s1, i, xi, yi, zi, row, n, spill);
+  }
+  static constexpr int GATHER = 4;
+
   HD void operator()(int i) const {
     const Scalar4 ri = pos[i];
     const double xi = ri.x, yi = ri.y, zi = ri.z;
@@ -137,21 +152,30 @@ struct BuildCells {
     const int ys[3] = {cy == 0 ? nc - 1 : cy - 1, cy, cy == nc - 1 ? 0 : cy + 1};
     int* row = list + static_cast<long>(i) * cap;
     int n = 0, spill = 0;
+    int cand[18 * GATHER];  // at most 18 ranges (9 columns, split in two where they wrap in z)
+    int m = 0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
         // the three cells cz-1, cz, cz+1 of a column are consecutive in the cell order (one slot
         // range) unless the column wraps through the z faces (two ranges)
         const int base = (xs[a] * nc + ys[b]) * nc;
         if (cz > 0 && cz < nc - 1) {
-          scan(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n, spill);
+          range(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n, spill, cand, m);
         } else if (cz == 0) {
-          scan(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill);
-          scan(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill);
+          range(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill, cand, m);
+          range(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
         } else {
-          scan(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill);
-          scan(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill);
+          range(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill, cand, m);
+          range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
         }
       }
+    for (int t = 0; t < m; ++t) {  // SORTED: the gathered candidates, in one loop
+      const int j = cand[t];
+      const Scalar4 rj = pos[j];
+      const double rx = box.minimumImageWrapped(xi - rj.x), ry = box.minimumImageWrapped(yi - rj.y),
+                   rz = box.minimumImageWrapped(zi - rj.z);
+      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
+    }
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
   }
