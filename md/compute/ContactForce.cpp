@@ -320,7 +320,7 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
   p.fx.swap(w.fx);  // p.f = f(t); the old forces stay in w until the next pass overwrites them
   p.fy.swap(w.fy);
   p.fz.swap(w.fz);
-  const StepAccum a = thrust::reduce(w.block_flags.begin(), w.block_flags.end(), StepAccum{}, CombineStepAccum{});
+  const StepAccum a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
   ContactStepResult r;
   r.collisions = a.collisions;
   // v - v == 0 exactly for finite v and is NaN for NaN or inf (no math library needed)

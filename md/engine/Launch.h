@@ -12,8 +12,10 @@
 /// Per-block results (block maxima, counts) go to an array reduced afterwards over the blocks;
 /// sums of integers and maxima are exact, so results do not depend on the blocking or the thread
 /// count.
+#include <thrust/device_vector.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/reduce.h>
 
 #if !defined(__CUDACC__)
 #include <omp.h>
@@ -79,6 +81,20 @@ template <class Body>
 void forEachBlockRange(int n, int block, const Body& body, typename Body::value_type* out) {
   thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(blockCount(n, block)),
                    BlockRangeLoop<Body>{body, out, n, block});
+}
+
+/// Combines the per-block results: a handful of values. On the OpenMP backend a plain loop on the
+/// calling thread (thrust::reduce would open another parallel region, whose fork and join cost
+/// more than the work); on CUDA thrust::reduce on the device.
+template <class T, class Op>
+T reduceBlocks(const thrust::device_vector<T>& blocks, T init, Op op) {
+#if defined(__CUDACC__)
+  return thrust::reduce(blocks.begin(), blocks.end(), init, op);
+#else
+  const T* b = thrust::raw_pointer_cast(blocks.data());
+  for (std::size_t k = 0; k < blocks.size(); ++k) init = op(init, b[k]);
+  return init;
+#endif
 }
 
 template <class Body, class Reduction>

@@ -84,7 +84,7 @@ double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& 
                  KickDrift{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(p.ix),
                            raw(p.iy), raw(p.iz), dq, half_dt, dt, close_pending, box},
                  MaxReduction{}, raw(block_max));
-  return thrust::reduce(block_max.begin(), block_max.end(), 0.0, thrust::maximum<double>());
+  return reduceBlocks(block_max, 0.0, MaxReduction{});
 }
 
 void closeKick(ParticleData& p, double half_dt, double* dq) {
