@@ -18,6 +18,17 @@
 /// The pass computes only what every step needs (forces, collisions, the NaN / overlap check);
 /// energies, overlaps and contact counts are a separate pass over the same list, run only when
 /// observables are sampled (contactSummary).
+///
+/// Two loop shapes, the same arithmetic (identical results to the bit):
+/// - per particle over its row (with the fast Coulomb part, which every listed pair has, and on
+///   lists without a compressed copy);
+/// - per block of particles over the compressed list (NeighborList::keepFlat; contacts only): all
+///   entries of the block are screened in one branch-free loop and the contact work is done for
+///   the hits only. In a dilute gas a row holds one or two entries and about one in eight is in
+///   contact, so the per-row loops spent their time in mispredicted loop exits and contact tests
+///   (docs/benchmarks.md). On CUDA a block is one particle, i.e. the row loop again.
+/// The block form can also finish the step and open the next (ContactStep::advance_dt): one pass
+/// over the particles per step.
 #include <cstdint>
 
 #include "common/Box.h"

@@ -12,6 +12,9 @@
 /// (output, observables, checkpoints) closeKick() applies it alone. Between the passes v therefore
 /// holds the drift velocity u = v(t - dt/2), which the force pass reads for neighbours while
 /// writing the new forces elsewhere: no particle's data changes while others read it.
+/// Contact-only force passes can take over the kicks and the drift themselves (ContactStep::
+/// advance_dt), writing the next positions and velocities to second buffers: the steps between
+/// the first and the last of Engine::run are then one pass each, with this file's arithmetic.
 #include "common/Box.h"
 #include "md/engine/ParticleData.h"
 
