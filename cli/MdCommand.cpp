@@ -308,7 +308,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   if (!quiet) {
     const auto o = engine.observables();
     const std::int64_t steps = engine.step() - first_step, builds = engine.neighborBuilds() - first_builds;
-    std::printf("md: %lld steps in %.3g s (%.3g particle-steps/s incl. output); neighbour list rebuilt %lld times (every %.3g steps)\n",
+    std::printf("md: %lld steps in %.4g s (%.3g particle-steps/s incl. output); neighbour list rebuilt %lld times (every %.3g steps)\n",
                 static_cast<long long>(steps), loop_seconds,
                 loop_seconds > 0 ? static_cast<double>(steps) * engine.size() / loop_seconds : 0.0,
                 static_cast<long long>(builds), builds > 0 ? static_cast<double>(steps) / builds : 0.0);

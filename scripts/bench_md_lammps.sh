@@ -14,12 +14,13 @@
 # Installs Debian's `lammps` (29 Sep 2021 stable, binary lmp) if it is missing; builds nothing.
 #
 # Timing: every run is done at two lengths n1 < n2 from the same initial state; the rate is
-# N (n2 - n1) / (t(n2) - t(n1)). For granagg t is the wall time of the whole process, so start-up,
-# initial-state reading, the first neighbour build and output cancel; for LAMMPS the input does
-# `run n1` then `run n2-n1` and t(n2) - t(n1) is the second run's "Loop time" (same steps n1..n2 of
-# the same cooling gas, so both codes do the same physical work). Each time is the smallest of
-# REPEATS runs (the machine may be shared: load only slows a run down); the range of the
-# per-repeat rates is printed as a measure of the noise.
+# N (n2 - n1) / (t(n2) - t(n1)). For granagg t is the time of the MD loop that `granagg md` reports
+# ("md: n steps in t s": from the first step to the last, output included), so start-up,
+# initial-state reading and file creation stay out and the first neighbour build cancels; for
+# LAMMPS the input does `run n1` then `run n2-n1` and t(n2) - t(n1) is the second run's "Loop time"
+# (same steps n1..n2 of the same cooling gas, so both codes do the same physical work). Each time
+# is the smallest of REPEATS runs (the machine may be shared: load only slows a run down); the
+# range of the per-repeat rates is printed as a measure of the noise.
 #
 # LAMMPS mapping (src/GRANULAR/pair_gran_hertz_history.cpp): the normal force on each partner is
 #     F = sqrt(delta R_i R_j/(R_i+R_j)) [kn delta + m_eff gamma_n xi'],
@@ -64,7 +65,6 @@ steps_for() {  # N -> "n1 n2": STEPS_<N> if set, else 200 2000 up to N = 2e4 and
   local var="STEPS_$1"
   if [ -n "${!var:-}" ]; then echo "${!var}"; elif [ "$1" -le 20000 ]; then echo "200 2000"; else echo "100 500"; fi
 }
-now() { date +%s.%N; }
 
 # ---------------------------------------------------------------------------------------------
 # Machine
@@ -106,7 +106,7 @@ gen_state() {  # N -> $TMP/state_N.csv (granagg) and $TMP/state_N.data (LAMMPS):
   /usr/bin/python3 "$ROOT/scripts/lammps/make_state.py" "$1" "$PHI" "$TMP"
 }
 
-granagg_time() {  # N steps threads -> wall seconds of the whole process
+granagg_time() {  # N steps threads -> seconds of the MD loop (granagg md's "n steps in t s")
   local N=$1 n=$2 th=$3
   cat > "$TMP/g.toml" <<EOF
 [system]
@@ -134,13 +134,10 @@ checkpoint_interval = 0
 checkpoint_wall_seconds = 0.0
 write_velocities = false
 EOF
-  local t0 t1
-  t0=$(now)
   OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" > "$TMP/g.log" 2>&1 \
     || { cat "$TMP/g.log" >&2; exit 1; }
-  t1=$(now)
   grep -q "$n steps to t_end" "$TMP/g.log" || { echo "granagg did not run $n steps:" >&2; cat "$TMP/g.log" >&2; exit 1; }
-  calc "$t1 - $t0"
+  sed -n "s/^md: $n steps in \([0-9.e+-]*\) s.*/\1/p" "$TMP/g.log"
 }
 
 lammps_time() {  # N n1 n2 ranks fix -> loop seconds of steps n1..n2
