@@ -19,7 +19,7 @@
 namespace granagg::md {
 
 void ContactWork::resize(std::size_t n) {
-  for (auto* v : {&fx, &fy, &fz}) v->resize(n);
+  f.resize(n);
 }
 
 bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step) {
@@ -35,8 +35,8 @@ template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING, bool ADVA
 struct ContactForceFunctor {
   using value_type = StepAccum;
   const Scalar4* pos;
-  const double *vx, *vy, *vz;        // drift velocities u = v(t - dt/2) of the step just taken
-  const double *fx_old, *fy_old, *fz_old;  // f(t - dt), which kicked u
+  const Vec3* vel;    // drift velocities u = v(t - dt/2) of the step just taken
+  const Vec3* f_old;  // f(t - dt), which kicked u
   const int *rows, *counts;
   int cap;
   // the same list compressed (NeighborList::keepFlat), for range(); null: operator() only
@@ -44,7 +44,7 @@ struct ContactForceFunctor {
   common::Box box;
   typename Potential::Params params;
   double h_pred, dt_prev;
-  double *fx, *fy, *fz;  // f(t), written
+  Vec3* f_new;  // f(t), written
   // collisional charging (null dq: off): the charge each particle gains at its new contacts
   const int* id;
   ChargeExchange::Params charging;
@@ -59,16 +59,17 @@ struct ContactForceFunctor {
   PairTable fast_table;
   // ADVANCE only: where the next positions and drift velocities go, the image counts, dt
   Scalar4* next_pos;
-  double *next_vx, *next_vy, *next_vz;
+  Vec3* next_vel;
   int *ix, *iy, *iz;
   double advance_dt;
 
   /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old, corrected for
   /// a multiple-time-step impulse given or about to be given (ContactStep::ext_predict_scale)
   HD void predicted(int k, double& a, double& b, double& c) const {
-    a = vx[k] + h_pred * fx_old[k];
-    b = vy[k] + h_pred * fy_old[k];
-    c = vz[k] + h_pred * fz_old[k];
+    const Vec3 u = vel[k], f = f_old[k];
+    a = u.x + h_pred * f.x;
+    b = u.y + h_pred * f.y;
+    c = u.z + h_pred * f.z;
     if (EXT && ext_predict_scale != 0.0) {
       a += ext_predict_scale * ext_fx[k];
       b += ext_predict_scale * ext_fy[k];
@@ -98,8 +99,9 @@ struct ContactForceFunctor {
     // a collision is the first step at which the pair overlaps after not overlapping; the
     // separation one step earlier is r - dt (u_i - u_j), the drift undone (antisymmetric in i
     // and j to the last bit, so both partners agree, as they must for the charge exchange)
-    const double px = rx - dt_prev * (vx[i] - vx[j]), py = ry - dt_prev * (vy[i] - vy[j]),
-                 pz = rz - dt_prev * (vz[i] - vz[j]);
+    const Vec3 ui = vel[i], uj = vel[j];
+    const double px = rx - dt_prev * (ui.x - uj.x), py = ry - dt_prev * (ui.y - uj.y),
+                 pz = rz - dt_prev * (ui.z - uj.z);
     if (px * px + py * py + pz * pz >= 1.0) {
       if (j > i) ++nnew;  // each collision counted once
       if (CHARGING)       // xi_dot is the same for both partners (g and n both change sign)
@@ -153,23 +155,20 @@ struct ContactForceFunctor {
       f1 += ext_force_scale * ext_fy[i];
       f2 += ext_force_scale * ext_fz[i];
     }
-    fx[i] = f0;
-    fy[i] = f1;
-    fz[i] = f2;
+    f_new[i] = Vec3{f0, f1, f2};
     const Scalar4 ri = pos[i];
     res.probe += f0 + f1 + f2 + ri.x + ri.y + ri.z;  // NaN or inf if any term is
     if (ADVANCE) {  // kickDrift's arithmetic, in the same order (VelocityVerlet.cpp)
       const double h = 0.5 * advance_dt;
-      double u0 = vx[i], u1 = vy[i], u2 = vz[i];
+      const Vec3 u = vel[i];
+      double u0 = u.x, u1 = u.y, u2 = u.z;
       u0 += h * f0;  // closing kick: v(t)
       u1 += h * f1;
       u2 += h * f2;
       u0 += h * f0;  // opening kick: u(t + dt/2)
       u1 += h * f1;
       u2 += h * f2;
-      next_vx[i] = u0;
-      next_vy[i] = u1;
-      next_vz[i] = u2;
+      next_vel[i] = Vec3{u0, u1, u2};
       double q = ri.w;
       if (CHARGING && dq[i] != 0.0) {  // the charge exchanged at this pass's new contacts
         q += dq[i];
@@ -195,11 +194,7 @@ struct ContactForceFunctor {
   /// identical to the bit.
   HD StepAccum range(int first, int last) const {
     StepAccum res;
-    for (int i = first; i < last; ++i) {
-      fx[i] = 0.0;
-      fy[i] = 0.0;
-      fz[i] = 0.0;
-    }
+    for (int i = first; i < last; ++i) f_new[i] = Vec3{0.0, 0.0, 0.0};
     constexpr int CHUNK = 64;
     int hit[CHUNK];
     const int end = flat_offsets[last];
@@ -218,17 +213,19 @@ struct ContactForceFunctor {
         const int e = hit[h], i = flat_owners[e], j = flat_partners[e];
         double rx, ry, rz;
         const double r2 = separation(pos[i], pos[j], rx, ry, rz);
-        double f0 = fx[i], f1 = fy[i], f2 = fz[i], dqi = 0.0;
+        const Vec3 fi = f_new[i];
+        double f0 = fi.x, f1 = fi.y, f2 = fi.z, dqi = 0.0;
         contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
-        fx[i] = f0;
-        fy[i] = f1;
-        fz[i] = f2;
+        f_new[i] = Vec3{f0, f1, f2};
         if (CHARGING) dq[i] += dqi;  // dq is zero before the pass (applied and cleared by the kick)
       }
     }
     res.collisions = nnew;
     res.max_overlap = mx;
-    for (int i = first; i < last; ++i) finish(i, fx[i], fy[i], fz[i], res);
+    for (int i = first; i < last; ++i) {
+      const Vec3 fi = f_new[i];
+      finish(i, fi.x, fi.y, fi.z, res);
+    }
     return res;
   }
 };
@@ -298,17 +295,16 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
                             const typename Potential::Params& params, const ContactStep& st, ContactWork& w) {
   const int N = static_cast<int>(p.size());
   const double dt = st.dt, half_dt = 0.5 * dt;
-  if (w.fx.size() != p.size()) w.resize(p.size());
-  if (ADVANCE)
-    for (auto* v : {&w.vx, &w.vy, &w.vz}) v->resize(p.size());
+  if (w.f.size() != p.size()) w.resize(p.size());
+  if (ADVANCE) w.vel.resize(p.size());
   if (ADVANCE) w.pos.resize(p.size());
   const bool flat = !FAST_COULOMB && nl.hasFlat();
   ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING, ADVANCE> f{
-      raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), nl.rows(), nl.counts(),
+      raw(p.pos), raw(p.vel), raw(p.force), nl.rows(), nl.counts(),
       nl.capacity(), flat ? nl.flatOffsets() : nullptr, flat ? nl.flatPartners() : nullptr,
-      flat ? nl.flatOwners() : nullptr, box, params, half_dt, dt, raw(w.fx), raw(w.fy), raw(w.fz), raw(p.id),
+      flat ? nl.flatOwners() : nullptr, box, params, half_dt, dt, raw(w.f), raw(p.id),
       st.charging, st.step, st.dq, st.ext_fx, st.ext_fy, st.ext_fz, st.ext_force_scale, st.ext_predict_scale,
-      st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table, raw(w.pos), raw(w.vx), raw(w.vy), raw(w.vz), raw(p.ix),
+      st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table, raw(w.pos), raw(w.vel), raw(p.ix),
       raw(p.iy), raw(p.iz), st.advance_dt};
   // forces and, per block, collisions, probe sum and largest overlap; then one reduction over blocks
   const int block = blockSizeFor(N);
@@ -317,9 +313,7 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
     forEachBlockRange(N, block, f, raw(w.block_flags));
   else
     forEachBlocked(N, block, f, CombineStepAccum{}, raw(w.block_flags));
-  p.fx.swap(w.fx);  // p.f = f(t); the old forces stay in w until the next pass overwrites them
-  p.fy.swap(w.fy);
-  p.fz.swap(w.fz);
+  p.force.swap(w.f);  // p.force = f(t); the old forces stay in w until the next pass overwrites them
   const StepAccum a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
   ContactStepResult r;
   r.collisions = a.collisions;
@@ -328,9 +322,7 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
   r.max_u2 = a.max_u2;
   if (ADVANCE && r.worst == 0) {  // the next positions and drift velocities take over
     p.pos.swap(w.pos);
-    p.vx.swap(w.vx);
-    p.vy.swap(w.vy);
-    p.vz.swap(w.vz);
+    p.vel.swap(w.vel);
   }
   return r;
 }

@@ -56,9 +56,9 @@ struct StepAccum {
 
 /// Scratch of the force pass.
 struct ContactWork {
-  DVec<double> fx, fy, fz;       ///< forces being computed (swapped with ParticleData's)
+  DVec<Vec3> f;                  ///< forces being computed (swapped with ParticleData's)
   DVec<Scalar4> pos;             ///< advance_dt: the next positions (swapped with ParticleData's)
-  DVec<double> vx, vy, vz;       ///< advance_dt: the next drift velocities (swapped likewise)
+  DVec<Vec3> vel;                ///< advance_dt: the next drift velocities (swapped likewise)
   DVec<StepAccum> block_flags;   ///< per-block partial results (md/engine/Launch.h)
   void resize(std::size_t n);
 };
@@ -106,7 +106,7 @@ struct ContactStep {
 /// Whether computeContactForces can advance the step (ContactStep::advance_dt) with this list and step.
 bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step);
 
-/// Contact forces of the current positions into p.fx, p.fy, p.fz (state as described above),
+/// Contact forces of the current positions into p.force (state as described above),
 /// collisions, and with charging the charge each particle gains at its new contacts.
 template <class Potential>
 ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,

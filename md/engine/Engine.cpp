@@ -111,6 +111,7 @@ struct Engine::Impl {
   DVec<double> scratch_d;  // for permutations
   DVec<int> scratch_i;
   DVec<Scalar4> scratch4;
+  DVec<Vec3> scratch3;
   double dt = 0.0;
   std::int64_t step = 0;
   double time = 0.0;
@@ -156,9 +157,7 @@ struct Engine::Impl {
   /// Copies a host state (same N, wrapped, with images and charges) into the device arrays.
   void upload(const Frame& f) {
     p.setPositions(f.x, f.y, f.z, f.charge);
-    toDevice(f.vx, p.vx);
-    toDevice(f.vy, p.vy);
-    toDevice(f.vz, p.vz);
+    packVec3(f.vx, f.vy, f.vz, p.vel);
     toDevice(f.ix, p.ix);
     toDevice(f.iy, p.iy);
     toDevice(f.iz, p.iz);
@@ -175,7 +174,7 @@ struct Engine::Impl {
     const DVec<int>& order = nl.computeCellOrder(p, box);
     if (order.size() != p.size()) return false;  // all-pairs builds: nothing to sort
     permute(p.pos, order, scratch4);  // (dq is all zero here: applied by the kick pass before)
-    for (auto* v : {&p.vx, &p.vy, &p.vz, &p.fx, &p.fy, &p.fz}) permute(*v, order, scratch_d);
+    for (auto* v : {&p.vel, &p.force}) permute(*v, order, scratch3);
     if (coulomb)  // the Coulomb forces, used until the next evaluation, follow their particles
       for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) permute(*v, order, scratch_d);
     for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
@@ -386,7 +385,7 @@ struct Engine::Impl {
   /// Forces of a state given at full step (initial or restored state without forces): the
   /// predicted velocities are v itself and no pair counts as a new collision.
   void computeInitialForces() {
-    for (auto* f : {&p.fx, &p.fy, &p.fz}) thrust::fill(f->begin(), f->end(), 0.0);
+    thrust::fill(p.force.begin(), p.force.end(), Vec3{0.0, 0.0, 0.0});
     computeForces(0.0);
     close_pending = false;
   }
@@ -414,11 +413,13 @@ struct Engine::Impl {
   /// v - velocityOffset() * F_coulomb, per slot.
   void smoothVelocities(DVec<double>& sx, DVec<double>& sy, DVec<double>& sz) const {
     const double c = velocityOffset();
-    const std::pair<const DVec<double>*, const DVec<double>*> in[3] = {{&p.vx, &ext_fx}, {&p.vy, &ext_fy}, {&p.vz, &ext_fz}};
+    DVec<double> v[3];
+    unpackVec3(p.vel, v[0], v[1], v[2]);
+    const DVec<double>* ext[3] = {&ext_fx, &ext_fy, &ext_fz};
     DVec<double>* out[3] = {&sx, &sy, &sz};
     for (int a = 0; a < 3; ++a) {
       out[a]->resize(p.size());
-      thrust::transform(in[a].first->begin(), in[a].first->end(), in[a].second->begin(), out[a]->begin(), Axpy{-c});
+      thrust::transform(v[a].begin(), v[a].end(), ext[a]->begin(), out[a]->begin(), Axpy{-c});
     }
   }
 
@@ -452,7 +453,9 @@ struct Engine::Impl {
     const auto mx = toHostById(mx_slots, p.id);
     // which particles: the force pass's test again, per particle (cold path)
     const auto pos = toHostById(p.pos, p.id);
-    const auto fx = toHostById(p.fx, p.id), fy = toHostById(p.fy, p.id), fz = toHostById(p.fz, p.id);
+    DVec<double> dfx, dfy, dfz;
+    unpackVec3(p.force, dfx, dfy, dfz);
+    const auto fx = toHostById(dfx, p.id), fy = toHostById(dfy, p.id), fz = toHostById(dfz, p.id);
     std::vector<int> bad(pos.size(), 0);
     for (std::size_t i = 0; i < bad.size(); ++i) {
       const bool finite = std::isfinite(pos[i].x + pos[i].y + pos[i].z + fx[i] + fy[i] + fz[i]);
@@ -652,9 +655,11 @@ Frame Engine::frame(StateKind kind) const {
     f.vy = toHostById(sy, id);
     f.vz = toHostById(sz, id);
   } else {
-    f.vx = toHostById(d.p.vx, id);
-    f.vy = toHostById(d.p.vy, id);
-    f.vz = toHostById(d.p.vz, id);
+    DVec<double> vx, vy, vz;
+    unpackVec3(d.p.vel, vx, vy, vz);
+    f.vx = toHostById(vx, id);
+    f.vy = toHostById(vy, id);
+    f.vz = toHostById(vz, id);
   }
   f.ix = toHostById(d.p.ix, id);
   f.iy = toHostById(d.p.iy, id);
@@ -664,7 +669,9 @@ Frame Engine::frame(StateKind kind) const {
 
 std::vector<double> Engine::forces(StateKind kind) const {
   const Impl& d = *m_impl;
-  const DVec<double>* f[3] = {&d.p.fx, &d.p.fy, &d.p.fz};
+  DVec<double> comp[3];
+  unpackVec3(d.p.force, comp[0], comp[1], comp[2]);
+  const DVec<double>* f[3] = {&comp[0], &comp[1], &comp[2]};
   DVec<double> g[3];
   const double w = d.coulomb ? 1.0 - d.slowWeight(d.step) : 0.0;  // physical: contact + Coulomb once
   if (kind == StateKind::Physical && w != 0.0) {
@@ -700,9 +707,9 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
   if (s.size() != N || forces.size() != 3 * N || s.charge.size() != N || s.ix.size() != N)
     throw std::invalid_argument("checkpoint has " + std::to_string(s.size()) + " particles, the run " + std::to_string(N));
   d.upload(s);  // storage in id order again
-  d.p.fx.assign(forces.begin(), forces.begin() + N);
-  d.p.fy.assign(forces.begin() + N, forces.begin() + 2 * N);
-  d.p.fz.assign(forces.begin() + 2 * N, forces.end());
+  packVec3(std::vector<double>(forces.begin(), forces.begin() + N),
+           std::vector<double>(forces.begin() + N, forces.begin() + 2 * N),
+           std::vector<double>(forces.begin() + 2 * N, forces.end()), d.p.force);
   d.step = s.step;
   d.time = s.step * d.dt;
   d.collisions = collisions;
@@ -741,7 +748,8 @@ Observables Engine::observables() const {
   o.time = d.time;
   // velocities of the smooth trajectory between Coulomb impulses (Engine.h)
   DVec<double> sx, sy, sz;
-  const DVec<double>* v[3] = {&d.p.vx, &d.p.vy, &d.p.vz};
+  if (d.velocityOffset() == 0.0) unpackVec3(d.p.vel, sx, sy, sz);
+  const DVec<double>* v[3] = {&sx, &sy, &sz};
   if (d.velocityOffset() != 0.0) {
     d.smoothVelocities(sx, sy, sz);
     v[0] = &sx, v[1] = &sy, v[2] = &sz;

@@ -18,8 +18,8 @@ struct MaxReduction {
 
 struct KickDrift {
   Scalar4* pos;
-  double *vx, *vy, *vz;
-  const double *fx, *fy, *fz;
+  Vec3* vel;
+  const Vec3* force;
   int *ix, *iy, *iz;
   double* dq;
   double h, dt;
@@ -27,8 +27,9 @@ struct KickDrift {
   common::Box box;
   /// returns |u|^2 of the drift velocity
   HD double operator()(int i) const {
-    const double f0 = fx[i], f1 = fy[i], f2 = fz[i];
-    double u0 = vx[i], u1 = vy[i], u2 = vz[i];
+    const Vec3 f = force[i], v = vel[i];
+    const double f0 = f.x, f1 = f.y, f2 = f.z;
+    double u0 = v.x, u1 = v.y, u2 = v.z;
     if (close_pending) {  // v(t) = u(t - dt/2) + (dt/2) f(t)
       u0 += h * f0;
       u1 += h * f1;
@@ -37,9 +38,7 @@ struct KickDrift {
     u0 += h * f0;  // u(t + dt/2) = v(t) + (dt/2) f(t)
     u1 += h * f1;
     u2 += h * f2;
-    vx[i] = u0;
-    vy[i] = u1;
-    vz[i] = u2;
+    vel[i] = Vec3{u0, u1, u2};
     const Scalar4 r = pos[i];
     double q = r.w;
     if (dq && dq[i] != 0.0) {  // charge exchanged at the last force pass
@@ -58,15 +57,18 @@ struct KickDrift {
 };
 
 struct CloseKick {
-  double *vx, *vy, *vz;
-  const double *fx, *fy, *fz;
+  Vec3* vel;
+  const Vec3* force;
   Scalar4* pos;
   double* dq;
   double h;
   HD void operator()(int i) const {
-    vx[i] += h * fx[i];
-    vy[i] += h * fy[i];
-    vz[i] += h * fz[i];
+    const Vec3 f = force[i];
+    Vec3 v = vel[i];
+    v.x += h * f.x;
+    v.y += h * f.y;
+    v.z += h * f.z;
+    vel[i] = v;
     if (dq && dq[i] != 0.0) {
       pos[i].w += dq[i];
       dq[i] = 0.0;
@@ -81,7 +83,7 @@ double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& 
   const int block = blockSizeFor(n);
   block_max.resize(blockCount(n, block));
   forEachBlocked(n, block,
-                 KickDrift{raw(p.pos), raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(p.ix),
+                 KickDrift{raw(p.pos), raw(p.vel), raw(p.force), raw(p.ix),
                            raw(p.iy), raw(p.iz), dq, half_dt, dt, close_pending, box},
                  MaxReduction{}, raw(block_max));
   return reduceBlocks(block_max, 0.0, MaxReduction{});
@@ -89,7 +91,7 @@ double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& 
 
 void closeKick(ParticleData& p, double half_dt, double* dq) {
   thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(static_cast<int>(p.size())),
-                   CloseKick{raw(p.vx), raw(p.vy), raw(p.vz), raw(p.fx), raw(p.fy), raw(p.fz), raw(p.pos), dq, half_dt});
+                   CloseKick{raw(p.vel), raw(p.force), raw(p.pos), dq, half_dt});
 }
 
 }  // namespace granagg::md

@@ -46,13 +46,13 @@ ParticleData makeParticles(const std::vector<double>& pos, const std::vector<dou
   const std::size_t n = pos.size() / 3;
   ParticleData p;
   p.resize(n);
-  std::vector<double> h(n), P[3];
-  DVec<double>* V[3] = {&p.vx, &p.vy, &p.vz};
-  for (int c = 0; c < 3; ++c) {
-    for (std::size_t i = 0; i < n; ++i) P[c].push_back(pos[3 * i + c]);
-    for (std::size_t i = 0; i < n; ++i) h[i] = vel[3 * i + c];
-    V[c]->assign(h.begin(), h.end());
-  }
+  std::vector<double> P[3], V[3];
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < n; ++i) {
+      P[c].push_back(pos[3 * i + c]);
+      V[c].push_back(vel[3 * i + c]);
+    }
+  packVec3(V[0], V[1], V[2], p.vel);
   p.setPositions(P[0], P[1], P[2], {});
   return p;
 }
@@ -118,9 +118,11 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   REQUIRE(pairs > 10);  // the configuration must actually test contacts
   const std::size_t n = pos.size() / 3;
   std::vector<double> fx(n), fy(n), fz(n);
-  thrust::copy(p.fx.begin(), p.fx.end(), fx.begin());
-  thrust::copy(p.fy.begin(), p.fy.end(), fy.begin());
-  thrust::copy(p.fz.begin(), p.fz.end(), fz.begin());
+  DVec<double> dfx, dfy, dfz;
+  unpackVec3(p.force, dfx, dfy, dfz);
+  thrust::copy(dfx.begin(), dfx.end(), fx.begin());
+  thrust::copy(dfy.begin(), dfy.end(), fy.begin());
+  thrust::copy(dfz.begin(), dfz.end(), fz.begin());
   out = fx;
   out.insert(out.end(), fy.begin(), fy.end());
   out.insert(out.end(), fz.begin(), fz.end());
