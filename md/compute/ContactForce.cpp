@@ -13,6 +13,7 @@
 
 #include "md/coulomb/RealSpace.h"
 #include "md/engine/Launch.h"
+#include "md/integrate/VelocityVerlet.h"
 #include "md/potentials/HertzViscoelastic.h"
 #include "md/potentials/SpringDashpot.h"
 
@@ -158,30 +159,10 @@ struct ContactForceFunctor {
     f_new[i] = Vec3{f0, f1, f2};
     const Scalar4 ri = pos[i];
     res.probe += f0 + f1 + f2 + ri.x + ri.y + ri.z;  // NaN or inf if any term is
-    if (ADVANCE) {  // kickDrift's arithmetic, in the same order (VelocityVerlet.cpp)
-      const double h = 0.5 * advance_dt;
-      const Vec3 u = vel[i];
-      double u0 = u.x, u1 = u.y, u2 = u.z;
-      u0 += h * f0;  // closing kick: v(t)
-      u1 += h * f1;
-      u2 += h * f2;
-      u0 += h * f0;  // opening kick: u(t + dt/2)
-      u1 += h * f1;
-      u2 += h * f2;
-      next_vel[i] = Vec3{u0, u1, u2};
-      double q = ri.w;
-      if (CHARGING && dq[i] != 0.0) {  // the charge exchanged at this pass's new contacts
-        q += dq[i];
-        dq[i] = 0.0;
-      }
-      double a = ri.x + advance_dt * u0, b = ri.y + advance_dt * u1, c = ri.z + advance_dt * u2;
-      const int sa = box.wrap(a), sb = box.wrap(b), sc = box.wrap(c);
-      if (sa) ix[i] += sa;
-      if (sb) iy[i] += sb;
-      if (sc) iz[i] += sc;
-      next_pos[i] = Scalar4{a, b, c, q};
-      const double u2sum = u0 * u0 + u1 * u1 + u2 * u2;
-      res.max_u2 = u2sum > res.max_u2 ? u2sum : res.max_u2;
+    if (ADVANCE) {  // this step's closing kick, the next step's opening kick and drift (kickDrift)
+      const double u2 = kickDriftParticle(box, 0.5 * advance_dt, advance_dt, true, Vec3{f0, f1, f2}, vel[i], ri,
+                                          CHARGING ? dq + i : nullptr, ix[i], iy[i], iz[i], next_vel[i], next_pos[i]);
+      res.max_u2 = u2 > res.max_u2 ? u2 : res.max_u2;
     }
   }
 

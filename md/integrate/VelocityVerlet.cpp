@@ -27,32 +27,8 @@ struct KickDrift {
   common::Box box;
   /// returns |u|^2 of the drift velocity
   HD double operator()(int i) const {
-    const Vec3 f = force[i], v = vel[i];
-    const double f0 = f.x, f1 = f.y, f2 = f.z;
-    double u0 = v.x, u1 = v.y, u2 = v.z;
-    if (close_pending) {  // v(t) = u(t - dt/2) + (dt/2) f(t)
-      u0 += h * f0;
-      u1 += h * f1;
-      u2 += h * f2;
-    }
-    u0 += h * f0;  // u(t + dt/2) = v(t) + (dt/2) f(t)
-    u1 += h * f1;
-    u2 += h * f2;
-    vel[i] = Vec3{u0, u1, u2};
-    const Scalar4 r = pos[i];
-    double q = r.w;
-    if (dq && dq[i] != 0.0) {  // charge exchanged at the last force pass
-      q += dq[i];
-      dq[i] = 0.0;
-    }
-    double a = r.x + dt * u0, b = r.y + dt * u1, c = r.z + dt * u2;
-    // image counts are touched only when a particle crosses a face (rare)
-    const int sa = box.wrap(a), sb = box.wrap(b), sc = box.wrap(c);
-    if (sa) ix[i] += sa;
-    if (sb) iy[i] += sb;
-    if (sc) iz[i] += sc;
-    pos[i] = Scalar4{a, b, c, q};
-    return u0 * u0 + u1 * u1 + u2 * u2;
+    return kickDriftParticle(box, h, dt, close_pending, force[i], vel[i], pos[i], dq ? dq + i : nullptr, ix[i], iy[i],
+                             iz[i], vel[i], pos[i]);
   }
 };
 
