@@ -379,8 +379,13 @@ struct Engine::Impl {
     if (advance) driftTaken(r.max_u2);
   }
 
-  /// Whether the force pass can also advance the step (no fast Coulomb part; compressed list).
-  bool canAdvanceInForcePass() const { return nl.keepsFlat() && !(fast_switch.r2 > 0.0); }
+  /// Whether the force pass can also advance the step (ContactForce.h decides: no fast Coulomb
+  /// part, compressed list; the list exists, built when the initial forces were computed).
+  bool canAdvanceInForcePass() const {
+    ContactStep st;
+    st.fast = fast_switch;
+    return md::canAdvanceInForcePass(nl, st);
+  }
 
   /// Forces of a state given at full step (initial or restored state without forces): the
   /// predicted velocities are v itself and no pair counts as a new collision.

@@ -45,7 +45,6 @@ class NeighborList {
   /// flatOwners), rebuilt with every build. For passes that walk the entries of many particles as
   /// one loop (ContactForce.cpp).
   void keepFlat(bool on) { m_keep_flat = on; }
-  bool keepsFlat() const { return m_keep_flat; }
   /// Entries of row i are flatPartners()[flatOffsets()[i] .. flatOffsets()[i + 1]) (N + 1 offsets).
   const int* flatOffsets() const { return raw(m_flat_offsets); }
   const int* flatPartners() const { return raw(m_flat_partners); }  ///< partner slot of each entry
