@@ -24,7 +24,7 @@ void ContactWork::resize(std::size_t n) {
 }
 
 bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step) {
-  return nl.hasFlat() && !(step.fast.r2 > 0.0);
+  return nl.hasPairs() && !(step.fast.r2 > 0.0);
 }
 
 namespace {
@@ -40,8 +40,9 @@ struct ContactForceFunctor {
   const Vec3* f_old;  // f(t - dt), which kicked u
   const int *rows, *counts;
   int cap;
-  // the same list compressed (NeighborList::keepFlat), for range(); null: operator() only
-  const int *flat_offsets, *flat_partners, *flat_owners;
+  // the same list in compressed pair form (NeighborList::keepPairs), for pairs() and gather();
+  // null: operator() only
+  const int *pair_offsets, *pair_owners, *pair_partners, *entry_offsets, *entry_owners, *entry_pairs;
   common::Box box;
   typename Potential::Params params;
   double h_pred, dt_prev;
@@ -63,6 +64,10 @@ struct ContactForceFunctor {
   Vec3* next_vel;
   int *ix, *iy, *iz;
   double advance_dt;
+  // pair form only: each pair's contact, written by pairs() and read by gather() (ContactWork)
+  unsigned char* pair_hit;  // in contact
+  Vec3* pair_f;             // force on the owner (where in contact)
+  double* pair_dq;          // charge the owner gains (CHARGING, where in contact)
 
   /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old, corrected for
   /// a multiple-time-step impulse given or about to be given (ContactStep::ext_predict_scale)
@@ -166,49 +171,102 @@ struct ContactForceFunctor {
     }
   }
 
-  /// Particles [first, last) at once, as one loop over their entries of the compressed list (no
-  /// fast Coulomb part): the entries are screened in chunks, branch-free, collecting those in
-  /// contact, and only those get the contact work. In a dilute gas a row holds one or two
-  /// entries and few are in contact, so per-row loops spend their time in mispredicted loop exits
-  /// and contact tests; here the loop lengths are those of whole chunks. Each particle's force is
-  /// summed over its contacts in row order, starting from zero, as in operator(): the results are
-  /// identical to the bit.
-  HD StepAccum range(int first, int last) const {
+  /// Compressed pair form, first pass: the pairs owned by particles [first, last) as one loop. The
+  /// pairs are screened in chunks, branch-free, and those in contact get the contact work, once
+  /// per pair: pair_hit, and for the hits the force on the owner (pair_f) and the charge it gains
+  /// (pair_dq). In a dilute gas a row holds one or two entries and few are in contact: per-row
+  /// loops spent their time in mispredicted loop exits and contact tests, whole chunks do not.
+  /// Returns the collisions (each pair once) and the largest overlap.
+  HD StepAccum pairs(int first, int last) const {
+    constexpr int CHUNK = 64;
+    int hit[CHUNK];
+    const int end = pair_offsets[last];
+    int nnew = 0;
+    double mx = 0.0;
+    for (int c0 = pair_offsets[first]; c0 < end; c0 += CHUNK) {
+      const int c1 = c0 + CHUNK < end ? c0 + CHUNK : end;
+      int nhit = 0;
+      for (int p = c0; p < c1; ++p) {
+        double rx, ry, rz;
+        const double r2 = separation(pos[pair_owners[p]], pos[pair_partners[p]], rx, ry, rz);
+        const bool in_contact = r2 < 1.0;
+        pair_hit[p] = in_contact;
+        hit[nhit] = p;
+        nhit += in_contact;
+      }
+      for (int h = 0; h < nhit; ++h) {
+        const int p = hit[h], i = pair_owners[p], j = pair_partners[p];
+        double rx, ry, rz;
+        const double r2 = separation(pos[i], pos[j], rx, ry, rz);
+        double f0 = 0.0, f1 = 0.0, f2 = 0.0, dqi = 0.0;
+        contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);  // j > i: counts each collision once
+        pair_f[p] = Vec3{f0, f1, f2};
+        if (CHARGING) pair_dq[p] = dqi;
+      }
+    }
+    StepAccum res;
+    res.collisions = nnew;
+    res.max_overlap = mx;
+    return res;
+  }
+
+  /// Compressed pair form, second pass: each particle of [first, last) sums the forces of its pairs
+  /// in contact over its row, in row (id) order from zero -- the owner's force for pairs it owns,
+  /// its negative for the others (Newton's third law; the contact arithmetic is antisymmetric in
+  /// i and j to the last bit, so each particle gets exactly what a contact computed from its side
+  /// gives, and the per-row pass operator() the same sums) -- then finishes (finish()). Entries
+  /// are screened in chunks, as in pairs(). Gather only: each particle writes its own force.
+  HD StepAccum gather(int first, int last) const {
     StepAccum res;
     for (int i = first; i < last; ++i) f_new[i] = Vec3{0.0, 0.0, 0.0};
     constexpr int CHUNK = 64;
     int hit[CHUNK];
-    const int end = flat_offsets[last];
-    int nnew = 0;
-    double mx = 0.0;
-    for (int c0 = flat_offsets[first]; c0 < end; c0 += CHUNK) {
+    const int end = entry_offsets[last];
+    for (int c0 = entry_offsets[first]; c0 < end; c0 += CHUNK) {
       const int c1 = c0 + CHUNK < end ? c0 + CHUNK : end;
       int nhit = 0;
       for (int e = c0; e < c1; ++e) {
-        double rx, ry, rz;
-        const double r2 = separation(pos[flat_owners[e]], pos[flat_partners[e]], rx, ry, rz);
+        const int q = entry_pairs[e];
         hit[nhit] = e;
-        nhit += r2 < 1.0;
+        nhit += pair_hit[q < 0 ? ~q : q];
       }
       for (int h = 0; h < nhit; ++h) {
-        const int e = hit[h], i = flat_owners[e], j = flat_partners[e];
-        double rx, ry, rz;
-        const double r2 = separation(pos[i], pos[j], rx, ry, rz);
-        const Vec3 fi = f_new[i];
-        double f0 = fi.x, f1 = fi.y, f2 = fi.z, dqi = 0.0;
-        contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
-        f_new[i] = Vec3{f0, f1, f2};
-        if (CHARGING) dq[i] += dqi;  // dq is zero before the pass (applied and cleared by the kick)
+        const int e = hit[h], i = entry_owners[e], q = entry_pairs[e];
+        const Vec3 fp = pair_f[q < 0 ? ~q : q];
+        Vec3 fi = f_new[i];
+        if (q >= 0) {
+          fi.x += fp.x;
+          fi.y += fp.y;
+          fi.z += fp.z;
+        } else {
+          fi.x += -fp.x;
+          fi.y += -fp.y;
+          fi.z += -fp.z;
+        }
+        f_new[i] = fi;
+        if (CHARGING) dq[i] += q >= 0 ? pair_dq[q] : -pair_dq[~q];  // dq is zero before the pass (kick clears it)
       }
     }
-    res.collisions = nnew;
-    res.max_overlap = mx;
     for (int i = first; i < last; ++i) {
       const Vec3 fi = f_new[i];
       finish(i, fi.x, fi.y, fi.z, res);
     }
     return res;
   }
+};
+
+/// The two passes of the compressed pair form as block bodies (md/engine/Launch.h).
+template <class F>
+struct PairsPass {
+  using value_type = StepAccum;
+  F f;
+  HD StepAccum range(int first, int last) const { return f.pairs(first, last); }
+};
+template <class F>
+struct GatherPass {
+  using value_type = StepAccum;
+  F f;
+  HD StepAccum range(int first, int last) const { return f.gather(first, last); }
 };
 
 /// Block reduction of the force pass: sums and maxima only, so the pass has no per-particle branch
@@ -279,23 +337,34 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
   if (w.f.size() != p.size()) w.resize(p.size());
   if (ADVANCE) w.vel.resize(p.size());
   if (ADVANCE) w.pos.resize(p.size());
-  const bool flat = !FAST_COULOMB && nl.hasFlat();
+  const bool paired = !FAST_COULOMB && nl.hasPairs();
+  if (paired) {
+    w.pair_hit.resize(nl.pairCount());
+    w.pair_f.resize(nl.pairCount());
+    if (CHARGING) w.pair_dq.resize(nl.pairCount());
+  }
   ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING, ADVANCE> f{
-      raw(p.pos), raw(p.vel), raw(p.force), nl.rows(), nl.counts(),
-      nl.capacity(), flat ? nl.flatOffsets() : nullptr, flat ? nl.flatPartners() : nullptr,
-      flat ? nl.flatOwners() : nullptr, box, params, half_dt, dt, raw(w.f), raw(p.id),
+      raw(p.pos), raw(p.vel), raw(p.force), nl.rows(), nl.counts(), nl.capacity(),
+      paired ? nl.pairOffsets() : nullptr, paired ? nl.pairOwners() : nullptr, paired ? nl.pairPartners() : nullptr,
+      paired ? nl.entryOffsets() : nullptr, paired ? nl.entryOwners() : nullptr, paired ? nl.entryPairs() : nullptr,
+      box, params, half_dt, dt, raw(w.f), raw(p.id),
       st.charging, st.step, st.dq, st.ext_fx, st.ext_fy, st.ext_fz, st.ext_force_scale, st.ext_predict_scale,
       st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table, raw(w.pos), raw(w.vel), raw(p.ix),
-      raw(p.iy), raw(p.iz), st.advance_dt};
+      raw(p.iy), raw(p.iz), st.advance_dt, raw(w.pair_hit), raw(w.pair_f), raw(w.pair_dq)};
   // forces and, per block, collisions, probe sum and largest overlap; then one reduction over blocks
   const int block = blockSizeFor(N);
-  w.block_flags.resize(blockCount(N, block));
-  if (flat)
-    forEachBlockRange(N, block, f, raw(w.block_flags));
-  else
+  const int nblocks = blockCount(N, block);
+  StepAccum a;
+  if (paired) {
+    w.block_flags.resize(2 * nblocks);
+    forEachBlockRange(N, block, PairsPass<decltype(f)>{f}, raw(w.block_flags));
+    forEachBlockRange(N, block, GatherPass<decltype(f)>{f}, raw(w.block_flags) + nblocks);
+  } else {
+    w.block_flags.resize(nblocks);
     forEachBlocked(N, block, f, CombineStepAccum{}, raw(w.block_flags));
+  }
   p.force.swap(w.f);  // p.force = f(t); the old forces stay in w until the next pass overwrites them
-  const StepAccum a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
+  a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
   ContactStepResult r;
   r.collisions = a.collisions;
   // v - v == 0 exactly for finite v and is NaN for NaN or inf (no math library needed)

@@ -21,14 +21,17 @@
 ///
 /// Two loop shapes, the same arithmetic (identical results to the bit):
 /// - per particle over its row (with the fast Coulomb part, which every listed pair has, and on
-///   lists without a compressed copy);
-/// - per block of particles over the compressed list (NeighborList::keepFlat; contacts only): all
-///   entries of the block are screened in one branch-free loop and the contact work is done for
-///   the hits only. In a dilute gas a row holds one or two entries and about one in eight is in
-///   contact, so the per-row loops spent their time in mispredicted loop exits and contact tests
-///   (docs/benchmarks.md). On CUDA a block is one particle, i.e. the row loop again.
-/// The block form can also finish the step and open the next (ContactStep::advance_dt): one pass
-/// over the particles per step.
+///   lists without the compressed pair form);
+/// - over the compressed pair form (NeighborList::keepPairs; contacts only), in two passes over
+///   blocks of particles: the first computes each pair's contact once (Newton's third law), the
+///   second lets every particle gather its pairs' forces over its row. Each pass screens all
+///   entries of its block in one branch-free loop and does the work for the hits only: in a
+///   dilute gas a row holds one or two entries and about one in eight is in contact, so per-row
+///   loops spent their time in mispredicted loop exits and contact tests (docs/benchmarks.md).
+///   Both passes write only the block's own pairs and particles: no atomics, and sums in row order.
+///   On CUDA a block is one particle.
+/// The pair form can also finish the step and open the next (ContactStep::advance_dt): the
+/// gathering pass advances each particle as soon as its force is known.
 #include <cstdint>
 
 #include "common/Box.h"
@@ -60,6 +63,9 @@ struct ContactWork {
   DVec<Scalar4> pos;             ///< advance_dt: the next positions (swapped with ParticleData's)
   DVec<Vec3> vel;                ///< advance_dt: the next drift velocities (swapped likewise)
   DVec<StepAccum> block_flags;   ///< per-block partial results (md/engine/Launch.h)
+  DVec<unsigned char> pair_hit;  ///< compressed pair form: each pair's contact (ContactForce.cpp)
+  DVec<Vec3> pair_f;
+  DVec<double> pair_dq;
   void resize(std::size_t n);
 };
 

@@ -141,7 +141,7 @@ struct Engine::Impl {
   SpringDashpot::Params sd_params{};
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
-    nl.keepFlat(true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
+    nl.keepPairs(true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
     exchange = c.charging.mode == "exchange";
     charging.seed = c.system.seed;
     charging.Q = c.charging.Q;
@@ -233,7 +233,7 @@ struct Engine::Impl {
     slow_table.clear();
     fast_table.clear();
     nl = NeighborList(1.0, skin);
-    nl.keepFlat(true);
+    nl.keepPairs(true);
     if (cc.method == "pppm") {
       // "auto": a longer skin than the contact list's when the list is used every k-th step only
       // (fewer builds of a long list; measured optimum at N = 1e4, K = 5: docs/benchmarks-coulomb.md)
@@ -280,7 +280,7 @@ struct Engine::Impl {
         fast_table.assign(f.begin(), f.end());
       }
       nl = NeighborList(std::max(1.0, fast_switch.r2), skin);
-      nl.keepFlat(fast_switch.r2 == 0.0);  // with a fast Coulomb part every entry has work: per-row loops
+      nl.keepPairs(fast_switch.r2 == 0.0);  // with a fast Coulomb part every entry has work: per-row loops
     } else {
       const EwaldParams prm = chooseEwaldParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut);
       ewald = std::make_unique<EwaldReference>(prm, L, cc.K);

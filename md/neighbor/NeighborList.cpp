@@ -12,6 +12,7 @@
 #include <thrust/scan.h>
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
+#include <thrust/transform_reduce.h>
 
 namespace granagg::md {
 
@@ -206,18 +207,46 @@ struct FilterRows {
   }
 };
 
-/// Copies row i to its place in the compressed list.
-struct FlattenRow {
-  const int *rows, *count, *offsets;
-  int *partners, *owners;
+/// Pairs owned by row i: its entries with a higher partner slot.
+struct CountOwnedPairs {
+  const int *rows, *count;
+  int* owned;
   int cap;
   HD void operator()(int i) const {
     const int* row = rows + static_cast<long>(i) * cap;
-    const int o = offsets[i];
-    for (int k = 0; k < count[i]; ++k) {
-      partners[o + k] = row[k];
-      owners[o + k] = i;
+    int n = 0;
+    for (int k = 0; k < count[i]; ++k) n += row[k] > i;
+    owned[i] = n;
+  }
+};
+
+/// Row i's share of the compressed pair form (NeighborList::keepPairs): its owned pairs, and its
+/// entries with the pair of each. The pair of an entry (i, j < i) is found in row j, the row that
+/// owns it, by counting j's owned pairs before i. Returns the entries whose partner row does not
+/// list i (zero for a valid list, which is symmetric: both rows test the same squared distance).
+struct CompressRow {
+  const int *rows, *count, *pair_offsets, *entry_offsets;
+  int *pair_owners, *pair_partners, *entry_owners, *entry_pairs;
+  int cap;
+  HD int operator()(int i) const {
+    const int* row = rows + static_cast<long>(i) * cap;
+    int p = pair_offsets[i], e = entry_offsets[i], missing = 0;
+    for (int k = 0; k < count[i]; ++k, ++e) {
+      const int j = row[k];
+      entry_owners[e] = i;
+      if (j > i) {
+        pair_owners[p] = i;
+        pair_partners[p] = j;
+        entry_pairs[e] = p++;
+        continue;
+      }
+      const int* rj = rows + static_cast<long>(j) * cap;
+      int q = pair_offsets[j], m = 0;
+      while (m < count[j] && rj[m] != i) q += rj[m++] > j;
+      missing += m == count[j];
+      entry_pairs[e] = ~q;
     }
+    return missing;
   }
 };
 
@@ -323,22 +352,36 @@ void NeighborList::buildImpl(const ParticleData& p, const common::Box& box, bool
   ++m_builds;
 }
 
-void NeighborList::flatten(int N) {
-  m_flat_offsets.resize(N + 1);
-  thrust::exclusive_scan(m_count.begin(), m_count.end(), m_flat_offsets.begin());
-  const int total = N ? static_cast<int>(m_flat_offsets[N - 1]) + static_cast<int>(m_count[N - 1]) : 0;
-  m_flat_offsets[N] = total;
-  m_flat_partners.resize(total);
-  m_flat_owners.resize(total);
-  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
-                   FlattenRow{raw(m_list), raw(m_count), raw(m_flat_offsets), raw(m_flat_partners), raw(m_flat_owners),
-                              m_capacity});
+void NeighborList::compress(int N) {
+  const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
+  m_entry_offsets.resize(N + 1);
+  m_pair_offsets.resize(N + 1);
+  thrust::exclusive_scan(m_count.begin(), m_count.end(), m_entry_offsets.begin());
+  const int entries = N ? static_cast<int>(m_entry_offsets[N - 1]) + static_cast<int>(m_count[N - 1]) : 0;
+  m_entry_offsets[N] = entries;
+  thrust::for_each(first, last, CountOwnedPairs{raw(m_list), raw(m_count), raw(m_pair_offsets), m_capacity});
+  const int last_owned = N ? static_cast<int>(m_pair_offsets[N - 1]) : 0;
+  thrust::exclusive_scan(m_pair_offsets.begin(), m_pair_offsets.begin() + N, m_pair_offsets.begin());
+  const int pairs = N ? static_cast<int>(m_pair_offsets[N - 1]) + last_owned : 0;
+  m_pair_offsets[N] = pairs;
+  m_pair_owners.resize(pairs);
+  m_pair_partners.resize(pairs);
+  m_entry_owners.resize(entries);
+  m_entry_pairs.resize(entries);
+  const int missing = thrust::transform_reduce(
+      first, last,
+      CompressRow{raw(m_list), raw(m_count), raw(m_pair_offsets), raw(m_entry_offsets), raw(m_pair_owners),
+                  raw(m_pair_partners), raw(m_entry_owners), raw(m_entry_pairs), m_capacity},
+      0, thrust::plus<int>());
+  if (missing != 0 || 2 * pairs != entries)
+    throw std::logic_error("NeighborList: the rows are not symmetric (" + std::to_string(missing) +
+                           " entries without their mirror entry)");
 }
 
 bool NeighborList::fitCapacity(int N) {
   const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
   if (most <= m_capacity) {
-    if (m_keep_flat) flatten(N);
+    if (m_keep_pairs) compress(N);
     // rows much wider than needed cost a cache line per particle per step for nothing: the next
     // build uses a tighter capacity (a later overflow is caught by the caller). Not this one: its
     // rows are laid out with the current stride.

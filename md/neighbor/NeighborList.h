@@ -41,15 +41,24 @@ class NeighborList {
   /// search when super is the Coulomb list and this the short contact list (Engine).
   void buildFrom(const NeighborList& super, const ParticleData& p, const common::Box& box);
 
-  /// Also keep the list in compressed form (rows back to back: flatOffsets, flatPartners,
-  /// flatOwners), rebuilt with every build. For passes that walk the entries of many particles as
-  /// one loop (ContactForce.cpp).
-  void keepFlat(bool on) { m_keep_flat = on; }
-  /// Entries of row i are flatPartners()[flatOffsets()[i] .. flatOffsets()[i + 1]) (N + 1 offsets).
-  const int* flatOffsets() const { return raw(m_flat_offsets); }
-  const int* flatPartners() const { return raw(m_flat_partners); }  ///< partner slot of each entry
-  const int* flatOwners() const { return raw(m_flat_owners); }      ///< row (particle slot) of each entry
-  bool hasFlat() const { return m_keep_flat && m_flat_offsets.size() == m_built_n + 1; }
+  /// Also keep the list in compressed pair form, rebuilt with every build, for passes that walk the
+  /// entries of many particles as one loop and compute each pair's contact once (ContactForce.cpp):
+  /// - pairs: every pair once, owned by its lower slot. Pair p joins pairOwners()[p] and
+  ///   pairPartners()[p] (> owner); the pairs of owner i are [pairOffsets()[i], pairOffsets()[i + 1]),
+  ///   in row (id) order.
+  /// - entries: the full rows back to back, entry e of row entryOwners()[e] (the entries of row i
+  ///   are [entryOffsets()[i], entryOffsets()[i + 1]), in row order), each with its pair:
+  ///   entryPairs()[e] = p where the row owns pair p, ~p (negative) where the row is p's partner.
+  /// Every offset array holds N + 1 values.
+  void keepPairs(bool on) { m_keep_pairs = on; }
+  bool hasPairs() const { return m_keep_pairs && m_pair_offsets.size() == m_built_n + 1; }
+  const int* pairOffsets() const { return raw(m_pair_offsets); }
+  const int* pairOwners() const { return raw(m_pair_owners); }
+  const int* pairPartners() const { return raw(m_pair_partners); }
+  std::size_t pairCount() const { return m_pair_owners.size(); }
+  const int* entryOffsets() const { return raw(m_entry_offsets); }
+  const int* entryOwners() const { return raw(m_entry_owners); }
+  const int* entryPairs() const { return raw(m_entry_pairs); }
 
   const int* rows() const { return raw(m_list); }     ///< row i at rows()[i * capacity()]
   const int* counts() const { return raw(m_count); }  ///< entries in row i
@@ -62,15 +71,16 @@ class NeighborList {
   void buildImpl(const ParticleData& p, const common::Box& box, bool sorted);
   /// Finishes a build: checks the rows against the capacity (true: they fit) and plans the next one.
   bool fitCapacity(int N);
-  /// The compressed copy of the rows (keepFlat).
-  void flatten(int N);
+  /// The compressed pair form of the rows (keepPairs).
+  void compress(int N);
   double m_cutoff, m_skin;
   int m_capacity = 16;       // row stride of the current list
   int m_next_capacity = 16;  // for the next build: grows on overflow, shrinks when rows are mostly empty
   std::int64_t m_builds = 0;
   DVec<int> m_list, m_count;
-  bool m_keep_flat = false;
-  DVec<int> m_flat_offsets, m_flat_partners, m_flat_owners;
+  bool m_keep_pairs = false;
+  DVec<int> m_pair_offsets, m_pair_owners, m_pair_partners;
+  DVec<int> m_entry_offsets, m_entry_owners, m_entry_pairs;
   std::size_t m_built_n = 0;  // N at the last build
   DVec<int> m_cell, m_order, m_cell_start;
 };

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -101,9 +102,9 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   ParticleData p = makeParticles(pos, vel);
   common::Box box{L};
   NeighborList nl(1.0, 0.3);
-  nl.keepFlat(flat);
+  nl.keepPairs(flat);
   nl.build(p, box);
-  REQUIRE(nl.hasFlat() == flat);
+  REQUIRE(nl.hasPairs() == flat);
   ContactWork w;
   // dt = 0: a state at full step, so the predicted velocities equal v, as in the reference. Overlap
   // bound 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite force.
@@ -181,6 +182,62 @@ TEST_CASE("neighbour-list forces equal brute force in dense clusters across the 
   compareWithBruteForce(pos, vel, L);
 }
 
+TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and charging included", "[md][neighbor]") {
+  // The compressed pair form computes each contact once and hands the owner's force, negated, to
+  // the partner; the per-row pass computes every contact from both sides. Both must give the same
+  // forces, collision count and exchanged charges to the last bit (the contact arithmetic is
+  // antisymmetric in i and j). A large step (dt = 0.15) makes many overlapping pairs count as
+  // collisions that started this step, so the charge exchange runs for many pairs.
+  std::mt19937_64 rng(17);
+  const double L = 14.5;
+  std::uniform_real_distribution<double> u(0.0, L), v(-2.0, 2.0);
+  std::vector<double> pos, vel;
+  for (int i = 0; i < 600; ++i)
+    for (int c = 0; c < 3; ++c) {
+      pos.push_back(u(rng));
+      vel.push_back(v(rng));
+    }
+  const HertzViscoelastic::Params prm{278.6, 27.7, true};
+  const common::Box box{L};
+  std::vector<double> force[2], charge[2];
+  std::int64_t collisions[2];
+  for (bool paired : {false, true}) {
+    ParticleData p = makeParticles(pos, vel);
+    NeighborList nl(1.0, 0.3);
+    nl.keepPairs(paired);
+    nl.build(p, box);
+    REQUIRE(nl.hasPairs() == paired);
+    DVec<double> dq(p.size(), 0.0);
+    ContactStep st;
+    st.dt = 0.15;
+    st.step = 123;
+    st.charging.seed = 99;
+    st.dq = raw(dq);
+    ContactWork w;
+    const ContactStepResult r = computeContactForces<HertzViscoelastic>(p, nl, box, prm, st, w);
+    REQUIRE(r.worst == 0);
+    collisions[paired] = r.collisions;
+    DVec<double> fx, fy, fz;
+    unpackVec3(p.force, fx, fy, fz);
+    for (auto* c : {&fx, &fy, &fz}) force[paired].insert(force[paired].end(), c->begin(), c->end());
+    charge[paired].assign(dq.begin(), dq.end());
+  }
+  INFO("collisions this step: " << collisions[0]);
+  REQUIRE(collisions[0] > 20);
+  CHECK(collisions[1] == collisions[0]);
+  CHECK(force[1] == force[0]);
+  CHECK(charge[1] == charge[0]);
+  int charged = 0;
+  double total = 0.0, magnitude = 0.0;
+  for (double q : charge[1]) {
+    charged += q != 0.0;
+    total += q;
+    magnitude += std::fabs(q);
+  }
+  CHECK(charged > 20);
+  CHECK(std::fabs(total) <= 1e-14 * magnitude);  // every transfer leaves one partner and reaches the other
+}
+
 TEST_CASE("a box too small for the neighbour range is refused", "[md][neighbor]") {
   ParticleData p = makeParticles({0.1, 0.1, 0.1, 1.5, 0.1, 0.1}, {0, 0, 0, 0, 0, 0});
   NeighborList nl(1.0, 0.3);
@@ -194,7 +251,7 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
   std::mt19937_64 rng(3);
   const double L = 10.0;
   NeighborList nl(1.0, 0.3);
-  nl.keepFlat(true);
+  nl.keepPairs(true);
   const common::Box box{L};
   auto check = [&](const std::vector<double>& pos) {
     ParticleData p = makeParticles(pos, std::vector<double>(pos.size(), 0.0));
@@ -218,20 +275,39 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
       INFO("particle " << i << ", capacity " << nl.capacity());
       REQUIRE(got == expected);
     }
-    // the compressed copy (keepFlat) holds the same rows back to back
-    REQUIRE(nl.hasFlat());
-    std::vector<int> off(n + 1);
-    thrust::copy(thrust::device_pointer_cast(nl.flatOffsets()), thrust::device_pointer_cast(nl.flatOffsets()) + n + 1, off.begin());
-    std::vector<int> partners(off[n]), owners(off[n]);
-    thrust::copy(thrust::device_pointer_cast(nl.flatPartners()), thrust::device_pointer_cast(nl.flatPartners()) + off[n], partners.begin());
-    thrust::copy(thrust::device_pointer_cast(nl.flatOwners()), thrust::device_pointer_cast(nl.flatOwners()) + off[n], owners.begin());
+    // the compressed pair form (keepPairs): the rows back to back as entries, each pair once
+    // (owned by its lower slot, in the owner's row order), and every entry mapped to its pair
+    REQUIRE(nl.hasPairs());
+    auto fetch = [](const int* d, std::size_t count) {
+      std::vector<int> h(count);
+      thrust::copy(thrust::device_pointer_cast(d), thrust::device_pointer_cast(d) + count, h.begin());
+      return h;
+    };
+    const std::vector<int> eoff = fetch(nl.entryOffsets(), n + 1), poff = fetch(nl.pairOffsets(), n + 1);
+    REQUIRE(eoff[n] == 2 * poff[n]);
+    REQUIRE(nl.pairCount() == static_cast<std::size_t>(poff[n]));
+    const std::vector<int> eowners = fetch(nl.entryOwners(), eoff[n]), epairs = fetch(nl.entryPairs(), eoff[n]);
+    const std::vector<int> powners = fetch(nl.pairOwners(), poff[n]), ppartners = fetch(nl.pairPartners(), poff[n]);
+    std::vector<int> seen(poff[n], 0);
     for (std::size_t i = 0; i < n; ++i) {
-      REQUIRE(off[i + 1] - off[i] == counts[i]);
+      REQUIRE(eoff[i + 1] - eoff[i] == counts[i]);
+      std::vector<int> owned;
       for (int k = 0; k < counts[i]; ++k) {
-        CHECK(partners[off[i] + k] == rows[i * nl.capacity() + k]);
-        CHECK(owners[off[i] + k] == static_cast<int>(i));
+        const int e = eoff[i] + k, j = rows[i * nl.capacity() + k];
+        CHECK(eowners[e] == static_cast<int>(i));
+        const int q = epairs[e], pr = q < 0 ? ~q : q;
+        REQUIRE(pr < poff[n]);
+        ++seen[pr];
+        CHECK((q >= 0) == (j > static_cast<int>(i)));  // owned by the lower slot
+        CHECK(powners[pr] == std::min(static_cast<int>(i), j));
+        CHECK(ppartners[pr] == std::max(static_cast<int>(i), j));
+        if (j > static_cast<int>(i)) owned.push_back(pr);
       }
+      std::vector<int> range(poff[i + 1] - poff[i]);
+      std::iota(range.begin(), range.end(), poff[i]);
+      CHECK(owned == range);  // the owner's pairs, in its row order
     }
+    for (int c : seen) CHECK(c == 2);  // each pair reached from both rows
   };
   std::uniform_real_distribution<double> u(0.0, L);
   std::vector<double> sparse;
