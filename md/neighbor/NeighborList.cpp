@@ -141,6 +141,23 @@ struct BuildCells {
   }
   static constexpr int GATHER = 4;
 
+  /// The candidates cand[0, m); WRAP: with minimum images (differences across the faces).
+  template <bool WRAP>
+  HD_INLINE void screen(const int* cand, int m, int i, double xi, double yi, double zi, int* row, int& n,
+                        int& spill) const {
+    for (int t = 0; t < m; ++t) {
+      const int j = cand[t];
+      const Scalar4 rj = pos[j];
+      double rx = xi - rj.x, ry = yi - rj.y, rz = zi - rj.z;
+      if (WRAP) {
+        rx = box.minimumImageWrapped(rx);
+        ry = box.minimumImageWrapped(ry);
+        rz = box.minimumImageWrapped(rz);
+      }
+      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
+    }
+  }
+
   HD void operator()(int i) const {
     const Scalar4 ri = pos[i];
     const double xi = ri.x, yi = ri.y, zi = ri.z;
@@ -170,13 +187,12 @@ struct BuildCells {
           range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
         }
       }
-    for (int t = 0; t < m; ++t) {  // SORTED: the gathered candidates, in one loop
-      const int j = cand[t];
-      const Scalar4 rj = pos[j];
-      const double rx = box.minimumImageWrapped(xi - rj.x), ry = box.minimumImageWrapped(yi - rj.y),
-                   rz = box.minimumImageWrapped(zi - rj.z);
-      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
-    }
+    // SORTED: the gathered candidates, in one loop. Away from the faces (no neighbour cell wraps,
+    // about two particles in three) every difference is its own minimum image: no image tests.
+    if (cx > 0 && cx < nc - 1 && cy > 0 && cy < nc - 1 && cz > 0 && cz < nc - 1)
+      screen<false>(cand, m, i, xi, yi, zi, row, n, spill);
+    else
+      screen<true>(cand, m, i, xi, yi, zi, row, n, spill);
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
   }
