@@ -20,7 +20,10 @@
 # LAMMPS the input does `run n1` then `run n2-n1` and t(n2) - t(n1) is the second run's "Loop time"
 # (same steps n1..n2 of the same cooling gas, so both codes do the same physical work). Each time
 # is the smallest of REPEATS runs (the machine may be shared: load only slows a run down); the
-# range of the per-repeat rates is printed as a measure of the noise.
+# range of the per-repeat rates is printed as a measure of the noise. The ratio is given twice:
+# from the fastest runs of each code, and as the median (and range) of the ratios within each
+# repeat, whose runs lie minutes apart at most -- on a VM whose speed drifts over minutes the
+# ratio of two fastest runs can pair one code's fast window with the other's slow one.
 #
 # LAMMPS mapping (src/GRANULAR/pair_gran_hertz_history.cpp): the normal force on each partner is
 #     F = sqrt(delta R_i R_j/(R_i+R_j)) [kn delta + m_eff gamma_n xi'],
@@ -205,16 +208,29 @@ for N in $SIZES; do
       # the ratio is against the fastest LAMMPS set-up on as many cores
       LR[$np]=$(awk -v a="${LR[$np]:-0}" -v b="$lr" 'BEGIN {print (b > a) ? b : a}')
       # shellcheck disable=SC2086
-      ROWS+=("| $N | LAMMPS gran/hertz/history + fix $fix, $([ "$np" -eq 1 ] && echo serial || echo "MPI") | $np | $(printf '%.3g' "$lr") | | $(range ${R[l$np$fix]}) |")
+      ROWS+=("| $N | LAMMPS gran/hertz/history + fix $fix, $([ "$np" -eq 1 ] && echo serial || echo "MPI") | $np | $(printf '%.3g' "$lr") | | | $(range ${R[l$np$fix]}) |")
     done
   done
   for th in $THREADS; do
     # shellcheck disable=SC2086
     rate=$(calc "$N * ($n2 - $n1) / ($(mins ${T[b$th]}) - $(mins ${T[a$th]}))")
-    ratio=""
-    [ -z "${LR[$th]:-}" ] || ratio=$(calc "$rate / ${LR[$th]}" | xargs printf '%.2f')
+    ratio="" paired=""
+    if [ -n "${LR[$th]:-}" ]; then
+      ratio=$(calc "$rate / ${LR[$th]}" | xargs printf '%.2f')
+      # the same ratio repeat by repeat (granagg against the faster LAMMPS integrator of the same
+      # repeat, run minutes apart at most): the VM's speed drifts over minutes, and a ratio of two
+      # fastest runs can pair a fast window of one code with a slow one of the other
+      lists=()
+      for fix in $LMP_FIXES; do lists+=("${R[l$th$fix]}"); done
+      paired=$(printf '%s\n' "${lists[@]}" | awk -v g="${R[g$th]}" '
+        {n = split($0, a, " "); for (k = 1; k <= n; ++k) if (a[k] > best[k]) best[k] = a[k]}
+        END {m = split(g, b, " "); for (k = 1; k <= m; ++k) r[k] = b[k] / best[k]
+             for (i = 1; i <= m; ++i) for (j = i + 1; j <= m; ++j) if (r[j] < r[i]) {t = r[i]; r[i] = r[j]; r[j] = t}
+             med = (m % 2) ? r[(m + 1) / 2] : 0.5 * (r[m / 2] + r[m / 2 + 1])
+             printf "%.2f (%.2f-%.2f)", med, r[1], r[m]}')
+    fi
     # shellcheck disable=SC2086
-    ROWS+=("| $N | granagg, OpenMP | $th | $(printf '%.3g' "$rate") | $ratio | $(range ${R[g$th]}) |")
+    ROWS+=("| $N | granagg, OpenMP | $th | $(printf '%.3g' "$rate") | $ratio | $paired | $(range ${R[g$th]}) |")
   done
   # what the window looks like (temperature at n1 and n2, rebuilds, time split), from the log of
   # the last LAMMPS run on the fewest ranks
@@ -230,10 +246,10 @@ for N in $SIZES; do
   NOTES+=("  temperature at step $n2 by LAMMPS integrator (the same trajectory): $(for fix in $LMP_FIXES; do printf 'fix %s %s; ' "$fix" "$(awk '/^Loop time/ {t = prev} {prev = $2} END {print t}' "$TMP/lmp_${np1}_${fix//\//_}.log")"; done)")
 done
 
-echo "Throughput: phi = $PHI, dt = $DT, skin $SKIN, clamped Hertz (E = $E, D = $D), T(0) = 1; rates over steps n1..n2 from the fastest of $REPEATS runs of each kind"
+echo "Throughput: phi = $PHI, dt = $DT, skin $SKIN, clamped Hertz (E = $E, D = $D), T(0) = 1; rates over steps n1..n2 from the fastest of $REPEATS runs of each kind; ratios against the faster LAMMPS integrator on as many cores, from the fastest runs and, per repeat, from the runs of the same repeat (median, min-max)"
 echo
-echo "| N | code | cores (threads or ranks) | particle-steps/s | granagg / LAMMPS on as many cores | range over repeats |"
-echo "|---|---|---|---|---|---|"
+echo "| N | code | cores (threads or ranks) | particle-steps/s | granagg / LAMMPS, fastest runs | granagg / LAMMPS per repeat: median (range) | range over repeats |"
+echo "|---|---|---|---|---|---|---|"
 printf '%s\n' "${ROWS[@]}"
 echo
 printf '%s\n' "${NOTES[@]}"
