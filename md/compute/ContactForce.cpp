@@ -238,7 +238,7 @@ struct ContactForceFunctor {
           fi.x += fp.x;
           fi.y += fp.y;
           fi.z += fp.z;
-        } else {
+        } else {  // the partner gets minus the owner's share (exact)
           fi.x += -fp.x;
           fi.y += -fp.y;
           fi.z += -fp.z;
@@ -354,7 +354,6 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
   // forces and, per block, collisions, probe sum and largest overlap; then one reduction over blocks
   const int block = blockSizeFor(N);
   const int nblocks = blockCount(N, block);
-  StepAccum a;
   if (paired) {
     w.block_flags.resize(2 * nblocks);
     forEachBlockRange(N, block, PairsPass<decltype(f)>{f}, raw(w.block_flags));
@@ -364,7 +363,7 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
     forEachBlocked(N, block, f, CombineStepAccum{}, raw(w.block_flags));
   }
   p.force.swap(w.f);  // p.force = f(t); the old forces stay in w until the next pass overwrites them
-  a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
+  const StepAccum a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
   ContactStepResult r;
   r.collisions = a.collisions;
   // v - v == 0 exactly for finite v and is NaN for NaN or inf (no math library needed)

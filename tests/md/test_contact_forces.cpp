@@ -146,20 +146,27 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   }
   for (double t : tot) CHECK(std::fabs(t) <= 1e-12 * scale * n);
 }
+/// n particles placed independently at random in [0, L)^3 (overlaps included) with velocity
+/// components uniform in [-2, 2], from seed.
+void randomGas(unsigned seed, int n, double L, std::vector<double>& pos, std::vector<double>& vel) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, L), v(-2.0, 2.0);
+  pos.clear();
+  vel.clear();
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      pos.push_back(u(rng));
+      vel.push_back(v(rng));
+    }
+}
 }  // namespace
 
 TEST_CASE("neighbour-list forces equal brute force on a random configuration", "[md][neighbor]") {
   // 600 particles placed independently at random (phi ~ 0.1): many overlapping pairs, some across
   // every periodic face; random velocities exercise the dissipative term.
-  std::mt19937_64 rng(11);
   const double L = 14.5;
-  std::uniform_real_distribution<double> u(0.0, L), v(-2.0, 2.0);
   std::vector<double> pos, vel;
-  for (int i = 0; i < 600; ++i)
-    for (int c = 0; c < 3; ++c) {
-      pos.push_back(u(rng));
-      vel.push_back(v(rng));
-    }
+  randomGas(11, 600, L, pos, vel);
   compareWithBruteForce(pos, vel, L);
 }
 
@@ -188,15 +195,9 @@ TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and
   // forces, collision count and exchanged charges to the last bit (the contact arithmetic is
   // antisymmetric in i and j). A large step (dt = 0.15) makes many overlapping pairs count as
   // collisions that started this step, so the charge exchange runs for many pairs.
-  std::mt19937_64 rng(17);
   const double L = 14.5;
-  std::uniform_real_distribution<double> u(0.0, L), v(-2.0, 2.0);
   std::vector<double> pos, vel;
-  for (int i = 0; i < 600; ++i)
-    for (int c = 0; c < 3; ++c) {
-      pos.push_back(u(rng));
-      vel.push_back(v(rng));
-    }
+  randomGas(17, 600, L, pos, vel);
   const HertzViscoelastic::Params prm{278.6, 27.7, true};
   const common::Box box{L};
   std::vector<double> force[2], charge[2];
