@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <thrust/for_each.h>
@@ -42,7 +43,7 @@ struct ContactForceFunctor {
   int cap;
   // the same list in compressed pair form (NeighborList::keepPairs), for pairs() and gather();
   // null: operator() only
-  const int *pair_offsets, *pair_owners, *pair_partners, *entry_offsets, *entry_owners, *entry_pairs;
+  const int *pair_offsets, *pair_owners, *pair_partners, *entry_offsets, *entry_owners, *entry_pairs, *pair_entries;
   common::Box box;
   typename Potential::Params params;
   double h_pred, dt_prev;
@@ -66,8 +67,11 @@ struct ContactForceFunctor {
   double advance_dt;
   // pair form only: each pair's contact, written by pairs() and read by gather() (ContactWork)
   unsigned char* pair_hit;  // in contact
+  unsigned char* entry_hit;  // in contact, per entry
   Vec3* pair_f;             // force on the owner (where in contact)
   double* pair_dq;          // charge the owner gains (CHARGING, where in contact)
+  double* pair_next;        // displacement bound up to which each pair cannot be in contact
+  double bound;             // the displacement bound of this pass (ContactStep::displacement_bound)
 
   /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old, corrected for
   /// a multiple-time-step impulse given or about to be given (ContactStep::ext_predict_scale)
@@ -176,23 +180,41 @@ struct ContactForceFunctor {
   /// per pair: pair_hit, and for the hits the force on the owner (pair_f) and the charge it gains
   /// (pair_dq). In a dilute gas a row holds one or two entries and few are in contact: per-row
   /// loops spent their time in mispredicted loop exits and contact tests, whole chunks do not.
+  /// With a displacement bound (ContactStep::displacement_bound) only the pairs that may have
+  /// closed their gap since their last screening are screened (pair_next): a pair at distance r
+  /// cannot touch before the bound has grown by (r - 1) / 2, so a pair near the edge of the list
+  /// waits many steps and only pairs in or near contact are screened at every step.
   /// Returns the collisions (each pair once) and the largest overlap.
   HD StepAccum pairs(int first, int last) const {
     constexpr int CHUNK = 64;
-    int hit[CHUNK];
+    int due[CHUNK], hit[CHUNK];
     const int end = pair_offsets[last];
     int nnew = 0;
     double mx = 0.0;
     for (int c0 = pair_offsets[first]; c0 < end; c0 += CHUNK) {
       const int c1 = c0 + CHUNK < end ? c0 + CHUNK : end;
-      int nhit = 0;
+      int ndue = 0, nhit = 0;
+      // pairs that may be in contact; the others are not, and were not at the last pass (a pair
+      // in contact is due at the next pass), so their hit flags are zero already
       for (int p = c0; p < c1; ++p) {
+        due[ndue] = p;
+        ndue += !(pair_next[p] >= bound);
+      }
+      for (int k = 0; k < ndue; ++k) {
+        const int p = due[k];
         double rx, ry, rz;
         const double r2 = separation(pos[pair_owners[p]], pos[pair_partners[p]], rx, ry, rz);
-        const bool in_contact = r2 < 1.0;
-        pair_hit[p] = in_contact;
+        const unsigned char in_contact = r2 < 1.0;
+        if (in_contact != pair_hit[p]) {  // a contact begins or ends (rare): the flags of both entries
+          pair_hit[p] = in_contact;
+          entry_hit[pair_entries[2 * p]] = in_contact;
+          entry_hit[pair_entries[2 * p + 1]] = in_contact;  // the partner's row: this pass alone writes it
+        }
         hit[nhit] = p;
         nhit += in_contact;
+        // the gap r - 1 closes by at most twice the growth of the displacement bound; NEXT_MARGIN
+        // covers the rounding of the separations (ulps of L) at this pass and the next
+        pair_next[p] = bound + 0.5 * (sqrt(r2) - 1.0) - NEXT_MARGIN;
       }
       for (int h = 0; h < nhit; ++h) {
         const int p = hit[h], i = pair_owners[p], j = pair_partners[p];
@@ -209,6 +231,7 @@ struct ContactForceFunctor {
     res.max_overlap = mx;
     return res;
   }
+  static constexpr double NEXT_MARGIN = 1e-12;
 
   /// Compressed pair form, second pass: each particle of [first, last) sums the forces of its pairs
   /// in contact over its row, in row (id) order from zero -- the owner's force for pairs it owns,
@@ -226,9 +249,8 @@ struct ContactForceFunctor {
       const int c1 = c0 + CHUNK < end ? c0 + CHUNK : end;
       int nhit = 0;
       for (int e = c0; e < c1; ++e) {
-        const int q = entry_pairs[e];
         hit[nhit] = e;
-        nhit += pair_hit[q < 0 ? ~q : q];
+        nhit += entry_hit[e];
       }
       for (int h = 0; h < nhit; ++h) {
         const int e = hit[h], i = entry_owners[e], q = entry_pairs[e];
@@ -339,18 +361,32 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
   if (ADVANCE) w.pos.resize(p.size());
   const bool paired = !FAST_COULOMB && nl.hasPairs();
   if (paired) {
-    w.pair_hit.resize(nl.pairCount());
     w.pair_f.resize(nl.pairCount());
     if (CHARGING) w.pair_dq.resize(nl.pairCount());
+    // a new list: no pair in contact yet, and every pair to be screened (threshold -inf). The
+    // thresholds also hold only for bounds from the last pass's on, if that pass had one:
+    // otherwise every pair is screened, and without a bound at every pass.
+    const double bound = st.displacement_bound;
+    const bool new_list = w.pairs_of != nl.generation();
+    if (new_list) {
+      w.pair_hit.assign(nl.pairCount(), 0);
+      w.entry_hit.assign(2 * nl.pairCount(), 0);
+      w.pairs_of = nl.generation();
+    }
+    if (new_list || !(bound >= 0.0) || w.next_bound < 0.0 || !(bound >= w.next_bound))
+      w.pair_next.assign(nl.pairCount(), -std::numeric_limits<double>::infinity());
+    w.next_bound = bound >= 0.0 ? bound : -1.0;
   }
   ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING, ADVANCE> f{
       raw(p.pos), raw(p.vel), raw(p.force), nl.rows(), nl.counts(), nl.capacity(),
       paired ? nl.pairOffsets() : nullptr, paired ? nl.pairOwners() : nullptr, paired ? nl.pairPartners() : nullptr,
       paired ? nl.entryOffsets() : nullptr, paired ? nl.entryOwners() : nullptr, paired ? nl.entryPairs() : nullptr,
+      paired ? nl.pairEntries() : nullptr,
       box, params, half_dt, dt, raw(w.f), raw(p.id),
       st.charging, st.step, st.dq, st.ext_fx, st.ext_fy, st.ext_fz, st.ext_force_scale, st.ext_predict_scale,
       st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table, raw(w.pos), raw(w.vel), raw(p.ix),
-      raw(p.iy), raw(p.iz), st.advance_dt, raw(w.pair_hit), raw(w.pair_f), raw(w.pair_dq)};
+      raw(p.iy), raw(p.iz), st.advance_dt, raw(w.pair_hit), raw(w.entry_hit), raw(w.pair_f), raw(w.pair_dq), raw(w.pair_next),
+      st.displacement_bound >= 0.0 ? st.displacement_bound : 0.0};
   // forces and, per block, collisions, probe sum and largest overlap; then one reduction over blocks
   const int block = blockSizeFor(N);
   const int nblocks = blockCount(N, block);

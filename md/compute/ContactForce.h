@@ -29,7 +29,9 @@
 ///   dilute gas a row holds one or two entries and about one in eight is in contact, so per-row
 ///   loops spent their time in mispredicted loop exits and contact tests (docs/benchmarks.md).
 ///   Both passes write only the block's own pairs and particles: no atomics, and sums in row order.
-///   On CUDA a block is one particle.
+///   On CUDA a block is one particle. With a bound on the displacements since the list was built
+///   (ContactStep::displacement_bound) the first pass skips the pairs that cannot have come into
+///   contact since it last looked at them (the same contacts, fewer distance tests).
 /// The pair form can also finish the step and open the next (ContactStep::advance_dt): the
 /// gathering pass advances each particle as soon as its force is known.
 #include <cstdint>
@@ -63,9 +65,17 @@ struct ContactWork {
   DVec<Scalar4> pos;             ///< advance_dt: the next positions (swapped with ParticleData's)
   DVec<Vec3> vel;                ///< advance_dt: the next drift velocities (swapped likewise)
   DVec<StepAccum> block_flags;   ///< per-block partial results (md/engine/Launch.h)
-  DVec<unsigned char> pair_hit;  ///< compressed pair form: each pair's contact (ContactForce.cpp)
-  DVec<Vec3> pair_f;
-  DVec<double> pair_dq;
+  // compressed pair form (ContactForce.cpp), kept from pass to pass for the list of generation
+  // `pairs_of` (NeighborList::generation):
+  DVec<unsigned char> pair_hit;   ///< each pair's contact at the last pass
+  DVec<unsigned char> entry_hit;  ///< the same per entry (both entries of each pair)
+  DVec<Vec3> pair_f;              ///< force on the owner of each pair in contact
+  DVec<double> pair_dq;           ///< charge the owner of each pair in contact gains
+  /// With ContactStep::displacement_bound: pair p cannot be in contact while the bound stays at
+  /// or below pair_next[p]; valid for bounds from `next_bound` on (< 0: not valid).
+  DVec<double> pair_next;
+  std::uint64_t pairs_of = 0;
+  double next_bound = -1.0;
   void resize(std::size_t n);
 };
 
@@ -107,6 +117,12 @@ struct ContactStep {
   /// are stored, positions and velocities stay those of t, for the error report; image counts may
   /// already have moved).
   double advance_dt = 0.0;
+  /// >= 0: a bound on every particle's displacement since the list was built, non-decreasing from
+  /// pass to pass while the list stays the same (the engine's sum of dt max|u| plus rounding).
+  /// The compressed-pair pass then screens a pair only once the bound has grown by half the
+  /// pair's distance from contact at its last screening: before that neither partner can have
+  /// closed the gap. < 0 (unknown): every pair is screened at every pass.
+  double displacement_bound = -1.0;
 };
 
 /// Whether computeContactForces can advance the step (ContactStep::advance_dt) with this list and step.

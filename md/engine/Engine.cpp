@@ -117,7 +117,7 @@ struct Engine::Impl {
   double time = 0.0;
   std::int64_t collisions = 0;
   bool close_pending = false;      // v holds u = v(t - dt/2): the closing kick is still to apply
-  double drift_since_build = 0.0;  // sum over steps of dt * max |u|: bounds every displacement
+  double drift_since_build = 0.0;  // sum over steps of dt * max |u| (+ rounding): bounds every displacement
   bool exchange = false;           // collisional charging on (charging.mode = "exchange")
   ChargeExchange::Params charging{};
   DVec<double> dq;                 // charge gained at the last force pass, per slot (exchange only)
@@ -371,6 +371,7 @@ struct Engine::Impl {
     if (slow) evaluateCoulomb();
     ContactStep st = makeStep(dt_taken, coulomb ? slowWeight(step) : 0.0, prev_weight);
     st.dq = dqOrNull();
+    st.displacement_bound = drift_since_build;
     if (advance) st.advance_dt = dt;
     const ContactStepResult r = hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
                                       : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
@@ -494,9 +495,13 @@ struct Engine::Impl {
   }
 
   /// A drift with drift velocities of largest |u|^2 = max_u2 was taken: bounds and step count.
+  /// Each stored position moves by dt u up to the rounding of x + dt u and of the wrap, half an ulp
+  /// of L each per component: 2 ulp(L) per step bounds that for the vector, so that the bounds
+  /// hold to the last bit, also for a gas so cold that dt |u| is itself of the order of an ulp.
   void driftTaken(double max_u2) {
-    drift_since_build += dt * std::sqrt(max_u2);
-    drift_since_coul_build += dt * std::sqrt(max_u2);
+    const double moved = dt * std::sqrt(max_u2) + 2.0 * (std::nextafter(box.L, 2.0 * box.L) - box.L);
+    drift_since_build += moved;
+    drift_since_coul_build += moved;
     ++step;
     time = step * dt;  // no accumulated round-off in t
   }

@@ -1,5 +1,6 @@
 #include "md/neighbor/NeighborList.h"
 
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -13,6 +14,8 @@
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
 #include <thrust/transform_reduce.h>
+
+#include "md/engine/Launch.h"
 
 namespace granagg::md {
 
@@ -52,6 +55,14 @@ HD inline void appendIf(int* row, int& n, int cap, int j, bool hit, int& spill) 
 /// Shell sort (Ciura's gaps) for the long rows of Coulomb real-space lists, where insertion while
 /// scanning was quadratic in the row length.
 HD inline void sortRowById(int* row, int n, const int* id) {
+  if (n < 2) return;
+  if (n == 2) {  // most sorted rows of a dilute gas: one compare-and-swap
+    const int a = row[0], b = row[1];
+    const bool swap = id[b] < id[a];
+    row[0] = swap ? b : a;
+    row[1] = swap ? a : b;
+    return;
+  }
   const int gaps[6] = {132, 57, 23, 10, 4, 1};
   constexpr int LOCAL = 384;
   if (n > 16 && n <= LOCAL) {
@@ -96,11 +107,12 @@ struct CellStarts {
   const int* cell;  // sorted cell index of each position in the order
   int* start;
   int n, ncell;
-  HD void operator()(int s) const {
+  HD int operator()(int s) const {
     const int lo = s == 0 ? 0 : cell[s - 1] + 1;
     for (int c = lo; c <= cell[s]; ++c) start[c] = s;
     if (s == n - 1)
       for (int c = cell[s] + 1; c <= ncell; ++c) start[c] = n;
+    return 0;
   }
 };
 
@@ -111,18 +123,21 @@ struct BuildCells {
   const Scalar4* pos;
   const int *order, *cell_start, *id;
   int *list, *count;
+  int* owned;  // null, or the number of entries j > i of each row (the pairs it owns: keepPairs)
   common::Box box;
   double inv_cell, r2;
   int nc, cap;
 
   /// Candidates in the slot range [s0, s1) of the cell order.
-  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill) const {
+  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int& own) const {
     for (int s = s0; s < s1; ++s) {
       const int j = SORTED ? s : order[s];
       const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(xi - rj.x), ry = box.minimumImageWrapped(yi - rj.y),
                    rz = box.minimumImageWrapped(zi - rj.z);
-      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
+      const bool hit = (rx * rx + ry * ry + rz * rz < r2) & (j != i);
+      appendIf(row, n, cap, j, hit, spill);
+      own += hit & (j > i);
     }
   }
 
@@ -131,34 +146,39 @@ struct BuildCells {
   /// the rest (dense cells only) is scanned at once. In a dilute gas a range holds about one
   /// particle: a loop per range costs a mispredicted exit each, here the candidates of all ranges
   /// are screened in one loop. Unsorted: scanned at once.
-  HD void range(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int* cand,
-                int& m) const {
-    if (!SORTED) return scan(s0, s1, i, xi, yi, zi, row, n, spill);
+  HD void range(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int& own,
+                int* cand, int& m) const {
+    if (!SORTED) return scan(s0, s1, i, xi, yi, zi, row, n, spill, own);
     const int len = s1 - s0;
     for (int k = 0; k < GATHER; ++k) cand[m + k] = s0 + k;
     m += len < GATHER ? len : GATHER;
-    if (len > GATHER) scan(s0 + GATHER, s1, i, xi, yi, zi, row, n, spill);
+    if (len > GATHER) scan(s0 + GATHER, s1, i, xi, yi, zi, row, n, spill, own);
   }
   static constexpr int GATHER = 4;
 
-  /// The candidates cand[0, m); WRAP: with minimum images (differences across the faces).
+  /// The candidates cand[0, m); WRAP: with minimum images (differences across the faces), without
+  /// branches (about one candidate in three of a particle next to a face is across it: branches
+  /// on the image would be mispredicted; the result equals Box::minimumImageWrapped to the bit).
   template <bool WRAP>
   HD_INLINE void screen(const int* cand, int m, int i, double xi, double yi, double zi, int* row, int& n,
-                        int& spill) const {
+                        int& spill, int& own) const {
     for (int t = 0; t < m; ++t) {
       const int j = cand[t];
       const Scalar4 rj = pos[j];
       double rx = xi - rj.x, ry = yi - rj.y, rz = zi - rj.z;
       if (WRAP) {
-        rx = box.minimumImageWrapped(rx);
-        ry = box.minimumImageWrapped(ry);
-        rz = box.minimumImageWrapped(rz);
+        const double h = 0.5 * box.L;
+        rx -= box.L * static_cast<double>((rx > h) - (rx < -h));
+        ry -= box.L * static_cast<double>((ry > h) - (ry < -h));
+        rz -= box.L * static_cast<double>((rz > h) - (rz < -h));
       }
-      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
+      const bool hit = (rx * rx + ry * ry + rz * rz < r2) & (j != i);
+      appendIf(row, n, cap, j, hit, spill);
+      own += hit & (j > i);
     }
   }
 
-  HD void operator()(int i) const {
+  HD int operator()(int i) const {
     const Scalar4 ri = pos[i];
     const double xi = ri.x, yi = ri.y, zi = ri.z;
     int cx = static_cast<int>(xi * inv_cell), cy = static_cast<int>(yi * inv_cell), cz = static_cast<int>(zi * inv_cell);
@@ -169,7 +189,7 @@ struct BuildCells {
     const int xs[3] = {cx == 0 ? nc - 1 : cx - 1, cx, cx == nc - 1 ? 0 : cx + 1};
     const int ys[3] = {cy == 0 ? nc - 1 : cy - 1, cy, cy == nc - 1 ? 0 : cy + 1};
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0, spill = 0;
+    int n = 0, spill = 0, own = 0;
     int cand[18 * GATHER];  // at most 18 ranges (9 columns, split in two where they wrap in z)
     int m = 0;
     for (int a = 0; a < 3; ++a)
@@ -178,23 +198,25 @@ struct BuildCells {
         // range) unless the column wraps through the z faces (two ranges)
         const int base = (xs[a] * nc + ys[b]) * nc;
         if (cz > 0 && cz < nc - 1) {
-          range(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n, spill, cand, m);
+          range(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n, spill, own, cand, m);
         } else if (cz == 0) {
-          range(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill, cand, m);
-          range(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
+          range(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill, own, cand, m);
+          range(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill, own, cand, m);
         } else {
-          range(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill, cand, m);
-          range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
+          range(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill, own, cand, m);
+          range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill, own, cand, m);
         }
       }
     // SORTED: the gathered candidates, in one loop. Away from the faces (no neighbour cell wraps,
     // about two particles in three) every difference is its own minimum image: no image tests.
     if (cx > 0 && cx < nc - 1 && cy > 0 && cy < nc - 1 && cz > 0 && cz < nc - 1)
-      screen<false>(cand, m, i, xi, yi, zi, row, n, spill);
+      screen<false>(cand, m, i, xi, yi, zi, row, n, spill, own);
     else
-      screen<true>(cand, m, i, xi, yi, zi, row, n, spill);
+      screen<true>(cand, m, i, xi, yi, zi, row, n, spill, own);
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
+    if (owned) owned[i] = own;
+    return 0;
   }
 };
 
@@ -204,6 +226,7 @@ struct FilterRows {
   const int *super_rows, *super_count;
   int super_cap;
   int *list, *count;
+  int* owned;  // as in BuildCells
   common::Box box;
   double r2;
   int cap;
@@ -211,38 +234,28 @@ struct FilterRows {
     const Scalar4 ri = pos[i];
     const int* in = super_rows + static_cast<long>(i) * super_cap;
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0, spill = 0;
+    int n = 0, spill = 0, own = 0;
     for (int k = 0; k < super_count[i]; ++k) {
       const int j = in[k];
       const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
-      appendIf(row, n, cap, j, rx * rx + ry * ry + rz * rz < r2, spill);
+      const bool hit = rx * rx + ry * ry + rz * rz < r2;
+      appendIf(row, n, cap, j, hit, spill);
+      own += hit & (j > i);
     }
     count[i] = n;
-  }
-};
-
-/// Pairs owned by row i: its entries with a higher partner slot.
-struct CountOwnedPairs {
-  const int *rows, *count;
-  int* owned;
-  int cap;
-  HD void operator()(int i) const {
-    const int* row = rows + static_cast<long>(i) * cap;
-    int n = 0;
-    for (int k = 0; k < count[i]; ++k) n += row[k] > i;
-    owned[i] = n;
+    if (owned) owned[i] = own;
   }
 };
 
 /// Row i's share of the compressed pair form (NeighborList::keepPairs): its owned pairs, and its
-/// entries with the pair of each. The pair of an entry (i, j < i) is found in row j, the row that
+/// entries with the pair of each (and each pair with its two entries). The pair of an entry (i, j < i) is found in row j, the row that
 /// owns it, by counting j's owned pairs before i. Returns the entries whose partner row does not
 /// list i (zero for a valid list, which is symmetric: both rows test the same squared distance).
 struct CompressRow {
   const int *rows, *count, *pair_offsets, *entry_offsets;
-  int *pair_owners, *pair_partners, *entry_owners, *entry_pairs;
+  int *pair_owners, *pair_partners, *entry_owners, *entry_pairs, *pair_entries;
   int cap;
   HD int operator()(int i) const {
     const int* row = rows + static_cast<long>(i) * cap;
@@ -253,6 +266,7 @@ struct CompressRow {
       if (j > i) {
         pair_owners[p] = i;
         pair_partners[p] = j;
+        pair_entries[2 * p] = e;
         entry_pairs[e] = p++;
         continue;
       }
@@ -260,6 +274,7 @@ struct CompressRow {
       int q = pair_offsets[j], m = 0;
       while (m < count[j] && rj[m] != i) q += rj[m++] > j;
       missing += m == count[j];
+      if (m < count[j]) pair_entries[2 * q + 1] = e;  // (else the list is invalid: reported below)
       entry_pairs[e] = ~q;
     }
     return missing;
@@ -270,25 +285,36 @@ struct BuildAllPairs {
   const Scalar4* pos;
   const int* id;
   int *list, *count;
+  int* owned;  // as in BuildCells
   common::Box box;
   double r2;
   int N, cap;
   HD void operator()(int i) const {
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0;
+    int n = 0, own = 0;
     for (int j = 0; j < N; ++j) {
       if (j == i) continue;
       const Scalar4 ri = pos[i], rj = pos[j];
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
-      if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
+      if (rx * rx + ry * ry + rz * rz < r2) {
+        append(row, n, cap, j);
+        own += j > i;
+      }
     }
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
+    if (owned) owned[i] = own;
   }
 };
 
 }  // namespace
+
+/// A number never returned before in this process (NeighborList::generation).
+static std::uint64_t nextGeneration() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
 
 NeighborList::NeighborList(double cutoff, double skin) : m_cutoff(cutoff), m_skin(skin) {
   if (!(cutoff > 0.0) || !(skin > 0.0)) throw std::invalid_argument("neighbour list needs cutoff > 0 and skin > 0.");
@@ -347,35 +373,39 @@ void NeighborList::buildImpl(const ParticleData& p, const common::Box& box, bool
       const int ncell = nc * nc * nc;
       const double inv_cell = nc / box.L;
       m_cell_start.resize(ncell + 1);
-      thrust::for_each(first, last, CellStarts{raw(m_cell), raw(m_cell_start), N, ncell});
+      // blocked loops (md/engine/Launch.h): the functors' members stay in registers
+      const int block = blockSizeFor(N);
+      forEachBlocked(N, block, CellStarts{raw(m_cell), raw(m_cell_start), N, ncell}, NoReduction{}, nullptr);
       if (sorted)
-        thrust::for_each(first, last,
-                         BuildCells<true>{raw(p.pos), nullptr, raw(m_cell_start), raw(p.id), raw(m_list), raw(m_count),
-                                          box, inv_cell, range * range, nc, m_capacity});
+        forEachBlocked(N, block,
+                       BuildCells<true>{raw(p.pos), nullptr, raw(m_cell_start), raw(p.id), raw(m_list), raw(m_count),
+                                        ownedOut(N), box, inv_cell, range * range, nc, m_capacity},
+                       NoReduction{}, nullptr);
       else
-        thrust::for_each(first, last,
-                         BuildCells<false>{raw(p.pos), raw(m_order), raw(m_cell_start), raw(p.id), raw(m_list),
-                                           raw(m_count), box, inv_cell, range * range, nc, m_capacity});
+        forEachBlocked(N, block,
+                       BuildCells<false>{raw(p.pos), raw(m_order), raw(m_cell_start), raw(p.id), raw(m_list),
+                                         raw(m_count), ownedOut(N), box, inv_cell, range * range, nc, m_capacity},
+                       NoReduction{}, nullptr);
     } else {
       m_order.clear();
       thrust::for_each(first, last,
-                       BuildAllPairs{raw(p.pos), raw(p.id), raw(m_list), raw(m_count), box, range * range, N,
-                                     m_capacity});
+                       BuildAllPairs{raw(p.pos), raw(p.id), raw(m_list), raw(m_count), ownedOut(N), box, range * range,
+                                     N, m_capacity});
     }
     if (fitCapacity(N)) break;
   }
   m_built_n = p.size();
   ++m_builds;
+  m_generation = nextGeneration();
 }
 
 void NeighborList::compress(int N) {
   const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
   m_entry_offsets.resize(N + 1);
-  m_pair_offsets.resize(N + 1);
   thrust::exclusive_scan(m_count.begin(), m_count.end(), m_entry_offsets.begin());
   const int entries = N ? static_cast<int>(m_entry_offsets[N - 1]) + static_cast<int>(m_count[N - 1]) : 0;
   m_entry_offsets[N] = entries;
-  thrust::for_each(first, last, CountOwnedPairs{raw(m_list), raw(m_count), raw(m_pair_offsets), m_capacity});
+  // m_pair_offsets holds each row's owned pairs, counted by the build (ownedOut)
   const int last_owned = N ? static_cast<int>(m_pair_offsets[N - 1]) : 0;
   thrust::exclusive_scan(m_pair_offsets.begin(), m_pair_offsets.begin() + N, m_pair_offsets.begin());
   const int pairs = N ? static_cast<int>(m_pair_offsets[N - 1]) + last_owned : 0;
@@ -384,14 +414,21 @@ void NeighborList::compress(int N) {
   m_pair_partners.resize(pairs);
   m_entry_owners.resize(entries);
   m_entry_pairs.resize(entries);
+  m_pair_entries.resize(2 * static_cast<std::size_t>(pairs));
   const int missing = thrust::transform_reduce(
       first, last,
       CompressRow{raw(m_list), raw(m_count), raw(m_pair_offsets), raw(m_entry_offsets), raw(m_pair_owners),
-                  raw(m_pair_partners), raw(m_entry_owners), raw(m_entry_pairs), m_capacity},
+                  raw(m_pair_partners), raw(m_entry_owners), raw(m_entry_pairs), raw(m_pair_entries), m_capacity},
       0, thrust::plus<int>());
   if (missing != 0 || 2 * pairs != entries)
     throw std::logic_error("NeighborList: the rows are not symmetric (" + std::to_string(missing) +
                            " entries without their mirror entry)");
+}
+
+int* NeighborList::ownedOut(int N) {
+  if (!m_keep_pairs) return nullptr;
+  m_pair_offsets.resize(N + 1);
+  return raw(m_pair_offsets);
 }
 
 bool NeighborList::fitCapacity(int N) {
@@ -419,10 +456,11 @@ void NeighborList::buildFrom(const NeighborList& super, const ParticleData& p, c
     m_list.resize(static_cast<std::size_t>(N) * m_capacity);
     thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
                      FilterRows{raw(p.pos), super.rows(), super.counts(), super.capacity(), raw(m_list), raw(m_count),
-                                box, range * range, m_capacity});
+                                ownedOut(N), box, range * range, m_capacity});
   } while (!fitCapacity(N));
   m_built_n = p.size();
   ++m_builds;
+  m_generation = nextGeneration();
 }
 
 }  // namespace granagg::md

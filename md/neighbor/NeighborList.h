@@ -59,6 +59,11 @@ class NeighborList {
   const int* entryOffsets() const { return raw(m_entry_offsets); }
   const int* entryOwners() const { return raw(m_entry_owners); }
   const int* entryPairs() const { return raw(m_entry_pairs); }
+  /// The two entries of pair p: pairEntries()[2p] in the owner's row, pairEntries()[2p + 1] in
+  /// the partner's.
+  const int* pairEntries() const { return raw(m_pair_entries); }
+  /// Identifies the current list among every list built in this process (changes at each build).
+  std::uint64_t generation() const { return m_generation; }
 
   const int* rows() const { return raw(m_list); }     ///< row i at rows()[i * capacity()]
   const int* counts() const { return raw(m_count); }  ///< entries in row i
@@ -71,8 +76,11 @@ class NeighborList {
   void buildImpl(const ParticleData& p, const common::Box& box, bool sorted);
   /// Finishes a build: checks the rows against the capacity (true: they fit) and plans the next one.
   bool fitCapacity(int N);
-  /// The compressed pair form of the rows (keepPairs).
+  /// The compressed pair form of the rows (keepPairs), from the rows and their owned pairs (ownedOut).
   void compress(int N);
+  /// With keepPairs, where a build writes the number of pairs each row owns (its entries j > i,
+  /// the pair form's pair counts before the scan); otherwise null.
+  int* ownedOut(int N);
   double m_cutoff, m_skin;
   int m_capacity = 16;       // row stride of the current list
   int m_next_capacity = 16;  // for the next build: grows on overflow, shrinks when rows are mostly empty
@@ -80,7 +88,8 @@ class NeighborList {
   DVec<int> m_list, m_count;
   bool m_keep_pairs = false;
   DVec<int> m_pair_offsets, m_pair_owners, m_pair_partners;
-  DVec<int> m_entry_offsets, m_entry_owners, m_entry_pairs;
+  DVec<int> m_entry_offsets, m_entry_owners, m_entry_pairs, m_pair_entries;
+  std::uint64_t m_generation = 0;
   std::size_t m_built_n = 0;  // N at the last build
   DVec<int> m_cell, m_order, m_cell_start;
 };

@@ -239,6 +239,68 @@ TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and
   CHECK(std::fabs(total) <= 1e-14 * magnitude);  // every transfer leaves one partner and reaches the other
 }
 
+TEST_CASE("pairs screened only once the displacement bound allows a contact: no contact is missed", "[md][neighbor]") {
+  // With ContactStep::displacement_bound the pair-form pass skips a pair until the bound has grown
+  // by half its gap to contact. Every particle moves at the same speed v0 in a random direction,
+  // so head-on pairs close at nearly 2 v0, the rate the factor 1/2 is there for. The particles drift
+  // freely (no forces applied: the screening, not the physics, is under test) and pass through one
+  // another, so contacts start and end all the time. At every step the pass with the bound must
+  // give exactly the forces and collisions of the pass that screens every pair; the list is rebuilt
+  // whenever the bound reaches skin / 2, as in the engine.
+  const double L = 14.5, v0 = 2.0, dt = 0.01, skin = 0.4;
+  std::vector<double> pos, vel;
+  randomGas(29, 600, L, pos, vel);
+  std::mt19937_64 rng(31);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (std::size_t i = 0; i < vel.size(); i += 3) {
+    double d[3] = {g(rng), g(rng), g(rng)};
+    const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int c = 0; c < 3; ++c) vel[i + c] = v0 * d[c] / norm;
+  }
+  const HertzViscoelastic::Params prm{278.6, 27.7, true};
+  const common::Box box{L};
+  ParticleData screened = makeParticles(pos, vel), every = makeParticles(pos, vel);
+  NeighborList nl(1.0, skin);
+  nl.keepPairs(true);
+  ContactWork w_screened, w_every;
+  const double rounding = 2.0 * (std::nextafter(L, 2.0 * L) - L);  // as the engine's bound (Engine.cpp)
+  double bound = 0.0;
+  std::int64_t collisions = 0;
+  int builds = 0;
+  for (int step = 0; step < 300; ++step) {
+    if (step == 0 || bound > 0.5 * skin) {
+      nl.build(screened, box);
+      bound = 0.0;
+      ++builds;
+    }
+    ContactStep st;
+    st.dt = step == 0 ? 0.0 : dt;
+    st.max_overlap = 2.0;  // free flight overlaps deeply
+    st.displacement_bound = bound;
+    const ContactStepResult a = computeContactForces<HertzViscoelastic>(screened, nl, box, prm, st, w_screened);
+    st.displacement_bound = -1.0;
+    const ContactStepResult b = computeContactForces<HertzViscoelastic>(every, nl, box, prm, st, w_every);
+    REQUIRE(a.worst == 0);
+    REQUIRE(a.collisions == b.collisions);
+    const std::vector<Vec3> fa(screened.force.begin(), screened.force.end()), fb(every.force.begin(), every.force.end());
+    bool same = true;
+    for (std::size_t i = 0; i < fa.size(); ++i) same = same && fa[i].x == fb[i].x && fa[i].y == fb[i].y && fa[i].z == fb[i].z;
+    INFO("step " << step);
+    REQUIRE(same);
+    collisions += a.collisions;
+    for (std::size_t k = 0; k < pos.size(); ++k) pos[k] = std::fmod(pos[k] + dt * vel[k] + L, L);
+    std::vector<double> P[3];
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t i = 0; i < pos.size() / 3; ++i) P[c].push_back(pos[3 * i + c]);
+    screened.setPositions(P[0], P[1], P[2], {});
+    every.setPositions(P[0], P[1], P[2], {});
+    bound += dt * v0 + rounding;
+  }
+  INFO("collisions " << collisions << ", list builds " << builds);
+  CHECK(collisions > 500);
+  CHECK(builds > 10);
+}
+
 TEST_CASE("the build on cell-sorted storage (the engine's) finds exactly the pairs within range", "[md][neighbor]") {
   // The engine stores particles in cell order and builds with buildSorted, whose cell search reads
   // candidates from consecutive slots and skips the minimum image for particles away from the
@@ -344,6 +406,7 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
     REQUIRE(nl.pairCount() == static_cast<std::size_t>(poff[n]));
     const std::vector<int> eowners = fetch(nl.entryOwners(), eoff[n]), epairs = fetch(nl.entryPairs(), eoff[n]);
     const std::vector<int> powners = fetch(nl.pairOwners(), poff[n]), ppartners = fetch(nl.pairPartners(), poff[n]);
+    const std::vector<int> pentries = fetch(nl.pairEntries(), 2 * poff[n]);
     std::vector<int> seen(poff[n], 0);
     for (std::size_t i = 0; i < n; ++i) {
       REQUIRE(eoff[i + 1] - eoff[i] == counts[i]);
@@ -357,6 +420,7 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
         CHECK((q >= 0) == (j > static_cast<int>(i)));  // owned by the lower slot
         CHECK(powners[pr] == std::min(static_cast<int>(i), j));
         CHECK(ppartners[pr] == std::max(static_cast<int>(i), j));
+        CHECK(pentries[2 * pr + (q < 0)] == e);  // and the pair knows this entry
         if (j > static_cast<int>(i)) owned.push_back(pr);
       }
       std::vector<int> range(poff[i + 1] - poff[i]);
