@@ -108,12 +108,21 @@ struct CellStarts {
   int* start;
   int n, ncell;
   HD int operator()(int s) const {
-    const int lo = s == 0 ? 0 : cell[s - 1] + 1;
-    for (int c = lo; c <= cell[s]; ++c) start[c] = s;
+    const int lo = s == 0 ? 0 : cell[s - 1] + 1, hi = cell[s];
+    // The last RUN cells up to hi without a loop or a branch (a cell below lo goes to the scratch
+    // slot start[ncell + 1]; the index is selected by a mask, as g++ turns a select of addresses
+    // into a branch); longer runs of empty cells by a loop. Cells outnumber particles a few times
+    // and the runs vary at random: a loop per slot costs a mispredicted exit.
+    for (int k = 0; k < RUN; ++k) {
+      const int c = hi - k, below = -static_cast<int>(c < lo);
+      start[c ^ ((c ^ (ncell + 1)) & below)] = s;
+    }
+    for (int c = lo; c <= hi - RUN; ++c) start[c] = s;
     if (s == n - 1)
-      for (int c = cell[s] + 1; c <= ncell; ++c) start[c] = n;
+      for (int c = hi + 1; c <= ncell; ++c) start[c] = n;
     return 0;
   }
+  static constexpr int RUN = 4;
 };
 
 /// SORTED: the particle storage is in cell order (slot s is the s-th in the order), so candidates
@@ -372,7 +381,7 @@ void NeighborList::buildImpl(const ParticleData& p, const common::Box& box, bool
     if (nc >= 3) {
       const int ncell = nc * nc * nc;
       const double inv_cell = nc / box.L;
-      m_cell_start.resize(ncell + 1);
+      m_cell_start.resize(ncell + 2);  // + 1: CellStarts' scratch slot
       // blocked loops (md/engine/Launch.h): the functors' members stay in registers
       const int block = blockSizeFor(N);
       forEachBlocked(N, block, CellStarts{raw(m_cell), raw(m_cell_start), N, ncell}, NoReduction{}, nullptr);
