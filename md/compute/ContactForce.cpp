@@ -154,11 +154,15 @@ struct ContactForceFunctor {
     StepAccum res;
     res.collisions = nnew;
     res.max_overlap = mx;
-    finish(i, f0, f1, f2, res);
+    finish<true>(i, f0, f1, f2, res);
     return res;
   }
 
-  /// Adds the slow force, stores i's force and adds its finiteness probe to res.
+  /// Adds the slow force, stores i's force and adds its finiteness probe to res: PROBE_ALL, of the
+  /// force and the position; otherwise of the force only where it has a slow part (the pair-form
+  /// pass probes the contact forces where it computes them: a particle without contacts has a
+  /// zero contact force, and finite forces keep velocities and positions finite).
+  template <bool PROBE_ALL>
   HD_INLINE void finish(int i, double f0, double f1, double f2, StepAccum& res) const {
     if (EXT && ext_force_scale != 0.0) {
       f0 += ext_force_scale * ext_fx[i];
@@ -167,7 +171,10 @@ struct ContactForceFunctor {
     }
     f_new[i] = Vec3{f0, f1, f2};
     const Scalar4 ri = pos[i];
-    res.probe += f0 + f1 + f2 + ri.x + ri.y + ri.z;  // NaN or inf if any term is
+    if (PROBE_ALL)
+      res.probe += f0 + f1 + f2 + ri.x + ri.y + ri.z;  // NaN or inf if any term is
+    else if (EXT)
+      res.probe += f0 + f1 + f2;
     if (ADVANCE) {  // this step's closing kick, the next step's opening kick and drift (kickDrift)
       const double u2 = kickDriftParticle(box, 0.5 * advance_dt, advance_dt, true, Vec3{f0, f1, f2}, vel[i], ri,
                                           CHARGING ? dq + i : nullptr, ix[i], iy[i], iz[i], next_vel[i], next_pos[i]);
@@ -190,7 +197,7 @@ struct ContactForceFunctor {
     int due[CHUNK], hit[CHUNK];
     const int end = pair_offsets[last];
     int nnew = 0;
-    double mx = 0.0;
+    double mx = 0.0, probe = 0.0;
     for (int c0 = pair_offsets[first]; c0 < end; c0 += CHUNK) {
       const int c1 = c0 + CHUNK < end ? c0 + CHUNK : end;
       int ndue = 0, nhit = 0;
@@ -222,6 +229,7 @@ struct ContactForceFunctor {
         const double r2 = separation(pos[i], pos[j], rx, ry, rz);
         double f0 = 0.0, f1 = 0.0, f2 = 0.0, dqi = 0.0;
         contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);  // j > i: counts each collision once
+        probe += f0 + f1 + f2;  // (gather() probes only slow forces)
         pair_f[p] = Vec3{f0, f1, f2};
         if (CHARGING) pair_dq[p] = dqi;
       }
@@ -229,6 +237,7 @@ struct ContactForceFunctor {
     StepAccum res;
     res.collisions = nnew;
     res.max_overlap = mx;
+    res.probe = probe;
     return res;
   }
   static constexpr double NEXT_MARGIN = 1e-12;
@@ -271,7 +280,7 @@ struct ContactForceFunctor {
     }
     for (int i = first; i < last; ++i) {
       const Vec3 fi = f_new[i];
-      finish(i, fi.x, fi.y, fi.z, res);
+      finish<false>(i, fi.x, fi.y, fi.z, res);
     }
     return res;
   }

@@ -51,6 +51,16 @@ HD inline void appendIf(int* row, int& n, int cap, int j, bool hit, int& spill) 
   n += hit;
 }
 
+/// Entries of a row (n of them) with a partner slot above i: the pairs the row owns. Rows of a
+/// dilute gas hold zero to two entries: the first two are read whatever n (capacity >= 4) and
+/// counted by masks, without branches.
+HD inline int ownedEntries(const int* row, int n, int i) {
+  int own = (n > 0) & (row[0] > i);
+  own += (n > 1) & (row[1] > i);
+  for (int k = 2; k < n; ++k) own += row[k] > i;
+  return own;
+}
+
 /// Sorts a row of slots by particle id: insertion sort for the short rows of contact-only lists,
 /// Shell sort (Ciura's gaps) for the long rows of Coulomb real-space lists, where insertion while
 /// scanning was quadratic in the row length.
@@ -138,15 +148,13 @@ struct BuildCells {
   int nc, cap;
 
   /// Candidates in the slot range [s0, s1) of the cell order.
-  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int& own) const {
+  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill) const {
     for (int s = s0; s < s1; ++s) {
       const int j = SORTED ? s : order[s];
       const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(xi - rj.x), ry = box.minimumImageWrapped(yi - rj.y),
                    rz = box.minimumImageWrapped(zi - rj.z);
-      const bool hit = (rx * rx + ry * ry + rz * rz < r2) & (j != i);
-      appendIf(row, n, cap, j, hit, spill);
-      own += hit & (j > i);
+      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
     }
   }
 
@@ -155,13 +163,13 @@ struct BuildCells {
   /// the rest (dense cells only) is scanned at once. In a dilute gas a range holds about one
   /// particle: a loop per range costs a mispredicted exit each, here the candidates of all ranges
   /// are screened in one loop. Unsorted: scanned at once.
-  HD void range(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int& own,
-                int* cand, int& m) const {
-    if (!SORTED) return scan(s0, s1, i, xi, yi, zi, row, n, spill, own);
+  HD void range(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int* cand,
+                int& m) const {
+    if (!SORTED) return scan(s0, s1, i, xi, yi, zi, row, n, spill);
     const int len = s1 - s0;
     for (int k = 0; k < GATHER; ++k) cand[m + k] = s0 + k;
     m += len < GATHER ? len : GATHER;
-    if (len > GATHER) scan(s0 + GATHER, s1, i, xi, yi, zi, row, n, spill, own);
+    if (len > GATHER) scan(s0 + GATHER, s1, i, xi, yi, zi, row, n, spill);
   }
   static constexpr int GATHER = 4;
 
@@ -170,7 +178,7 @@ struct BuildCells {
   /// on the image would be mispredicted; the result equals Box::minimumImageWrapped to the bit).
   template <bool WRAP>
   HD_INLINE void screen(const int* cand, int m, int i, double xi, double yi, double zi, int* row, int& n,
-                        int& spill, int& own) const {
+                        int& spill) const {
     for (int t = 0; t < m; ++t) {
       const int j = cand[t];
       const Scalar4 rj = pos[j];
@@ -181,9 +189,7 @@ struct BuildCells {
         ry -= box.L * static_cast<double>((ry > h) - (ry < -h));
         rz -= box.L * static_cast<double>((rz > h) - (rz < -h));
       }
-      const bool hit = (rx * rx + ry * ry + rz * rz < r2) & (j != i);
-      appendIf(row, n, cap, j, hit, spill);
-      own += hit & (j > i);
+      appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
     }
   }
 
@@ -198,33 +204,41 @@ struct BuildCells {
     const int xs[3] = {cx == 0 ? nc - 1 : cx - 1, cx, cx == nc - 1 ? 0 : cx + 1};
     const int ys[3] = {cy == 0 ? nc - 1 : cy - 1, cy, cy == nc - 1 ? 0 : cy + 1};
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0, spill = 0, own = 0;
+    int n = 0, spill = 0;
     int cand[18 * GATHER];  // at most 18 ranges (9 columns, split in two where they wrap in z)
     int m = 0;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        // the three cells cz-1, cz, cz+1 of a column are consecutive in the cell order (one slot
-        // range) unless the column wraps through the z faces (two ranges)
-        const int base = (xs[a] * nc + ys[b]) * nc;
-        if (cz > 0 && cz < nc - 1) {
-          range(cell_start[base + cz - 1], cell_start[base + cz + 2], i, xi, yi, zi, row, n, spill, own, cand, m);
-        } else if (cz == 0) {
-          range(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill, own, cand, m);
-          range(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill, own, cand, m);
-        } else {
-          range(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill, own, cand, m);
-          range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill, own, cand, m);
+    // the three cells cz-1, cz, cz+1 of a column are consecutive in the cell order (one slot range)
+    // unless the column wraps through the z faces (two ranges)
+    if (cz > 0 && cz < nc - 1) {
+      for (int a = 0; a < 3; ++a) {
+        const int xbase = xs[a] * nc;
+        for (int b = 0; b < 3; ++b) {
+          const int c0 = (xbase + ys[b]) * nc + cz - 1;
+          range(cell_start[c0], cell_start[c0 + 3], i, xi, yi, zi, row, n, spill, cand, m);
         }
       }
+    } else {
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          const int base = (xs[a] * nc + ys[b]) * nc;
+          if (cz == 0) {
+            range(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill, cand, m);
+            range(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
+          } else {
+            range(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill, cand, m);
+            range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
+          }
+        }
+    }
     // SORTED: the gathered candidates, in one loop. Away from the faces (no neighbour cell wraps,
     // about two particles in three) every difference is its own minimum image: no image tests.
     if (cx > 0 && cx < nc - 1 && cy > 0 && cy < nc - 1 && cz > 0 && cz < nc - 1)
-      screen<false>(cand, m, i, xi, yi, zi, row, n, spill, own);
+      screen<false>(cand, m, i, xi, yi, zi, row, n, spill);
     else
-      screen<true>(cand, m, i, xi, yi, zi, row, n, spill, own);
+      screen<true>(cand, m, i, xi, yi, zi, row, n, spill);
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
-    if (owned) owned[i] = own;
+    if (owned) owned[i] = ownedEntries(row, n < cap ? n : cap, i);
     return 0;
   }
 };
@@ -243,18 +257,16 @@ struct FilterRows {
     const Scalar4 ri = pos[i];
     const int* in = super_rows + static_cast<long>(i) * super_cap;
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0, spill = 0, own = 0;
+    int n = 0, spill = 0;
     for (int k = 0; k < super_count[i]; ++k) {
       const int j = in[k];
       const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
-      const bool hit = rx * rx + ry * ry + rz * rz < r2;
-      appendIf(row, n, cap, j, hit, spill);
-      own += hit & (j > i);
+      appendIf(row, n, cap, j, rx * rx + ry * ry + rz * rz < r2, spill);
     }
     count[i] = n;
-    if (owned) owned[i] = own;
+    if (owned) owned[i] = ownedEntries(row, n < cap ? n : cap, i);
   }
 };
 
@@ -300,20 +312,17 @@ struct BuildAllPairs {
   int N, cap;
   HD void operator()(int i) const {
     int* row = list + static_cast<long>(i) * cap;
-    int n = 0, own = 0;
+    int n = 0;
     for (int j = 0; j < N; ++j) {
       if (j == i) continue;
       const Scalar4 ri = pos[i], rj = pos[j];
       const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
-      if (rx * rx + ry * ry + rz * rz < r2) {
-        append(row, n, cap, j);
-        own += j > i;
-      }
+      if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
     }
     sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
     count[i] = n;
-    if (owned) owned[i] = own;
+    if (owned) owned[i] = ownedEntries(row, n < cap ? n : cap, i);
   }
 };
 

@@ -239,6 +239,41 @@ TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and
   CHECK(std::fabs(total) <= 1e-14 * magnitude);  // every transfer leaves one partner and reaches the other
 }
 
+TEST_CASE("a non-finite contact force is flagged by every pass shape, and an advancing pass then moves nothing", "[md][neighbor]") {
+  // Two particles at the same point: r = 0, so the unit vector and the force are NaN. The pair-form
+  // passes check the finiteness of the contact forces where they compute them, the per-row pass
+  // that of every force and position; all must flag it.
+  const double L = 14.5;
+  std::vector<double> pos, vel;
+  randomGas(41, 200, L, pos, vel);
+  for (int c = 0; c < 3; ++c) pos[3 * 7 + c] = pos[3 * 3 + c];  // particle 7 on top of particle 3
+  const HertzViscoelastic::Params prm{278.6, 27.7, true};
+  const common::Box box{L};
+  for (int shape = 0; shape < 3; ++shape) {  // per row; pair form; pair form advancing the step
+    INFO("pass shape " << shape);
+    ParticleData p = makeParticles(pos, vel);
+    NeighborList nl(1.0, 0.3);
+    nl.keepPairs(shape > 0);
+    nl.build(p, box);
+    ContactWork w;
+    ContactStep st;
+    st.dt = 0.002;
+    st.max_overlap = 2.0;  // no overlap bound: only the NaN can flag
+    st.displacement_bound = 0.0;
+    if (shape == 2) st.advance_dt = st.dt;
+    const std::vector<Scalar4> before(p.pos.begin(), p.pos.end());
+    const ContactStepResult r = computeContactForces<HertzViscoelastic>(p, nl, box, prm, st, w);
+    CHECK(r.worst == 1);
+    const std::vector<Scalar4> after(p.pos.begin(), p.pos.end());
+    bool unchanged = true;
+    for (std::size_t i = 0; i < after.size(); ++i) unchanged = unchanged && after[i].x == before[i].x;
+    CHECK(unchanged);
+    const std::vector<Vec3> f(p.force.begin(), p.force.end());
+    CHECK(std::isnan(f[3].x + f[3].y + f[3].z));
+    CHECK(std::isnan(f[7].x + f[7].y + f[7].z));
+  }
+}
+
 TEST_CASE("pairs screened only once the displacement bound allows a contact: no contact is missed", "[md][neighbor]") {
   // With ContactStep::displacement_bound the pair-form pass skips a pair until the bound has grown
   // by half its gap to contact. Every particle moves at the same speed v0 in a random direction,
