@@ -270,10 +270,11 @@ struct FilterRows {
   }
 };
 
-/// Row i's share of the compressed pair form (NeighborList::keepPairs): its owned pairs, and its
-/// entries with the pair of each (and each pair with its two entries). The pair of an entry (i, j < i) is found in row j, the row that
-/// owns it, by counting j's owned pairs before i. Returns the entries whose partner row does not
-/// list i (zero for a valid list, which is symmetric: both rows test the same squared distance).
+/// Row i's share of the compressed pair form (NeighborList::keepPairs): its owned pairs, its
+/// entries with the pair of each, and each pair's entry in this row. The pair of an entry
+/// (i, j < i) is found in row j, the row that owns it, by counting j's owned pairs before i.
+/// Returns the entries whose partner row does not list i (zero for a valid list, which is
+/// symmetric: both rows test the same squared distance).
 struct CompressRow {
   const int *rows, *count, *pair_offsets, *entry_offsets;
   int *pair_owners, *pair_partners, *entry_owners, *entry_pairs, *pair_entries;
