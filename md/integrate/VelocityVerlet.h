@@ -44,12 +44,7 @@ HD_INLINE double kickDriftParticle(const common::Box& box, double h, double dt, 
     *dq = 0.0;
   }
   double a = r.x + dt * u0, b = r.y + dt * u1, c = r.z + dt * u2;
-  // Nearly always inside [0, L) in all three: one test for the three (|x - L/2| < L/2 holds only
-  // inside: x - L/2 is exact for x in [L/2, L], and rounds to at most -L/2 for x < 0; x = 0 takes
-  // the full path), which needs no branch per component
-  const double half_L = 0.5 * box.L;
-  const double da = fabs(a - half_L), db = fabs(b - half_L), dc = fabs(c - half_L);
-  if (!((da > db ? da : db) < half_L && dc < half_L)) {
+  if (!box.insideAll(a, b, c)) {  // nearly always inside: one test, no branch per component
     const int sa = box.wrap(a), sb = box.wrap(b), sc = box.wrap(c);
     if (sa) ix += sa;
     if (sb) iy += sb;

@@ -174,8 +174,7 @@ struct BuildCells {
   static constexpr int GATHER = 4;
 
   /// The candidates cand[0, m); WRAP: with minimum images (differences across the faces), without
-  /// branches (about one candidate in three of a particle next to a face is across it: branches
-  /// on the image would be mispredicted; the result equals Box::minimumImageWrapped to the bit).
+  /// branches: about one candidate in three of a particle next to a face is across it.
   template <bool WRAP>
   HD_INLINE void screen(const int* cand, int m, int i, double xi, double yi, double zi, int* row, int& n,
                         int& spill) const {
@@ -184,10 +183,9 @@ struct BuildCells {
       const Scalar4 rj = pos[j];
       double rx = xi - rj.x, ry = yi - rj.y, rz = zi - rj.z;
       if (WRAP) {
-        const double h = 0.5 * box.L;
-        rx -= box.L * static_cast<double>((rx > h) - (rx < -h));
-        ry -= box.L * static_cast<double>((ry > h) - (ry < -h));
-        rz -= box.L * static_cast<double>((rz > h) - (rz < -h));
+        rx = box.minimumImageWrappedBranchless(rx);
+        ry = box.minimumImageWrappedBranchless(ry);
+        rz = box.minimumImageWrappedBranchless(rz);
       }
       appendIf(row, n, cap, j, (rx * rx + ry * ry + rz * rz < r2) & (j != i), spill);
     }

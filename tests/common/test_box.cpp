@@ -1,6 +1,7 @@
 // Periodic box helpers (common/Box.h): the fast paths used by the MD hot loops against the general
 // definitions, on random and on edge-case inputs.
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <catch2/catch.hpp>
@@ -24,6 +25,28 @@ TEST_CASE("minimumImageWrapped equals minimumImage for differences of wrapped co
   CHECK(box.minimumImageWrapped(top - 0.0) == box.minimumImage(top));
   CHECK(box.minimumImageWrapped(0.0 - top) == box.minimumImage(-top));
   CHECK(std::abs(box.minimumImageWrapped(0.5 * box.L)) == 0.5 * box.L);
+}
+
+TEST_CASE("the branchless minimum image and the three-coordinate inside test agree with their plain forms", "[box]") {
+  const Box box{34.62};
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0.0, box.L), wide(-0.1 * box.L, 1.1 * box.L);
+  const auto inside = [&](double x) { return x >= 0.0 && x < box.L; };
+  for (int k = 0; k < 100000; ++k) {
+    const double dx = u(rng) - u(rng);
+    REQUIRE(box.minimumImageWrappedBranchless(dx) == box.minimumImageWrapped(dx));
+    const double a = wide(rng), b = wide(rng), c = wide(rng);
+    REQUIRE(box.insideAll(a, b, c) == (inside(a) && inside(b) && inside(c)));
+  }
+  const double top = std::nextafter(box.L, 0.0), tiny = -std::numeric_limits<double>::denorm_min();
+  for (double dx : {top, -top, 0.5 * box.L, -0.5 * box.L, 0.0})
+    CHECK(box.minimumImageWrappedBranchless(dx) == box.minimumImageWrapped(dx));
+  // the faces: L and anything below 0 are outside; 0 itself is left to the full path (reported outside)
+  CHECK(box.insideAll(top, top, top));
+  CHECK_FALSE(box.insideAll(box.L, 1.0, 1.0));
+  CHECK_FALSE(box.insideAll(1.0, tiny, 1.0));
+  CHECK_FALSE(box.insideAll(1.0, 1.0, std::nan("")));
+  CHECK_FALSE(box.insideAll(0.0, 1.0, 1.0));
 }
 
 TEST_CASE("wrap returns a coordinate in [0, L) and the image shift, fast path and general case", "[box]") {
