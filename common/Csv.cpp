@@ -94,6 +94,12 @@ void CsvWriter::close() {
   if (bad) throw std::runtime_error("writing '" + m_path + "' failed");
 }
 
+bool CsvTable::hasColumn(const std::string& name) const {
+  for (const auto& c : columns)
+    if (c == name) return true;
+  return false;
+}
+
 std::size_t CsvTable::column(const std::string& name) const {
   for (std::size_t c = 0; c < columns.size(); ++c)
     if (columns[c] == name) return c;

@@ -78,6 +78,8 @@ struct CsvTable {
   std::vector<std::vector<double>> rows;
   /// Index of a named column; throws std::invalid_argument naming the file and column.
   std::size_t column(const std::string& name) const;
+  /// Whether a column of that name exists.
+  bool hasColumn(const std::string& name) const;
   std::string source;
 };
 

@@ -7,6 +7,7 @@
 
 #include "analysis/io/TrajectoryReader.h"
 #include "analysis/stats/ChargeStats.h"
+#include "analysis/stats/GrowthMarkers.h"
 #include "analysis/stats/Msd.h"
 #include "analysis/stats/PowerLawFit.h"
 #include "analysis/stats/PowerLawMle.h"
@@ -54,24 +55,71 @@ std::pair<double, double> fitWindow(const AnalysisOptions& o, const std::vector<
   return {last / 10.0, last};
 }
 
+const std::vector<std::string> FISHER_COLUMNS = {
+    "t", "tau_grid", "tau_grid_err", "xmin_grid", "tail_grid", "ks_grid", "tau_particle", "tau_particle_err",
+    "xmin_particle", "tail_particle", "ks_particle", "tau_ls_grid", "tau_ls_grid_err", "bins_ls_grid",
+    "tau_ls_particle", "tau_ls_particle_err", "bins_ls_particle"};
+
 const std::vector<std::string> FITS_COLUMNS = {
     "z_grid", "z_grid_err", "z_grid_low", "z_grid_high", "z_particle", "z_particle_err", "z_particle_low",
     "z_particle_high", "fit_t_min", "fit_t_max", "fit_points", "charging_rate_exponent", "charging_rate_exponent_err",
     "charging_rate_low", "charging_rate_high", "charging_rate_expected", "kappa", "charge_fit_t_min",
-    "charge_fit_t_max", "charge_fit_points", "runs"};
+    "charge_fit_t_max", "charge_fit_points", "runs", "onset_time_grid", "onset_time_grid_err",
+    "onset_time_particle", "onset_time_particle_err", "onset_S_base_grid", "onset_factor", "onset_t_base"};
 const char* FITS_DESCRIPTION =
     "growth exponent z of S(t) ~ t^z (grid and particle clusters) by least squares of ln S on ln t over "
     "[fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; bootstrap over runs, percentile "
     "interval, for the ensemble); err = standard error (bootstrap: std of replicates); charging_rate_exponent: "
-    "the same fit to d<|q|>/dt over [charge_fit_t_min, charge_fit_t_max], beside the expected -5/6 - 5 kappa/3";
+    "the same fit to d<|q|>/dt over [charge_fit_t_min, charge_fit_t_max], beside the expected -5/6 - 5 kappa/3; "
+    "onset_time: first time S reaches onset_factor x its median over 0 < t <= onset_t_base (onset_S_base_grid), "
+    "interpolated in (ln t, ln S); ensemble: onset of the mean S, err = standard error of the runs' onsets";
+
+/// Onset times of one table's S_grid and S_particle, with the standard errors over runs (ensemble).
+struct Onsets {
+  OnsetTime grid, particle;
+  double grid_err = NaN, particle_err = NaN;
+};
 
 std::vector<double> fitColumns(const PowerLawFitResult& g, const PowerLawFitResult& p, double t0, double t1,
-                               const PowerLawFitResult& q, double kappa, double q0, double q1, double runs) {
+                               const PowerLawFitResult& q, double kappa, double q0, double q1, double runs,
+                               const Onsets& on, const AnalysisOptions& o) {
   auto v = [](const PowerLawFitResult& f, double x) { return f.valid ? x : NaN; };
+  auto ov = [](const OnsetTime& m, double x) { return m.valid ? x : NaN; };
   return {v(g, g.exponent), v(g, g.stderr_z), v(g, g.low),  v(g, g.high), v(p, p.exponent), v(p, p.stderr_z),
           v(p, p.low),      v(p, p.high),     t0,           t1,           static_cast<double>(std::max(g.points, p.points)),
           v(q, q.exponent), v(q, q.stderr_z), v(q, q.low),  v(q, q.high), expectedChargingRateExponent(kappa),
-          kappa,            q0,               q1,           static_cast<double>(q.points), runs};
+          kappa,            q0,               q1,           static_cast<double>(q.points), runs,
+          ov(on.grid, on.grid.t_c), on.grid_err, ov(on.particle, on.particle.t_c), on.particle_err,
+          on.grid.S_base > 0 ? on.grid.S_base : NaN, o.onset_factor, o.onset_t_base};
+}
+
+/// Onsets of S_grid and S_particle; empty series give invalid onsets.
+Onsets onsetsOf(const std::vector<double>& t, const std::vector<double>& Sg, const std::vector<double>& Sp,
+                const AnalysisOptions& o) {
+  Onsets on;
+  on.grid = onsetTime(t, Sg, o.onset_factor, o.onset_t_base);
+  on.particle = onsetTime(t, Sp, o.onset_factor, o.onset_t_base);
+  return on;
+}
+
+/// Standard error of the mean of values, NaN unless every one is finite and there are >= 2.
+double standardErrorOfAll(const std::vector<double>& x) {
+  if (x.size() < 2) return NaN;
+  double m = 0;
+  for (double v : x) {
+    if (!std::isfinite(v)) return NaN;
+    m += v;
+  }
+  m /= static_cast<double>(x.size());
+  double ss = 0;
+  for (double v : x) ss += (v - m) * (v - m);
+  return std::sqrt(ss / static_cast<double>(x.size() - 1) / static_cast<double>(x.size()));
+}
+
+/// The paper's Fisher exponent (log-binned least squares) as three table values.
+std::vector<double> lsColumns(const std::map<std::uint64_t, std::uint64_t>& n_s, double ratio) {
+  const LogBinnedFit f = fitLogBinnedPowerLaw(n_s, ratio);
+  return {f.valid ? f.tau : NaN, f.valid ? f.tau_err : NaN, static_cast<double>(f.bins)};
 }
 
 }  // namespace
@@ -90,6 +138,9 @@ void AnalysisOptions::validate() const {
   require(mle_min_tail >= 2, "--mle-min-tail must be at least 2.");
   require(bootstrap_replicates >= 10, "--bootstrap must be at least 10 replicates.");
   require(lammps_dt >= 0 && std::isfinite(lammps_dt), "--lammps-dt must be >= 0.");
+  require(onset_factor > 1 && std::isfinite(onset_factor), "--onset-factor must be > 1 (got " + common::formatReal(onset_factor) + ").");
+  require(onset_t_base > 0 && std::isfinite(onset_t_base), "--onset-baseline must be > 0 (got " + common::formatReal(onset_t_base) + ").");
+  require(fisher_bin_ratio > 1 && fisher_bin_ratio <= 100, "--fisher-bin-ratio must lie in (1, 100] (got " + common::formatReal(fisher_bin_ratio) + ").");
   // The constructors validate their own parameters (and name them).
   GridClusters g(grid);
   ParticleClusters p(particle);
@@ -137,9 +188,10 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   Table fisher("fisher",
                "Fisher exponent tau of N_s ~ s^-tau per frame: discrete power-law MLE with xmin by KS distance "
                "(Clauset, Shalizi & Newman 2009); tau_err = 1/sqrt(n I(tau)); tail = clusters with s >= xmin; ks = KS "
-               "distance; NaN when fewer than min_tail clusters or no maximum",
-               {"t", "tau_grid", "tau_grid_err", "xmin_grid", "tail_grid", "ks_grid", "tau_particle", "tau_particle_err",
-                "xmin_particle", "tail_particle", "ks_particle"});
+               "distance; NaN when fewer than min_tail clusters or no maximum; tau_ls: the paper's estimator, minus the "
+               "least-squares slope of ln N_s on ln s over logarithmic bins (analysis/stats/GrowthMarkers.h), "
+               "bins_ls = non-empty bins (NaN below 3)",
+               FISHER_COLUMNS);
   Table thermo("thermo",
                "t: time; T_g = <|v - <v>|^2>/3 [T0]; a2 = (3/5)<c^4>/<c^2>^2 - 1 (Sonine) and its standard error; "
                "mean_abs_q = <|q|> [q_ref]; rms_q; net_q = sum q; max_abs_q; corr_absq_speed = Pearson correlation of |q~| and v~",
@@ -199,6 +251,7 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
     t_series.push_back(t);
     double sg = NaN, sp = NaN, cg = NaN, cp = NaN, lg = NaN, lp = NaN, occ = NaN, mc = NaN;
     PowerLawMleResult fg, fp;
+    std::vector<double> ls_g{NaN, NaN, NaN}, ls_p{NaN, NaN, NaN};
     if (o.grid_clusters) {
       grid.compute(f);
       const ClusterSizes& c = grid.result();
@@ -208,6 +261,7 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       occ = grid.occupiedFraction();
       for (const auto& [s, count] : c.n_s) Ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
       fg = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
+      ls_g = lsColumns(c.n_s, o.fisher_bin_ratio);
       if (cb.grid) cb.grid(f, grid);
     }
     if (o.particle_clusters) {
@@ -219,6 +273,7 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       mc = 2.0 * static_cast<double>(part.bonds()) / static_cast<double>(f.size());
       for (const auto& [s, count] : c.n_s) Ns_part.add({t, static_cast<double>(s), static_cast<double>(count)});
       fp = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
+      ls_p = lsColumns(c.n_s, o.fisher_bin_ratio);
       std::vector<double> row{t, 0.0};
       double sum = 0;
       for (std::size_t i : tracked) {
@@ -233,7 +288,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
     S_t.add({t, static_cast<double>(f.step), sg, sp, cg, cp, lg, lp, occ, mc, NaN, NaN});
     auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
     fisher.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)), fv(fg, double(fg.n_tail)), fv(fg, fg.ks),
-                fv(fp, fp.tau), fv(fp, fp.tau_err), fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks)});
+                fv(fp, fp.tau), fv(fp, fp.tau_err), fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks),
+                ls_g[0], ls_g[1], ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
 
     std::vector<double> speeds;
     VelocityMoments vm;
@@ -302,7 +358,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   }
   Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
   fits.ensemble = false;
-  fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, r.kappa, o.charge_fit_t_min, o.charge_fit_t_max, 1));
+  fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, r.kappa, o.charge_fit_t_min, o.charge_fit_t_max, 1,
+                      onsetsOf(t_series, Sg, Sp, o), o));
 
   r.tables.push_back(std::move(S_t));
   if (o.grid_clusters) r.tables.push_back(std::move(Ns_grid));
@@ -372,9 +429,9 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
   // Pooled Fisher exponents: N_s summed over runs at each time.
   {
     Table pooled("fisher_pooled",
-                 "Fisher exponent of N_s summed over all runs at each time (MLE, xmin by KS, as in fisher.csv)",
-                 {"t", "tau_grid", "tau_grid_err", "xmin_grid", "tail_grid", "ks_grid", "tau_particle", "tau_particle_err",
-                  "xmin_particle", "tail_particle", "ks_particle"});
+                 "Fisher exponent of N_s summed over all runs at each time (MLE, xmin by KS, and the paper's "
+                 "log-binned least squares, as in fisher.csv)",
+                 FISHER_COLUMNS);
     std::map<double, std::map<std::uint64_t, std::uint64_t>> g, p;
     for (const auto& r : runs) {
       for (const char* name : {"N_s_grid", "N_s_particle"}) {
@@ -393,12 +450,19 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
     for (const auto& kv : times) {
       const double t = kv.first;
       PowerLawMleResult fg, fp;
-      if (g.count(t)) fg = fitDiscretePowerLawKs(g[t], o.mle_min_tail);
-      if (p.count(t)) fp = fitDiscretePowerLawKs(p[t], o.mle_min_tail);
+      std::vector<double> ls_g{NaN, NaN, NaN}, ls_p{NaN, NaN, NaN};
+      if (g.count(t)) {
+        fg = fitDiscretePowerLawKs(g[t], o.mle_min_tail);
+        ls_g = lsColumns(g[t], o.fisher_bin_ratio);
+      }
+      if (p.count(t)) {
+        fp = fitDiscretePowerLawKs(p[t], o.mle_min_tail);
+        ls_p = lsColumns(p[t], o.fisher_bin_ratio);
+      }
       auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
       pooled.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)), fv(fg, double(fg.n_tail)),
                   fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err), fv(fp, double(fp.xmin)),
-                  fv(fp, double(fp.n_tail)), fv(fp, fp.ks)});
+                  fv(fp, double(fp.n_tail)), fv(fp, fp.ks), ls_g[0], ls_g[1], ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
     }
     out.push_back(std::move(pooled));
   }
@@ -452,8 +516,20 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
         }
         fq = fitOf(rates, tr, o.charge_fit_t_min, o.charge_fit_t_max);
       }
+      // Onset: of the ensemble-mean S (every frame time, as the local slope of the mean), with the
+      // standard error of the runs' own onsets.
+      Onsets on = onsetsOf(st->values("t"), st->values("S_grid_mean"), st->values("S_particle_mean"), o);
+      std::vector<double> tg, tp;
+      for (const auto& r : runs) {
+        const Table& tb = r.table("S_t");
+        const Onsets one = onsetsOf(tb.values("t"), tb.values("S_grid"), tb.values("S_particle"), o);
+        tg.push_back(one.grid.valid ? one.grid.t_c : NaN);
+        tp.push_back(one.particle.valid ? one.particle.t_c : NaN);
+      }
+      on.grid_err = standardErrorOfAll(tg);
+      on.particle_err = standardErrorOfAll(tp);
       fits.add(fitColumns(fg, fp, w0, w1, fq, runs.front().kappa, o.charge_fit_t_min, o.charge_fit_t_max,
-                          static_cast<double>(runs.size())));
+                          static_cast<double>(runs.size()), on, o));
     }
     out.push_back(std::move(fits));
   }

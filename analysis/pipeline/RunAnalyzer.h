@@ -39,6 +39,9 @@ struct AnalysisOptions {
   double lammps_dt = 0.0;           ///< LAMMPS timestep to convert steps to times (0: time = step)
   int bootstrap_replicates = 2000;  ///< ensemble growth exponent: bootstrap replicates over runs
   std::uint64_t bootstrap_seed = 20091;  ///< fixed seed: the same runs give the same interval
+  double onset_factor = 2.0;        ///< onset time: S reaches this multiple of its early plateau ...
+  double onset_t_base = 10.0;       ///< ... the median S over 0 < t <= this (GrowthMarkers.h)
+  double fisher_bin_ratio = 2.0;    ///< the paper's Fisher estimator: logarithmic bins [r^k, r^{k+1})
 
   /// Throws std::invalid_argument naming the option when a value is out of range.
   void validate() const;
