@@ -421,6 +421,9 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   if (!a.no_curve_fit && std::isfinite(cf.S_c) && cf.S_c > 0.0)
     bzs = mf::betaFromZ(curves, zf.z, zf.z_low, zf.z_high, zf.S0 / cf.S_c, zf.S1 / cf.S_c, a.beta_min, a.beta_max);
 
+  // 5. beta from z by the asymptotic law z = 3 beta / (beta + 3): needs no S scale.
+  const mf::BetaFromZ ba = mf::betaAsymptotic(zf.z, zf.z_low, zf.z_high);
+
   // Outputs.
   fs::create_directories(outDir);
   if (a.no_curve_fit && a.force) fs::remove(curvePath);  // a stale curve from an earlier run would mislead
@@ -443,6 +446,9 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   if (!bz.note.empty()) prov.add("beta_from_z_note", bz.note);
   prov.add("beta_from_z_scaled", std::string("the same at the S range [S0, S1] / S_c (S_c from the curve fit)"));
   if (!bzs.note.empty()) prov.add("beta_from_z_scaled_note", bzs.note);
+  prov.add("beta_asymptotic", std::string("3 z / (3 - z), the inverse of the large-S limit z = 3 beta / (beta + 3) "
+                                          "(no S scale needed; valid where z was measured in the scaling regime)"));
+  if (!ba.note.empty()) prov.add("beta_asymptotic_note", ba.note);
   if (!a.no_curve_fit) prov.add("curve_interval", cf.interval_method);
   if (!cf.note.empty()) prov.add("curve_fit_note", cf.note);
   for (std::size_t i = 0; i < L.notes.size(); ++i) prov.add("note." + std::to_string(i), L.notes[i]);
@@ -452,17 +458,20 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
                                   "range [S0, S1]; beta_fit, S_c, tau_c (+ _low/_high): fit of ln S(t) to "
                                 "ln[S_c S_MF(t/tau_c; beta)]; chi2_dof: residual variance of ln S; S0, S1: fitted S at "
                                 "t0, t1; n_runs: runs in the input; beta_from_z_scaled*: as beta_from_z at [S0, S1] / S_c; "
-                                "NaN = not available"));
+                                "beta_asymptotic*: 3 z / (3 - z) (the large-S law inverted) at z, z_low, z_high; "
+                                "beta_fit_determined: 0 when beta_fit lies at a bound of the search range; NaN = not available"));
   {
     common::CsvWriter w(csvPath, sp,
                         {"z", "z_low", "z_high", "t0", "t1", "n_points", "beta_from_z", "beta_from_z_low",
                          "beta_from_z_high", "beta_fit", "beta_fit_low", "beta_fit_high", "S_c", "S_c_low", "S_c_high",
                          "tau_c", "tau_c_low", "tau_c_high", "chi2_dof", "S0", "S1", "n_runs", "beta_from_z_scaled",
-                         "beta_from_z_scaled_low", "beta_from_z_scaled_high"},
+                         "beta_from_z_scaled_low", "beta_from_z_scaled_high", "beta_asymptotic", "beta_asymptotic_low",
+                         "beta_asymptotic_high", "beta_fit_determined"},
                         a.force);
     w.row({zf.z, zf.z_low, zf.z_high, zf.t0, zf.t1, static_cast<double>(zf.points), bz.beta, bz.beta_low, bz.beta_high,
            cf.beta, cf.beta_low, cf.beta_high, cf.S_c, cf.S_c_low, cf.S_c_high, cf.tau_c, cf.tau_c_low, cf.tau_c_high,
-           cf.chi2_dof, zf.S0, zf.S1, static_cast<double>(L.runs.size()), bzs.beta, bzs.beta_low, bzs.beta_high});
+           cf.chi2_dof, zf.S0, zf.S1, static_cast<double>(L.runs.size()), bzs.beta, bzs.beta_low, bzs.beta_high,
+           ba.beta, ba.beta_low, ba.beta_high, a.no_curve_fit ? nan : (cf.at_bound ? 0.0 : 1.0)});
     w.close();
   }
   if (!a.no_curve_fit) {
@@ -505,11 +514,17 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
     j.num("beta_from_z_scaled_low", bzs.beta_low);
     j.num("beta_from_z_scaled_high", bzs.beta_high);
     j.str("beta_from_z_scaled_note", bzs.note);
+    j.num("beta_asymptotic", ba.beta);
+    j.num("beta_asymptotic_low", ba.beta_low);
+    // +inf (z_high >= 3) is written as null like NaN; the note says which
+    j.num("beta_asymptotic_high", ba.beta_high);
+    j.str("beta_asymptotic_note", ba.note);
     j.num("z_mf_at_beta_min", bz.z_at_beta_min);
     j.num("z_mf_at_beta_max", bz.z_at_beta_max);
     j.num("z_mf_beta2_window", zmf2);
     j.num("z_mf_beta3_window", zmf3);
     j.boolean("curve_fit", !a.no_curve_fit);
+    j.boolean("beta_fit_determined", !a.no_curve_fit && !cf.at_bound);
     j.num("beta_fit", cf.beta);
     j.num("beta_fit_low", cf.beta_low);
     j.num("beta_fit_high", cf.beta_high);
@@ -549,10 +564,15 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
               interval(bz.beta, bz.beta_low, bz.beta_high).c_str(), bz.S0, bz.S1, zmf2, zmf3, PAPER_Z_MF_BETA2,
               PAPER_Z_MF_BETA3);
   if (!bz.note.empty()) std::printf("fit-beta:   note: %s\n", bz.note.c_str());
+  std::printf("fit-beta: beta from the asymptotic law z = 3 beta/(beta + 3) = %s (no S scale; valid where the local "
+              "slope is flat)\n", interval(ba.beta, ba.beta_low, ba.beta_high).c_str());
+  if (!ba.note.empty()) std::printf("fit-beta:   note: %s\n", ba.note.c_str());
   if (!a.no_curve_fit) {
     std::printf("fit-beta: beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s\n", bzs.S0, bzs.S1,
                 interval(bzs.beta, bzs.beta_low, bzs.beta_high).c_str());
     if (!bzs.note.empty()) std::printf("fit-beta:   note: %s\n", bzs.note.c_str());
+    if (cf.at_bound)
+      std::printf("fit-beta: beta from the curve fit: not determined (at the bound %.3g of the search range)\n", cf.beta);
     std::printf("fit-beta: beta from the curve fit = %s, S_c = %s, tau_c = %s, chi2/dof = %.3g (%s)\n",
                 interval(cf.beta, cf.beta_low, cf.beta_high).c_str(), interval(cf.S_c, cf.S_c_low, cf.S_c_high).c_str(),
                 interval(cf.tau_c, cf.tau_c_low, cf.tau_c_high).c_str(), cf.chi2_dof, cf.interval_method.c_str());

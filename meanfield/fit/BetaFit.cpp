@@ -461,6 +461,32 @@ double zResidual(double beta, void* p) {
 }
 }  // namespace
 
+BetaFromZ betaAsymptotic(double z, double z_low, double z_high) {
+  BetaFromZ out;
+  out.S0 = out.S1 = out.z_at_beta_min = out.z_at_beta_max = NaN;
+  // beta(z) = 3 z / (3 - z), increasing on (0, 3) from 0 to +inf.
+  auto beta = [](double x) {
+    if (!std::isfinite(x)) return NaN;
+    if (x <= 0.0) return 0.0;
+    if (x >= 3.0) return std::numeric_limits<double>::infinity();
+    return 3.0 * x / (3.0 - x);
+  };
+  if (!std::isfinite(z) || z <= 0.0 || z >= 3.0) {
+    out.beta = out.beta_low = out.beta_high = NaN;
+    out.note = std::isfinite(z) ? (z <= 0.0 ? "z = " + formatReal(z) + " <= 0: S does not grow, no beta."
+                                            : "z = " + formatReal(z) + " >= 3: faster than 3 beta/(beta + 3) for every beta, no beta.")
+                                : "z is not finite: no beta.";
+    return out;
+  }
+  out.beta = beta(z);
+  out.beta_low = beta(z_low);
+  out.beta_high = beta(z_high);
+  if (std::isfinite(z_high) && z_high >= 3.0) out.note += "z_high = " + formatReal(z_high) + " >= 3: no upper bound on beta. ";
+  if (std::isfinite(z_low) && z_low <= 0.0) out.note += "z_low = " + formatReal(z_low) + " <= 0: the interval reaches beta = 0. ";
+  if (!out.note.empty()) out.note.pop_back();
+  return out;
+}
+
 BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_high, double S0, double S1,
                     double beta_min, double beta_max) {
   validateBetaRange(beta_min, beta_max);
@@ -723,7 +749,8 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   }
   gsl_set_error_handler(old);
   const double edge = 1e-4 * (o.beta_max - o.beta_min);
-  if (fit.beta <= o.beta_min + edge || fit.beta >= o.beta_max - edge)
+  fit.at_bound = fit.beta <= o.beta_min + edge || fit.beta >= o.beta_max - edge;
+  if (fit.at_bound)
     fit.note = "beta_fit lies at the bound " + formatReal(fit.beta <= o.beta_min + edge ? o.beta_min : o.beta_max) +
                " of the search range; widen --beta-min/--beta-max.";
   fit.S_fitted.resize(n);

@@ -169,6 +169,17 @@ struct BetaFromZ {
 BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_high, double S0, double S1,
                     double beta_min, double beta_max);
 
+/// beta from z through the asymptotic law z = 3 beta / (beta + 3), i.e. beta = 3 z / (3 - z): the
+/// growth exponent the full Smoluchowski equation with the beta kernel converges to at large S
+/// (homogeneity lambda = 2/3 - 1/beta, z = 1/(1 - lambda); design.md sections 2 and 4; the
+/// sectional solver reaches it within 1e-4 by S ~ 1e6). It needs no S scale, so it applies to data
+/// whose S unit (grid sites) differs from the mean field's (monomers), provided z was measured in
+/// the scaling regime (a flat local slope). Every z in (0, 3) maps to one beta in (0, inf), and
+/// the interval maps monotonically: z_high >= 3 gives beta_high = +inf (no upper bound), z_low <= 0
+/// gives beta_low = 0. A central z outside (0, 3) gives NaN with a note (z >= 3 grows faster than
+/// any kernel of the family, z <= 0 does not grow). S0, S1 and z_at_beta_* are NaN.
+BetaFromZ betaAsymptotic(double z, double z_low, double z_high);
+
 /// Options of the full-curve fit.
 struct CurveFitOptions {
   double beta_min = 1.5, beta_max = 6.0;  ///< search range of beta
@@ -188,6 +199,9 @@ struct CurveFit {
   std::string interval_method;
   int replicates = 0;
   std::string note;             ///< empty, or e.g. that beta ended at a bound of its range
+  /// true when beta ended at a bound of [beta_min, beta_max]: then beta is not determined by the
+  /// data (the best curve lies beyond the range, or the data are not of the mean field's shape).
+  bool at_bound = false;
   /// Fitted model S_c S_MF(t / tau_c; beta) at the data times.
   std::vector<double> S_fitted;
 };

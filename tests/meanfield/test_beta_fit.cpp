@@ -277,3 +277,32 @@ TEST_CASE("fit-beta rejects bad data, windows and beta ranges", "[meanfield][fit
   CHECK_THROWS_WITH(fitCurve(curves, growthFromSeries({1, 2, 3, 4}, {1, 2, 3, 4})), Contains("too few points"));
   CHECK(curves.solves() == 0);
 }
+
+TEST_CASE("fit-beta's asymptotic beta inverts z = 3 beta/(beta + 3), the full equation's large-S limit",
+          "[meanfield][fitbeta]") {
+  // Closed form: the paper's two cases and the interval's monotone map.
+  const BetaFromZ b2 = betaAsymptotic(1.2, 1.1, 1.3);
+  CHECK(b2.beta == Approx(2.0).epsilon(1e-14));
+  CHECK(b2.beta_low == Approx(3.0 * 1.1 / 1.9).epsilon(1e-14));
+  CHECK(b2.beta_high == Approx(3.0 * 1.3 / 1.7).epsilon(1e-14));
+  CHECK(b2.note.empty());
+  CHECK(betaAsymptotic(1.5, 1.5, 1.5).beta == Approx(3.0).epsilon(1e-14));
+  // Independent reference: the sectional solver's own exponent far out (S = 1e6..1e7, where it has
+  // converged within 1e-4, design.md section 4) maps back to the beta it was solved with.
+  MeanFieldCurves curves;
+  for (const double beta : {2.0, 3.0}) {
+    const double z = curves.exponentBetween(1e6, 1e7, beta);
+    CHECK(betaAsymptotic(z, z, z).beta == Approx(beta).margin(5e-3));
+  }
+  // Ends outside (0, 3): no bound above, zero below, said so; a central value outside: NaN.
+  const BetaFromZ open = betaAsymptotic(2.5, 2.0, 3.4);
+  CHECK(open.beta == Approx(15.0));
+  CHECK(std::isinf(open.beta_high));
+  CHECK(open.note.find("no upper bound") != std::string::npos);
+  CHECK(betaAsymptotic(0.5, -0.1, 0.9).beta_low == 0.0);
+  for (const double z : {3.0, 4.5, 0.0, -0.2, std::nan("")}) {
+    const BetaFromZ none = betaAsymptotic(z, z - 0.1, z + 0.1);
+    CHECK(std::isnan(none.beta));
+    CHECK_FALSE(none.note.empty());
+  }
+}
