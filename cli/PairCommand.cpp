@@ -35,6 +35,7 @@
 #include <thread>
 #include <vector>
 
+#include "analysis/stats/GrowthMarkers.h"
 #include "cli/CliContext.h"
 #include "common/Csv.h"
 #include "common/Version.h"
@@ -953,9 +954,39 @@ struct KResult {
   double z = NAN, z_low = NAN, z_high = NAN, fit_t_min = NAN, fit_t_max = NAN, runs = NAN;
   double fz = NAN, fz_low = NAN, fz_high = NAN, bz = NAN, bz_low = NAN, bz_high = NAN;
   double bf = NAN, bf_low = NAN, bf_high = NAN, S_c = NAN, tau_c = NAN, w0 = NAN, w1 = NAN;
+  double ba = NAN, ba_low = NAN, ba_high = NAN;  ///< beta from the asymptotic law 3 z / (3 - z)
+  bool bf_determined = true;                      ///< false when the curve fit ended at a bound
+  double onset = NAN, onset_err = NAN;            ///< onset time of S_grid (analyze's fits.csv)
+  granagg::analysis::GrowthRegime regime;         ///< of the ensemble-mean S_grid (S_t.csv)
   bool has_fit = false;
   std::string notes;  ///< fit-beta's notes on beta (clamped, no beta, at a bound)
 };
+
+/// The validation study's result for this K (data/validation/verdict.csv, written by
+/// scripts/validation_report.py, described in docs/validation.md): one sentence, or "" when the
+/// study has no row for K.
+std::string validationLine(double K) {
+  for (const auto& d : dataDirs()) {
+    const fs::path p = fs::path(d) / "validation" / "verdict.csv";
+    if (!fs::exists(p)) continue;
+    try {
+      const common::CsvTable t = common::readCsv(p.string());
+      for (const auto& row : t.rows) {
+        if (std::abs(row[t.column("K")] - K) > 1e-12 || row[t.column("quantity_id")] != 1.0) continue;
+        char buf[400];
+        std::snprintf(buf, sizeof buf,
+                      "validation study (docs/validation.md; N = %.0f, %.0f runs to t = %.0f): z = %.2f [%.2f, %.2f] over "
+                      "t = %.0f..%.0f, onset t_c = %.0f, growth x%.0f",
+                      row[t.column("N")], row[t.column("runs")], row[t.column("t_end")], row[t.column("value")],
+                      row[t.column("low")], row[t.column("high")], row[t.column("t0")], row[t.column("t1")],
+                      row[t.column("onset")], row[t.column("growth_factor")]);
+        return buf;
+      }
+    } catch (const std::exception&) {
+    }
+  }
+  return "";
+}
 
 KResult readK(const fs::path& out, double K) {
   KResult r;
@@ -972,7 +1003,26 @@ KResult readK(const fs::path& out, double K) {
         r.fit_t_min = row[t.column("fit_t_min")];
         r.fit_t_max = row[t.column("fit_t_max")];
         r.runs = row[t.column("runs")];
+        if (t.hasColumn("onset_time_grid")) {
+          r.onset = row[t.column("onset_time_grid")];
+          r.onset_err = row[t.column("onset_time_grid_err")];
+        }
       }
+    } catch (const std::exception&) {
+    }
+  }
+  const fs::path st = out / "analysis" / kName(K) / "S_t.csv";
+  r.regime.regime = "unknown";
+  if (fs::exists(st)) {
+    try {
+      const common::CsvTable t = common::readCsv(st.string());
+      std::vector<double> tt, S, z;
+      for (const auto& row : t.rows) {
+        tt.push_back(row[t.column("t")]);
+        S.push_back(row[t.column("S_grid_mean")]);
+        z.push_back(row[t.column(t.hasColumn("z_local_grid_of_mean") ? "z_local_grid_of_mean" : "z_local_grid")]);
+      }
+      r.regime = granagg::analysis::classifyGrowth(tt, S, z);
     } catch (const std::exception&) {
     }
   }
@@ -989,6 +1039,10 @@ KResult readK(const fs::path& out, double K) {
     r.bf = jsonValue(j, "beta_fit");
     r.bf_low = jsonValue(j, "beta_fit_low");
     r.bf_high = jsonValue(j, "beta_fit_high");
+    r.ba = jsonValue(j, "beta_asymptotic");
+    r.ba_low = jsonValue(j, "beta_asymptotic_low");
+    r.ba_high = jsonValue(j, "beta_asymptotic_high");
+    r.bf_determined = j.find("\"beta_fit_determined\": false") == std::string::npos;
     r.S_c = jsonValue(j, "S_c");
     r.tau_c = jsonValue(j, "tau_c");
     r.w0 = jsonValue(j, "t0");
@@ -997,7 +1051,7 @@ KResult readK(const fs::path& out, double K) {
       r.w0 = jsonValue(j, "window", 0);
       r.w1 = jsonValue(j, "window", 1);
     }
-    for (const char* key : {"beta_from_z_note", "curve_fit_note"}) {
+    for (const char* key : {"beta_from_z_note", "beta_asymptotic_note", "curve_fit_note"}) {
       const std::string n = jsonText(j, key);
       if (!n.empty()) r.notes += (r.notes.empty() ? "" : " ") + n;
     }
@@ -1045,8 +1099,14 @@ void Pair::writeSummary() {
       << "     \"fit_beta\": " << (r.has_fit ? "\"done\"" : jsonString(m_fit_note.count(kName(K)) ? m_fit_note.at(kName(K)) : m_status.count("fit") ? m_status.at("fit") : "not run"))
       << ", \"z\": " << interval(r.fz, r.fz_low, r.fz_high) << ", \"fit_window\": [" << jsonNumber(r.w0) << ", "
       << jsonNumber(r.w1) << "],\n     \"beta_from_z\": " << interval(r.bz, r.bz_low, r.bz_high)
-      << ", \"beta_fit\": " << interval(r.bf, r.bf_low, r.bf_high) << ", \"S_c\": " << jsonNumber(r.S_c)
-      << ", \"tau_c\": " << jsonNumber(r.tau_c) << ", \"fit_notes\": " << jsonString(r.notes) << ",\n     \"paper_z\": "
+      << ", \"beta_asymptotic\": " << interval(r.ba, r.ba_low, r.ba_high)
+      << ", \"beta_fit\": " << interval(r.bf, r.bf_low, r.bf_high) << ", \"beta_fit_determined\": "
+      << (r.bf_determined ? "true" : "false") << ", \"S_c\": " << jsonNumber(r.S_c)
+      << ", \"tau_c\": " << jsonNumber(r.tau_c) << ", \"fit_notes\": " << jsonString(r.notes) << ",\n"
+      << "     \"growth_factor\": " << jsonNumber(r.regime.growth_factor) << ", \"onset_time\": " << jsonNumber(r.onset)
+      << ", \"onset_time_se\": " << jsonNumber(r.onset_err) << ", \"regime\": " << jsonString(r.regime.regime)
+      << ", \"regime_reason\": " << jsonString(r.regime.reason) << ", \"validation\": "
+      << jsonString(validationLine(K)) << ",\n     \"paper_z\": "
       << (K == 0 ? "1.21, \"paper_z_pm\": 0.04" : "1.49, \"paper_z_pm\": 0.012, \"paper_note\": \"the paper's charged value (K = 5)\"")
       << "}" << (k + 1 < m_c.K.size() ? "," : "") << "\n";
   }
@@ -1110,10 +1170,16 @@ void Pair::printSummary() {
     std::printf("pair: K = %-5s z = %s [%s, %s] (analyze, grid, t in [%s, %s])", formatReal(K).c_str(), fmt(r.z).c_str(),
                 fmt(r.z_low).c_str(), fmt(r.z_high).c_str(), fmt(r.fit_t_min, 3).c_str(), fmt(r.fit_t_max, 3).c_str());
     std::printf("   paper: %s\n", K == 0 ? "1.21 +- 0.04" : "1.49 +- 0.012 (K = 5)");
+    std::printf("pair:           regime: %s (%s)\n", r.regime.regime.c_str(), r.regime.reason.c_str());
+    const std::string v = validationLine(K);
+    if (!v.empty()) std::printf("pair:           %s\n", v.c_str());
     if (r.has_fit)
-      std::printf("pair:           fit-beta: z = %s [%s, %s], beta from z = %s [%s, %s], full-curve beta = %s [%s, %s]\n",
+      std::printf("pair:           fit-beta: z = %s [%s, %s], beta from z = %s [%s, %s], asymptotic beta = %s [%s, %s], "
+                  "full-curve beta = %s\n",
                   fmt(r.fz).c_str(), fmt(r.fz_low).c_str(), fmt(r.fz_high).c_str(), fmt(r.bz, 2).c_str(), fmt(r.bz_low, 2).c_str(),
-                  fmt(r.bz_high, 2).c_str(), fmt(r.bf, 2).c_str(), fmt(r.bf_low, 2).c_str(), fmt(r.bf_high, 2).c_str());
+                  fmt(r.bz_high, 2).c_str(), fmt(r.ba, 2).c_str(), fmt(r.ba_low, 2).c_str(), fmt(r.ba_high, 2).c_str(),
+                  r.bf_determined ? (fmt(r.bf, 2) + " [" + fmt(r.bf_low, 2) + ", " + fmt(r.bf_high, 2) + "]").c_str()
+                                  : "not determined (at the bound of its range)");
     if (r.has_fit && !r.notes.empty())
       std::printf("pair:           fit-beta note: %.200s%s\n", r.notes.c_str(), r.notes.size() > 200 ? "..." : "");
     if (!r.has_fit)
@@ -1229,7 +1295,7 @@ void registerPairCommand(CLI::App& app, const CliContext& ctx) {
       "--jobs runs at a time), their analysis, the mean field (Smoluchowski S(t) for beta = 2, 3 and z(beta)), the\n"
       "beta fit, the paper's figures and report.html, and summary.json. An interrupted study resumes: run the same\n"
       "command again and finished runs are not redone.");
-  c->add_option("--preset", a->preset, "Pair preset from data/pair: tiny, quick, paper");
+  c->add_option("--preset", a->preset, "Pair preset from data/pair: tiny, quick, paper, validate-neutral, validate-charged, validate-box");
   c->add_option("-c,--config", a->config, "Pair configuration TOML (keys: docs/pair.md)");
   c->add_option("--K", a->K, "Comma-separated Coulomb constants, e.g. 0,5 (overrides pair.K)");
   c->add_option("--runs", a->runs, "Runs per K (>= 1; overrides pair.runs)");

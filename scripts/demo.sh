@@ -3,8 +3,9 @@
 # mean-field study (issue 6, docs/pair.md): neutral (K = 0) and charged (K = 5) granular gases,
 # 3 MD runs each, their analysis, the Smoluchowski mean field (S(t) for beta = 2 and 3, z(beta)),
 # the beta fit, the paper's eight figures, summary.json and a self-contained report.html.
-# About 4 minutes on 2 cores after the build (227 s measured 2026-11-23; data/pair/quick.toml
-# states the sizes).
+# Under 10 minutes on 2 cores after the build (data/pair/quick.toml states the sizes; the measured
+# time is in docs/validation.md, "The demo"). Both ensembles aggregate; the summary says in which
+# regime (none / onset / scaling) and prints the validation study's numbers beside the demo's.
 #   usage: bash scripts/demo.sh [OUTDIR]     (default: results/demo-<date>-<time>; never reused)
 #   GRANAGG_BUILD_DIR   build folder (default: build)
 set -euo pipefail

@@ -89,7 +89,22 @@ def main():
         w(f"<tr><td>{esc(e['K'])}</td><td>{esc(e.get('runs'))}</td><td>{esc(e.get('N'))}</td><td>{esc(e.get('t_end'))}</td>"
           f"<td>{interval(e.get('z_analyze'))}</td><td>[{num(win[0], 3)}, {num(win[1], 3)}]</td>"
           f"<td>{interval(e.get('z'))}{fit_note}</td><td>{interval(e.get('beta_from_z'), 2)}</td>"
-          f"<td>{interval(e.get('beta_fit'), 2)}{beta_note}</td><td>{esc(e.get('paper_z'))} &plusmn; {esc(e.get('paper_z_pm'))}</td></tr>")
+          f"<td>{interval(e.get('beta_fit'), 2) if e.get('beta_fit_determined', True) else 'not determined (at a bound of the search range)'}{beta_note}</td><td>{esc(e.get('paper_z'))} &plusmn; {esc(e.get('paper_z_pm'))}</td></tr>")
+    w("</table>")
+    w("<h2>Which regime are these numbers in?</h2>")
+    w("<p class='small'>A growth exponent is a result only where S(t) has left its onset and its local slope is "
+      "flat (design.md section 3). Regime of the ensemble-mean S_grid at the end of the runs: <b>none</b> (S has not "
+      "doubled), <b>onset</b> (S grows but the local slope over the last half decade still changes by more than 25 %), "
+      "<b>scaling</b> (flat within 25 %). Beside it, the validation study's number for the same K "
+      "(docs/validation.md, data/validation/verdict.csv), so that a demo is not read as a result.</p>")
+    w("<table><tr><th>K</th><th>growth of S_grid</th><th>onset time t_c</th><th>regime</th><th>why</th>"
+      "<th>asymptotic beta 3z/(3-z)</th><th>validation study</th></tr>")
+    for e in s.get("ensembles", []):
+        w(f"<tr><td>{esc(e['K'])}</td><td>x{num(e.get('growth_factor'), 3)}</td>"
+          f"<td>{num(e.get('onset_time'), 3)} &plusmn; {num(e.get('onset_time_se'), 2)}</td>"
+          f"<td><b>{esc(e.get('regime', 'unknown'))}</b></td><td class='small'>{esc(e.get('regime_reason', ''))}</td>"
+          f"<td>{interval(e.get('beta_asymptotic'), 2)}</td>"
+          f"<td class='small'>{esc(e.get('validation') or 'no validation row for this K')}</td></tr>")
     w("</table>")
     w("<h2>Mean field (Smoluchowski equation, beta kernel, sectional solver)</h2>")
     w("<table><tr><th>beta</th><th>z local at S ~ 250</th><th>z local at S ~ 1650</th><th>z asymptotic</th>"

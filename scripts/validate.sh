@@ -1,0 +1,146 @@
+#!/usr/bin/env bash
+# The validation study (issue 14, docs/validation.md): does granagg reproduce Singh & Mazza 2018?
+# Runs paired MD / mean-field studies with `granagg pair` (each resumable: run the same command
+# again and finished runs are not redone), re-analyses them with other cluster definitions, fits
+# z and beta over several windows, and collects tables and figures into OUT/report/.
+#
+#   usage: bash scripts/validate.sh [--out DIR] [PART ...]
+#     DIR   default results/validate (reused: that is how the study resumes)
+#     PART  any of the parts below, in the order given; default: all, in this order
+#
+# part       what                                                          cost on 2 cores (measured)
+# neutral    K = 0, N = 50016, 20 runs to t = 1000 (data/pair/validate-neutral.toml)   ~22 min
+# charged5   K = 5, N = 1e4, Q = 0.05, 5 runs to t = 150 (validate-charged.toml)      ~30 min
+# box        K = 0, N = 400128 (L = 140), 1 run to t = 1000 (validate-box.toml)      ~12 min
+# charged1   K = 1, as charged5                                                       ~30 min
+# charged025 K = 0.25, as charged5                                                    ~30 min
+# qscan      K = 5 with Q = 0.025 and 0.1, 3 runs each (as charged5 otherwise)        ~35 min
+# fits       z and beta (fit-beta) over several windows, grid and particle clusters     ~1 min
+# sensitivity  grid spacing 1.5 / 2 / 3 d, threshold 0.2 / 0.25 / 0.3 on the neutral and K = 5
+#            ensembles (granagg analyze --no-particle), z over the windows              ~5 min
+# report     tables and figures of everything present: OUT/report/ (scripts/validation_report.py)
+#
+# Parts whose MD is not finished are resumed by running the same command again; `report` works
+# on whatever is present and says what is missing. Environment: GRANAGG_BUILD_DIR (default build),
+# VALIDATE_JOBS / VALIDATE_THREADS (passed to pair as --jobs / --threads when set).
+# The whole script is one brace group ending in exit: bash parses it completely before running
+# it, so editing this file while a long study runs cannot change what the running study does.
+{
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${GRANAGG_BUILD_DIR:-build}
+G="$BUILD_DIR/bin/granagg"
+PY=/usr/bin/python3
+
+OUT=results/validate
+PARTS=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --out) OUT=$2; shift 2 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | grep '^#' | sed 's/^# {0,1}//'; exit 0 ;;
+    neutral|charged5|box|charged1|charged025|qscan|fits|sensitivity|report) PARTS+=("$1"); shift ;;
+    *) echo "validate.sh: unknown part or option '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[ ${#PARTS[@]} -gt 0 ] || PARTS=(neutral charged5 box charged1 qscan charged025 fits sensitivity report)
+[ -x "$G" ] || bash scripts/setup.sh
+mkdir -p "$OUT"
+LOG="$OUT/validate.log"
+say() { echo "[$(date -u +%FT%TZ)] $*" | tee -a "$LOG" >&2; }
+
+PAIR_OPTS=(-q)
+[ -n "${VALIDATE_JOBS:-}" ] && PAIR_OPTS+=(--jobs "$VALIDATE_JOBS")
+[ -n "${VALIDATE_THREADS:-}" ] && PAIR_OPTS+=(--threads "$VALIDATE_THREADS")
+
+# pair NAME ARGS...: one resumable pair study into OUT/NAME, timed into OUT/cost.csv
+pair() {
+  local name=$1; shift
+  local t0; t0=$(date +%s)
+  # Tables written by an older granagg (before the onset time and the asymptotic beta existed)
+  # are redone: their markers go, the MD runs stay.
+  local f
+  for f in "$OUT/$name"/analysis/K*/fits.csv; do
+    [ -f "$f" ] && ! grep -q onset_time_grid "$f" && rm -f "${f%/fits.csv}.done"
+  done
+  for f in "$OUT/$name"/fit/K*/fit_beta.json; do
+    [ -f "$f" ] && ! grep -q beta_asymptotic "$f" && rm -f "${f%/fit_beta.json}.done"
+  done
+  say "part $name: granagg pair $* --out $OUT/$name"
+  "$G" pair "$@" --out "$OUT/$name" "${PAIR_OPTS[@]}"
+  local dt=$(( $(date +%s) - t0 ))
+  say "part $name: done in $dt s (wall time of this call; resumed parts count only what was left)"
+  echo "$name,$dt,$(date -u +%FT%TZ)" >> "$OUT/cost.csv"
+}
+
+# A pair configuration for the Q scan: validate-charged.toml with charged.Q replaced.
+q_config() {
+  local q=$1 f="$OUT/config/validate-charged-Q$1.toml"
+  mkdir -p "$OUT/config"
+  sed -e "s/^Q = 0.05 .*/Q = $q/" -e "s/^name = \"validate-charged\"/name = \"validate-charged-Q$q\"/" \
+      -e "s/^runs = 5/runs = 3/" data/pair/validate-charged.toml > "$f"
+  grep -q "^Q = $q\$" "$f" || { echo "validate.sh: could not set Q in $f" >&2; exit 1; }
+  echo "$f"
+}
+
+# sensitivity NAME WINDOW0 WINDOW1: grid-cluster variants of the ensemble OUT/NAME
+sensitivity() {
+  local name=$1 w0=$2 w1=$3 dir="$OUT/sensitivity/$1"
+  [ -d "$OUT/$name/runs" ] || { say "sensitivity: $OUT/$name has no runs yet, skipped"; return; }
+  mkdir -p "$dir"
+  local variant spacing fill
+  for variant in "1.5 0.25" "2 0.25" "3 0.25" "2 0.2" "2 0.3"; do
+    read -r spacing fill <<< "$variant"
+    local v="grid${spacing}_fill${fill}"
+    if [ ! -f "$dir/$v/S_t.csv" ]; then
+      say "sensitivity $name $v: granagg analyze --grid-spacing $spacing --grid-min-fill $fill"
+      rm -rf "$dir/$v"
+      "$G" analyze "$OUT/$name"/runs/K*/run* --no-particle --grid-spacing "$spacing" \
+        --grid-min-fill "$fill" --fit-window "$w0" "$w1" --msd-origins t0 -q --out "$dir/$v"
+    fi
+    if [ ! -f "$dir/$v/fit/fit_beta.json" ]; then
+      "$G" fit-beta "$dir/$v" --window "$w0" "$w1" --no-curve-fit -q --out "$dir/$v/fit"
+    fi
+  done
+}
+
+# fits NAME COLUMN "T0 T1" ...: fit-beta (z, beta from z, asymptotic beta) over several windows
+fits() {
+  local name=$1 column=$2; shift 2
+  local w
+  for w in "$@"; do
+    local w0 w1; read -r w0 w1 <<< "$w"
+    local dir="$OUT/$name/windows/${column}_${w0}_${w1}"
+    [ -d "$OUT/$name/analysis" ] || { say "fits: $OUT/$name has no analysis yet, skipped"; return; }
+    [ -f "$dir/fit_beta.json" ] && grep -q beta_asymptotic "$dir/fit_beta.json" && continue
+    local a; for a in "$OUT/$name"/analysis/K*; do
+      [ -f "$a/S_t.csv" ] || continue
+      "$G" fit-beta "$a" --column "$column" --window "$w0" "$w1" --no-curve-fit -q --force --out "$dir" \
+        || say "fits: $name $column [$w0, $w1]: fit-beta refused (see above)"
+    done
+  done
+}
+
+for part in "${PARTS[@]}"; do
+  case "$part" in
+    neutral)    pair neutral --preset validate-neutral ;;
+    charged5)   pair charged-K5 --preset validate-charged --K 5 ;;
+    box)        pair box --preset validate-box ;;
+    charged1)   pair charged-K1 --preset validate-charged --K 1 ;;
+    charged025) pair charged-K0.25 --preset validate-charged --K 0.25 ;;
+    qscan)      pair charged-K5-Q0.025 --config "$(q_config 0.025)" --K 5
+                pair charged-K5-Q0.1 --config "$(q_config 0.1)" --K 5 ;;
+    fits)       fits neutral S_grid_mean "100 1000" "300 1000" "631 1000"
+                fits box S_grid_mean "100 1000" "631 1000"
+                for c in charged-K5 charged-K1 charged-K0.25 charged-K5-Q0.025 charged-K5-Q0.1; do
+                  fits "$c" S_grid_mean "10 150" "50 150" "80 150"
+                  fits "$c" S_particle_mean "10 150" "50 150" "80 150"
+                done ;;
+    sensitivity) sensitivity neutral 100 1000
+                 sensitivity charged-K5 50 150 ;;
+    report)     say "report: $PY scripts/validation_report.py $OUT"
+                "$PY" scripts/validation_report.py "$OUT" ;;
+  esac
+done
+say "validate.sh: parts ${PARTS[*]} finished; report in $OUT/report/"
+exit
+}
