@@ -16,7 +16,7 @@
 # charged025 K = 0.25, as charged5                                                    ~30 min
 # qscan      K = 5 with Q = 0.025 and 0.1, 3 runs each (as charged5 otherwise)        ~35 min
 # fits       z and beta (fit-beta) over several windows, grid and particle clusters     ~1 min
-# sensitivity  grid spacing 1.5 / 2 / 3 d, threshold 0.2 / 0.25 / 0.3 on the neutral and K = 5
+# sensitivity  grid spacing 1.5 / 2 / 3 d, threshold 3 / 4 / 5 centres per 2 d cell on the neutral and K = 5
 #            ensembles (granagg analyze --no-particle), z over the windows              ~5 min
 # report     tables and figures of everything present: OUT/report/ (scripts/validation_report.py)
 #
@@ -85,17 +85,25 @@ q_config() {
 # sensitivity NAME WINDOW0 WINDOW1: grid-cluster variants of the ensemble OUT/NAME
 sensitivity() {
   local name=$1 w0=$2 w1=$3 dir="$OUT/sensitivity/$1"
-  [ -d "$OUT/$name/runs" ] || { say "sensitivity: $OUT/$name has no runs yet, skipped"; return; }
+  # only a finished study (its analysis exists): a running one holds its trajectories open
+  compgen -G "$OUT/$name/analysis/K*/S_t.csv" > /dev/null \
+    || { say "sensitivity: $OUT/$name has no finished analysis yet, skipped"; return 0; }
   mkdir -p "$dir"
   local variant spacing fill
-  for variant in "1.5 0.25" "2 0.25" "3 0.25" "2 0.2" "2 0.3"; do
-    read -r spacing fill <<< "$variant"
-    local v="grid${spacing}_fill${fill}"
+  # threshold by filling fraction (0.25: 4 centres in the 2 d cell of L = 70; 0.2 gives the same
+  # integer count, so the threshold scan is by count: 3, 4, 5 centres = filling 0.20, 0.26, 0.33)
+  for variant in "1.5 fill0.25" "2 fill0.25" "3 fill0.25" "2 count3" "2 count5"; do
+    read -r spacing thr <<< "$variant"
+    local v="grid${spacing}_${thr}" opt
+    case "$thr" in
+      fill*) opt=(--grid-min-fill "${thr#fill}") ;;
+      count*) opt=(--grid-min-count "${thr#count}") ;;
+    esac
     if [ ! -f "$dir/$v/S_t.csv" ]; then
-      say "sensitivity $name $v: granagg analyze --grid-spacing $spacing --grid-min-fill $fill"
+      say "sensitivity $name $v: granagg analyze --grid-spacing $spacing ${opt[*]}"
       rm -rf "$dir/$v"
-      "$G" analyze "$OUT/$name"/runs/K*/run* --no-particle --grid-spacing "$spacing" \
-        --grid-min-fill "$fill" --fit-window "$w0" "$w1" --msd-origins t0 -q --out "$dir/$v"
+      "$G" analyze "$OUT/$name"/runs/K*/run* --no-particle --grid-spacing "$spacing" "${opt[@]}" \
+        --fit-window "$w0" "$w1" --msd-origins t0 -q --out "$dir/$v"
     fi
     if [ ! -f "$dir/$v/fit/fit_beta.json" ]; then
       "$G" fit-beta "$dir/$v" --window "$w0" "$w1" --no-curve-fit -q --out "$dir/$v/fit"
@@ -110,7 +118,8 @@ fits() {
   for w in "$@"; do
     local w0 w1; read -r w0 w1 <<< "$w"
     local dir="$OUT/$name/windows/${column}_${w0}_${w1}"
-    [ -d "$OUT/$name/analysis" ] || { say "fits: $OUT/$name has no analysis yet, skipped"; return; }
+    compgen -G "$OUT/$name/analysis/K*/S_t.csv" > /dev/null \
+      || { say "fits: $OUT/$name has no finished analysis yet, skipped"; return 0; }
     [ -f "$dir/fit_beta.json" ] && grep -q beta_asymptotic "$dir/fit_beta.json" && continue
     local a; for a in "$OUT/$name"/analysis/K*; do
       [ -f "$a/S_t.csv" ] || continue

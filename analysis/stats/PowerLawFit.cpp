@@ -16,7 +16,9 @@ PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<do
   if (!(confidence > 0.0 && confidence < 1.0)) throw std::invalid_argument("fitPowerLaw: confidence must lie in (0, 1).");
   std::vector<double> lx, ly;
   for (std::size_t k = 0; k < t.size(); ++k)
-    if (t[k] > 0 && t[k] >= t_min && t[k] <= t_max && y[k] > 0 && std::isfinite(y[k]) && std::isfinite(t[k])) {
+    // Window ends include samples within a relative 1e-4 (WINDOW_SLACK): MD frames sit on whole
+    // steps, so the frame meant for t = 1000 may be at 1000.001 and must not drop out.
+    if (t[k] > 0 && t[k] >= t_min * (1 - WINDOW_SLACK) && t[k] <= t_max * (1 + WINDOW_SLACK) && y[k] > 0 && std::isfinite(y[k]) && std::isfinite(t[k])) {
       lx.push_back(std::log(t[k]));
       ly.push_back(std::log(y[k]));
     }

@@ -8,6 +8,10 @@
 
 namespace granagg::analysis {
 
+/// Relative slack of the fit windows' ends: a sample within t_min (1 - 1e-4) .. t_max (1 + 1e-4)
+/// is inside (frames sit on whole time steps, a little past their nominal times).
+constexpr double WINDOW_SLACK = 1e-4;
+
 struct PowerLawFitResult {
   bool valid = false;
   double exponent = 0.0;   ///< z

@@ -146,8 +146,10 @@ SlopeWindow explicitWindow(const GrowthData& data, double t0, double t1, int min
   SlopeWindow w;
   w.automatic = false;
   bool first = true;
+  // Ends include samples within a relative 1e-4: MD frames sit on whole steps, so the frame
+  // meant for t = 1000 may be at 1000.001 and must not drop out of a window [., 1000].
   for (double t : data.t)
-    if (t >= t0 && t <= t1) {
+    if (t >= t0 * (1 - 1e-4) && t <= t1 * (1 + 1e-4)) {
       if (first) w.t0 = t;
       first = false;
       w.t1 = t;

@@ -74,7 +74,8 @@ struct SlopeWindow {
 /// not flat. Samples correlated in time (one MD run) make the noise look smaller and the window
 /// shorter, never longer. Throws std::invalid_argument when the data hold fewer than min_points.
 SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& options = {});
-/// The window [t0, t1] given by the user; throws std::invalid_argument when t0 >= t1 or fewer than
+/// The window [t0, t1] given by the user (ends widened by a relative 1e-4, so that a frame a
+/// rounding step past t1 stays inside); throws std::invalid_argument when t0 >= t1 or fewer than
 /// min_points samples fall inside.
 SlopeWindow explicitWindow(const GrowthData& data, double t0, double t1, int min_points = 5);
 
