@@ -210,14 +210,24 @@ def main():
                 continue
             zmin, zmax = growth_regime(S)
             last = np.where(np.isfinite(S["S_grid_mean"]))[0][-1]
-            se_rows.append(dict(part=name, variant=v, z=float(f["z_grid"][0]), z_low=float(f["z_grid_low"][0]),
-                                z_high=float(f["z_grid_high"][0]), t0=float(f["fit_t_min"][0]), t1=float(f["fit_t_max"][0]),
+            fp = read(os.path.join(sd, name, v, "fisher_pooled.csv"))
+            ls = {}
+            for t in (50.0, 150.0, float(S["t"][last])):
+                k = nearest_row(fp, t) if fp is not None else None
+                ls[t] = -float(fp["tau_ls_grid"][k]) if k is not None else float("nan")
+            lst = list(ls.values())
+            se_rows.append(dict(part=name, variant=v, t0=float(f["fit_t_min"][0]), t1=float(f["fit_t_max"][0]),
                                 fb_z=j.get("z"), fb_z_low=j.get("z_low"), fb_z_high=j.get("z_high"),
                                 onset=float(f["onset_time_grid"][0]), S_base=float(f["onset_S_base_grid"][0]),
-                                S_end=float(S["S_grid_mean"][last]), zloc_min=zmin, zloc_max=zmax))
+                                S_end=float(S["S_grid_mean"][last]), zloc_min=zmin, zloc_max=zmax,
+                                fisher_ls_t50=lst[0], fisher_ls_t150=lst[1], fisher_ls_end=lst[2],
+                                occupied=float(S["occupied_fraction_mean"][1]) if col(S, "occupied_fraction_mean") is not None
+                                else float("nan")))
     write_csv(os.path.join(rep, "sensitivity.csv"), se_rows,
-              "# grid-cluster definitions: grid<spacing>_fill<threshold>; z: analyze (percentile bootstrap), fb_z: "
-              "fit-beta (t-corrected bootstrap) over [t0, t1]; onset and local slope as in ensembles.csv")
+              "# grid-cluster definitions: grid<spacing>_fill<filling fraction> or _count<centres per cell>; fb_z: "
+              "fit-beta z over [t0, t1] (bootstrap over runs); onset and local slope as in ensembles.csv; fisher_ls_*: "
+              "the paper's Fisher slope (-tau, log-binned least squares) at t = 50, 150 and the last frame; "
+              "occupied: fraction of occupied sites in the first frame after t = 0")
 
     figures(have, rep, out)
     verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing)
@@ -263,9 +273,9 @@ def cell(v):
 
 def figures(have, rep, out):
     by = {p.name: p for p in have}
-    # Fig. 5 analogue: S_grid(t) per ensemble with standard errors; inset: local slope against 1/t.
-    fig, ax = plt.subplots(figsize=(8, 5.5))
-    ins = ax.inset_axes([0.64, 0.1, 0.33, 0.36])
+    # Fig. 5 analogue: S_grid(t) per ensemble with standard errors; beside it (the paper's inset),
+    # the local slope of the mean against 1/t.
+    fig, (ax, ins) = plt.subplots(1, 2, figsize=(12, 4.8), gridspec_kw={"width_ratios": [1.4, 1]})
     for p in have:
         S = p.table("S_t.csv")
         m = (S["t"] > 0) & np.isfinite(S["S_grid_mean"])
@@ -273,16 +283,14 @@ def figures(have, rep, out):
                     label=f"{p.label} ({int(p.fits()['runs'])} runs)")
         z = col(S, "z_local_grid_of_mean")
         mz = m & np.isfinite(z) & (S["t"] >= 5)
-        ins.plot(1.0 / S["t"][mz], z[mz], ".-", ms=2, lw=0.7, color=p.colour)
-    ins.axhline(PAPER["z_neutral"]["value"], color="k", ls="--", lw=0.7)
-    ins.axhline(PAPER["z_charged"]["value"], color="k", ls=":", lw=0.7)
-    ins.set_xscale("log")
-    ins.set_xlabel("1/t", fontsize=8)
-    ins.set_ylabel("local slope z(t)", fontsize=8)
-    ins.tick_params(labelsize=7)
-    ins.text(0.98, 0.95, "paper: 1.21 (--), 1.49 (:)", transform=ins.transAxes, ha="right", va="top", fontsize=7)
+        ins.plot(1.0 / S["t"][mz], z[mz], ".-", ms=3, lw=0.8, color=p.colour, label=p.label)
+    ins.axhline(PAPER["z_neutral"]["value"], color="k", ls="--", lw=0.8, label="paper: 1.21 (neutral)")
+    ins.axhline(PAPER["z_charged"]["value"], color="k", ls=":", lw=0.8, label="paper: 1.49 (charged)")
+    ins.set(xscale="log", xlabel="1/t", ylabel="local slope z(t) = ln[S(t)/S(t/2)]/ln 2",
+            title="local slope of the mean S (the paper's Fig. 5 inset)")
+    ins.legend(fontsize=7)
     ax.set(xscale="log", yscale="log", xlabel="t", ylabel=r"$S_{grid}(t)$ (grid sites)",
-           title="Mean cluster size (grid clusters, mean $\\pm$ s.e. over runs); inset: local slope")
+           title="mean cluster size, grid clusters (mean $\\pm$ s.e. over runs)")
     ax.legend(fontsize=8, loc="upper left")
     save(fig, rep, "fig_growth")
 
@@ -478,10 +486,13 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
         th = p.table("thermo.csv")
         if th is None:
             continue
-        lo, hi = (100, 1000) if p.K() == 0 else (50, 150)
-        s = late_slope(th["t"], th["T_g_mean"], lo, hi)
-        lines.append(f"| T_g exponent, {p.name} (t = {lo}..{hi}) | -5/3 = -1.667 (viscoelastic, neutral) | {fmt(s)} | "
-                     f"{'yes' if abs(s + 5 / 3) < 0.1 else 'no'} | least squares of ln T_g on ln t (a check, in Python) |")
+        for lo, hi in ((20, 200), (300, 1000)) if p.K() == 0 else ((10, 50), (50, 150)):
+            s = late_slope(th["t"], th["T_g_mean"], lo, hi)
+            if not np.isfinite(s):
+                continue
+            lines.append(f"| T_g exponent, {p.name} (t = {lo}..{hi}) | -5/3 = -1.667 (viscoelastic, neutral, "
+                         f"homogeneous) | {fmt(s)} | {'yes' if abs(s + 5 / 3) < 0.1 else 'no'} | least squares of ln T_g "
+                         f"on ln t (a check, in Python) |")
     # beta
     for p in have:
         fb = p.fit_beta()
@@ -492,12 +503,15 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
                      f"{ival(fb.get('beta_asymptotic'), fb.get('beta_asymptotic_low'), fb.get('beta_asymptotic_high'))}; "
                      f"at the data's S: {ival(fb.get('beta_from_z'), fb.get('beta_from_z_low'), fb.get('beta_from_z_high'))}; "
                      f"curve fit: {'not determined' if not fb.get('beta_fit_determined', True) else fmt(fb.get('beta_fit'))} | "
-                     f"see text | z = {ival(fb.get('z'), fb.get('z_low'), fb.get('z_high'))} |")
+                     f"see text | z = {ival(fb.get('z'), fb.get('z_low'), fb.get('z_high'))}; regime at the end: "
+                     f"{p.ens.get('regime', '?')} (the asymptotic map needs a scaling regime) |")
     # sensitivity summary
     for r in se_rows:
         lines.append(f"| z, {r['part']}, grid {r['variant']} (t = {fmt(r['t0'])}..{fmt(r['t1'])}) | - | "
                      f"{ival(r['fb_z'], r['fb_z_low'], r['fb_z_high'])} | - | onset {fmt(r['onset'])}, S_end "
-                     f"{fmt(r['S_end'])}, local slope {fmt(r['zloc_min'])}..{fmt(r['zloc_max'])} |")
+                     f"{fmt(r['S_end'])}, local slope {fmt(r['zloc_min'])}..{fmt(r['zloc_max'])}; Fisher slope (LS) "
+                     f"{fmt(r['fisher_ls_t50'])} (t = 50), {fmt(r['fisher_ls_t150'])} (150), {fmt(r['fisher_ls_end'])} "
+                     f"(end); occupied {fmt(r['occupied'], 2)} |")
     if missing:
         lines.append(f"\nParts not (yet) run: {', '.join(missing)} (rerun scripts/validate.sh to resume).")
     with open(os.path.join(rep, "verdict.md"), "w") as f:
