@@ -10,9 +10,10 @@
 
 namespace granagg::analysis {
 
-LogBinnedFit fitLogBinnedPowerLaw(const std::map<std::uint64_t, std::uint64_t>& counts, double ratio,
-                                  std::size_t min_bins) {
-  if (!(ratio > 1.0) || !std::isfinite(ratio)) throw std::invalid_argument("log-binned fit: bin ratio must be > 1");
+LogBinnedFit fitLogBinnedPowerLaw(const std::map<std::uint64_t, std::uint64_t>& counts,
+                                  double ratio, std::size_t min_bins) {
+  if (!(ratio > 1.0) || !std::isfinite(ratio))
+    throw std::invalid_argument("log-binned fit: bin ratio must be > 1");
   if (min_bins < 3) throw std::invalid_argument("log-binned fit: needs at least 3 bins");
   LogBinnedFit fit;
   if (counts.empty()) return fit;
@@ -48,10 +49,13 @@ LogBinnedFit fitLogBinnedPowerLaw(const std::map<std::uint64_t, std::uint64_t>& 
   return fit;
 }
 
-OnsetTime onsetTime(const std::vector<double>& t, const std::vector<double>& S, double factor, double t_base) {
+OnsetTime onsetTime(const std::vector<double>& t, const std::vector<double>& S, double factor,
+                    double t_base) {
   if (t.size() != S.size()) throw std::invalid_argument("onset time: t and S differ in length");
-  if (!(factor > 1.0) || !std::isfinite(factor)) throw std::invalid_argument("onset time: factor must be > 1");
-  if (!(t_base > 0.0) || !std::isfinite(t_base)) throw std::invalid_argument("onset time: baseline time must be > 0");
+  if (!(factor > 1.0) || !std::isfinite(factor))
+    throw std::invalid_argument("onset time: factor must be > 1");
+  if (!(t_base > 0.0) || !std::isfinite(t_base))
+    throw std::invalid_argument("onset time: baseline time must be > 0");
   OnsetTime o;
   std::vector<double> early;
   for (std::size_t k = 0; k < t.size(); ++k)
@@ -83,8 +87,10 @@ OnsetTime onsetTime(const std::vector<double>& t, const std::vector<double>& S, 
 }
 
 GrowthRegime classifyGrowth(const std::vector<double>& t, const std::vector<double>& S,
-                            const std::vector<double>& z_local, double factor, double t_base, double flat_tolerance) {
-  if (z_local.size() != t.size()) throw std::invalid_argument("growth regime: t and z_local differ in length");
+                            const std::vector<double>& z_local, double factor, double t_base,
+                            double flat_tolerance) {
+  if (z_local.size() != t.size())
+    throw std::invalid_argument("growth regime: t and z_local differ in length");
   const double NaN = std::numeric_limits<double>::quiet_NaN();
   GrowthRegime g;
   const OnsetTime on = onsetTime(t, S, factor, t_base);
@@ -101,18 +107,23 @@ GrowthRegime classifyGrowth(const std::vector<double>& t, const std::vector<doub
   char buf[320];
   if (!(g.growth_factor >= factor)) {
     g.regime = "none";
-    std::snprintf(buf, sizeof buf, "S grew by a factor %.3g by t = %.4g, less than %g: no aggregation yet", g.growth_factor,
-                  t_last, factor);
+    std::snprintf(buf, sizeof buf,
+                  "S grew by a factor %.3g by t = %.4g, less than %g: no aggregation yet",
+                  g.growth_factor, t_last, factor);
     g.reason = buf;
     return g;
   }
   std::vector<double> z;
   for (std::size_t k = 0; k < t.size(); ++k)
-    if (t[k] >= t_last / std::sqrt(10.0) && t[k] <= t_last && std::isfinite(z_local[k])) z.push_back(z_local[k]);
+    if (t[k] >= t_last / std::sqrt(10.0) && t[k] <= t_last && std::isfinite(z_local[k]))
+      z.push_back(z_local[k]);
   if (z.size() < 3) {
     g.regime = "onset";
-    std::snprintf(buf, sizeof buf, "S grew by a factor %.3g (onset t_c = %.4g); fewer than 3 local slopes in the last "
-                  "half decade, no scaling regime can be claimed", g.growth_factor, g.t_c);
+    std::snprintf(
+        buf, sizeof buf,
+        "S grew by a factor %.3g (onset t_c = %.4g); fewer than 3 local slopes in the last "
+        "half decade, no scaling regime can be claimed",
+        g.growth_factor, g.t_c);
     g.reason = buf;
     return g;
   }
@@ -123,9 +134,11 @@ GrowthRegime classifyGrowth(const std::vector<double>& t, const std::vector<doub
   mean /= static_cast<double>(z.size());
   const bool flat = mean > 0 && (g.z_local_max - g.z_local_min) <= flat_tolerance * mean;
   g.regime = flat ? "scaling" : "onset";
-  std::snprintf(buf, sizeof buf, "S grew by a factor %.3g (onset t_c = %.4g); local slope %.3g..%.3g over t = %.4g..%.4g: %s",
-                g.growth_factor, g.t_c, g.z_local_min, g.z_local_max, t_last / std::sqrt(10.0), t_last,
-                flat ? "flat, a scaling regime" : "still changing, not yet a power law");
+  std::snprintf(
+      buf, sizeof buf,
+      "S grew by a factor %.3g (onset t_c = %.4g); local slope %.3g..%.3g over t = %.4g..%.4g: %s",
+      g.growth_factor, g.t_c, g.z_local_min, g.z_local_max, t_last / std::sqrt(10.0), t_last,
+      flat ? "flat, a scaling regime" : "still changing, not yet a power law");
   g.reason = buf;
   return g;
 }

@@ -25,22 +25,23 @@ namespace granagg::analysis {
 
 struct LogBinnedFit {
   bool valid = false;
-  double tau = 0.0;      ///< minus the least-squares slope of ln(density) on ln(s_c)
-  double tau_err = 0.0;  ///< its standard error from the residuals (bins - 2 degrees of freedom)
-  std::size_t bins = 0;  ///< non-empty bins fitted
+  double tau = 0.0;         ///< minus the least-squares slope of ln(density) on ln(s_c)
+  double tau_err = 0.0;     ///< its standard error from the residuals (bins - 2 degrees of freedom)
+  std::size_t bins = 0;     ///< non-empty bins fitted
   std::uint64_t s_max = 0;  ///< largest size present
 };
 
 /// The paper's Fisher exponent from a size histogram (size -> count). Bins with no cluster are left
 /// out (their logarithm does not exist). Needs clusters in at least `min_bins` (>= 3) bins,
 /// otherwise `valid` is false. Throws std::invalid_argument for ratio <= 1 or min_bins < 3.
-LogBinnedFit fitLogBinnedPowerLaw(const std::map<std::uint64_t, std::uint64_t>& counts, double ratio = 2.0,
-                                  std::size_t min_bins = 3);
+LogBinnedFit fitLogBinnedPowerLaw(const std::map<std::uint64_t, std::uint64_t>& counts,
+                                  double ratio = 2.0, std::size_t min_bins = 3);
 
 struct OnsetTime {
-  bool valid = false;      ///< false when S never reaches the threshold or no sample lies in (0, t_base]
-  double t_c = 0.0;        ///< onset time
-  double S_base = 0.0;     ///< median S over 0 < t <= t_base
+  bool valid =
+      false;         ///< false when S never reaches the threshold or no sample lies in (0, t_base]
+  double t_c = 0.0;  ///< onset time
+  double S_base = 0.0;       ///< median S over 0 < t <= t_base
   double S_threshold = 0.0;  ///< factor x S_base
 };
 
@@ -67,7 +68,7 @@ struct GrowthRegime {
 /// (max - min) / mean allowed for "scaling" (default 0.25: the paper's own local slopes vary by
 /// about that much over its plateau). Throws std::invalid_argument for mismatched lengths.
 GrowthRegime classifyGrowth(const std::vector<double>& t, const std::vector<double>& S,
-                            const std::vector<double>& z_local, double factor = 2.0, double t_base = 10.0,
-                            double flat_tolerance = 0.25);
+                            const std::vector<double>& z_local, double factor = 2.0,
+                            double t_base = 10.0, double flat_tolerance = 0.25);
 
 }  // namespace granagg::analysis

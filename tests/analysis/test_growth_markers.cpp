@@ -18,7 +18,8 @@ namespace {
 std::map<std::uint64_t, std::uint64_t> exactHistogram(double tau, double A, std::uint64_t s_max) {
   std::map<std::uint64_t, std::uint64_t> h;
   for (std::uint64_t s = 1; s <= s_max; ++s) {
-    const auto n = static_cast<std::uint64_t>(std::llround(A * std::pow(static_cast<double>(s), -tau)));
+    const auto n =
+        static_cast<std::uint64_t>(std::llround(A * std::pow(static_cast<double>(s), -tau)));
     if (n > 0) h[s] = n;
   }
   return h;
@@ -26,7 +27,8 @@ std::map<std::uint64_t, std::uint64_t> exactHistogram(double tau, double A, std:
 
 }  // namespace
 
-TEST_CASE("log-binned least squares recovers the exponent of an exact power-law histogram", "[analysis][fisher-ls]") {
+TEST_CASE("log-binned least squares recovers the exponent of an exact power-law histogram",
+          "[analysis][fisher-ls]") {
   // Bin densities of N_s = A s^-tau over [2^k, 2^(k+1)) equal A c(tau, k) s_c^-tau, where c tends
   // to a constant as k grows (the sum over a bin becomes an integral); the first bins (s = 1,
   // s = 2-3) deviate by a few per cent, which tilts the fitted line by less than 0.02 over the
@@ -59,7 +61,7 @@ TEST_CASE("log-binned least squares on samples of a discrete power law", "[analy
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::map<std::uint64_t, std::uint64_t> h;
   for (int k = 0; k < 20000; ++k) {
-    const double u = 1.0 - U(rng);  // (0, 1]
+    const double u = 1.0 - U(rng);             // (0, 1]
     const double x = std::pow(u, -1.0 / 1.5);  // continuous Pareto, density ~ x^-2.5 for x >= 1
     h[static_cast<std::uint64_t>(x)]++;
   }
@@ -108,8 +110,8 @@ TEST_CASE("onset time: the crossing of twice the early plateau", "[analysis][ons
 
 TEST_CASE("onset time: never reached, no baseline, NaN samples, bad options", "[analysis][onset]") {
   std::vector<double> t{1, 2, 5, 10, 20, 50}, S{1.2, 1.2, 1.3, 1.25, 1.4, 2.0};
-  CHECK_FALSE(onsetTime(t, S).valid);                      // never reaches 2 x 1.25
-  CHECK_FALSE(onsetTime(t, S, 2.0, 0.5).valid);            // no sample in (0, 0.5]
+  CHECK_FALSE(onsetTime(t, S).valid);            // never reaches 2 x 1.25
+  CHECK_FALSE(onsetTime(t, S, 2.0, 0.5).valid);  // no sample in (0, 0.5]
   std::vector<double> Sn{1.2, NAN, 1.2, 1.2, 3.0, 5.0};
   const OnsetTime o = onsetTime(t, Sn);
   REQUIRE(o.valid);

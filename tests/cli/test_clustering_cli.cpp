@@ -16,11 +16,11 @@
 
 #include "RunCommand.h"
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <string>
-#include <unistd.h>
 
 #include "common/Csv.h"
 
@@ -33,15 +33,18 @@ std::map<std::string, double> clusteringEnsemble(const fs::path& dir, double eps
   std::string runs;
   for (int seed = 1; seed <= 3; ++seed) {
     const fs::path out = dir / ("eps" + std::to_string(eps) + "_seed" + std::to_string(seed));
-    const Run r = runGranagg("md --preset haff --set system.N=2000 --set system.phi=0.15 --set contact.stiffness=2000 "
-                             "--set contact.restitution=" + std::to_string(eps) + " --set run.t_end=40 --seed " +
-                             std::to_string(seed) + " --threads 2 -q --out " + out.string());
+    const Run r = runGranagg(
+        "md --preset haff --set system.N=2000 --set system.phi=0.15 --set contact.stiffness=2000 "
+        "--set contact.restitution=" +
+        std::to_string(eps) + " --set run.t_end=40 --seed " + std::to_string(seed) +
+        " --threads 2 -q --out " + out.string());
     INFO(r.output);
     REQUIRE(r.status == 0);
     runs += " " + out.string();
   }
   const fs::path ana = dir / ("ana_eps" + std::to_string(eps));
-  const Run a = runGranagg("analyze" + runs + " --no-particle --fit-window 10 40 --threads 2 -q --out " + ana.string());
+  const Run a = runGranagg(
+      "analyze" + runs + " --no-particle --fit-window 10 40 --threads 2 -q --out " + ana.string());
   INFO(a.output);
   REQUIRE(a.status == 0);
   const granagg::common::CsvTable fits = granagg::common::readCsv((ana / "fits.csv").string());
@@ -55,15 +58,17 @@ std::map<std::string, double> clusteringEnsemble(const fs::path& dir, double eps
 
 }  // namespace
 
-TEST_CASE("a strongly dissipative gas clusters within seconds, an elastic one does not", "[cluster-growth]") {
-  const fs::path dir = fs::temp_directory_path() / ("granagg_clustering_" + std::to_string(::getpid()));
+TEST_CASE("a strongly dissipative gas clusters within seconds, an elastic one does not",
+          "[cluster-growth]") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("granagg_clustering_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
 
   const auto d = clusteringEnsemble(dir, 0.3);
   const double growth = d.at("S_end") / d.at("onset_S_base_grid");
-  INFO("dissipative: S_base " << d.at("onset_S_base_grid") << ", S(t = 40) " << d.at("S_end") << ", onset "
-                              << d.at("onset_time_grid") << ", z " << d.at("z_grid"));
+  INFO("dissipative: S_base " << d.at("onset_S_base_grid") << ", S(t = 40) " << d.at("S_end")
+                              << ", onset " << d.at("onset_time_grid") << ", z " << d.at("z_grid"));
   CHECK(d.at("t_end") == Approx(40.0));
   CHECK(growth > 3.0);
   CHECK(std::isfinite(d.at("onset_time_grid")));
