@@ -8,7 +8,7 @@
 #     DIR   default results/validate (reused: that is how the study resumes)
 #     PART  any of the parts below, in the order given; default: all, in this order
 #
-# part       what                                                          cost on 2 cores (measured)
+# part       what                                                         cost on 2 cores (measured)
 # neutral    K = 0, N = 50016, 20 runs to t = 1000 (data/pair/validate-neutral.toml)   ~22 min
 # charged5   K = 5, N = 1e4, Q = 0.05, 5 runs to t = 150 (validate-charged.toml)      ~30 min
 # box        K = 0, N = 400128 (L = 140), 1 run to t = 1000 (validate-box.toml)      ~12 min
@@ -16,8 +16,8 @@
 # charged025 K = 0.25, as charged5                                                    ~30 min
 # qscan      K = 5 with Q = 0.025 and 0.1, 3 runs each (as charged5 otherwise)        ~35 min
 # fits       z and beta (fit-beta) over several windows, grid and particle clusters     ~1 min
-# sensitivity  grid spacing 1.5 / 2 / 3 d, threshold 3 / 4 / 5 centres per 2 d cell on the neutral and K = 5
-#            ensembles (granagg analyze --no-particle), z over the windows              ~5 min
+# sensitivity  grid spacing 1.5 / 2 / 3 d, threshold 3 / 4 / 5 centres per 2 d cell on the
+#            neutral and K = 5 ensembles (granagg analyze --no-particle), z over the windows  ~5 min
 # report     tables and figures of everything present: OUT/report/ (scripts/validation_report.py)
 #
 # Parts whose MD is not finished are resumed by running the same command again; `report` works
@@ -37,12 +37,13 @@ PARTS=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) OUT=$2; shift 2 ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | grep '^#' | sed 's/^# {0,1}//'; exit 0 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | grep '^#' | sed -E 's/^# ?//'; exit 0 ;;
     neutral|charged5|box|charged1|charged025|qscan|fits|sensitivity|report) PARTS+=("$1"); shift ;;
     *) echo "validate.sh: unknown part or option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
-[ ${#PARTS[@]} -gt 0 ] || PARTS=(neutral charged5 box charged1 qscan charged025 fits sensitivity report)
+[ ${#PARTS[@]} -gt 0 ] \
+  || PARTS=(neutral charged5 box charged1 qscan charged025 fits sensitivity report)
 [ -x "$G" ] || bash scripts/setup.sh
 mkdir -p "$OUT"
 LOG="$OUT/validate.log"
@@ -76,7 +77,8 @@ pair() {
 q_config() {
   local q=$1 f="$OUT/config/validate-charged-Q$1.toml"
   mkdir -p "$OUT/config"
-  sed -e "s/^Q = 0.05 .*/Q = $q/" -e "s/^name = \"validate-charged\"/name = \"validate-charged-Q$q\"/" \
+  sed -e "s/^Q = 0.05 .*/Q = $q/" \
+      -e "s/^name = \"validate-charged\"/name = \"validate-charged-Q$q\"/" \
       -e "s/^runs = 5/runs = 3/" data/pair/validate-charged.toml > "$f"
   grep -q "^Q = $q\$" "$f" || { echo "validate.sh: could not set Q in $f" >&2; exit 1; }
   echo "$f"
@@ -123,7 +125,8 @@ fits() {
     [ -f "$dir/fit_beta.json" ] && grep -q beta_asymptotic "$dir/fit_beta.json" && continue
     local a; for a in "$OUT/$name"/analysis/K*; do
       [ -f "$a/S_t.csv" ] || continue
-      "$G" fit-beta "$a" --column "$column" --window "$w0" "$w1" --no-curve-fit -q --force --out "$dir" \
+      "$G" fit-beta "$a" --column "$column" --window "$w0" "$w1" --no-curve-fit -q --force \
+        --out "$dir" \
         || say "fits: $name $column [$w0, $w1]: fit-beta refused (see above)"
     done
   done

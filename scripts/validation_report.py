@@ -66,8 +66,10 @@ class Part:
     def __init__(self, out, name, label, colour):
         self.name, self.label, self.colour = name, label, colour
         self.d = os.path.join(out, name)
-        kdirs = sorted(os.listdir(os.path.join(self.d, "analysis"))) if os.path.isdir(os.path.join(self.d, "analysis")) else []
-        kdirs = [k for k in kdirs if k.startswith("K") and os.path.isdir(os.path.join(self.d, "analysis", k))]
+        kdirs = (sorted(os.listdir(os.path.join(self.d, "analysis")))
+                 if os.path.isdir(os.path.join(self.d, "analysis")) else [])
+        kdirs = [k for k in kdirs
+                 if k.startswith("K") and os.path.isdir(os.path.join(self.d, "analysis", k))]
         self.k = kdirs[0] if kdirs else None
         self.ok = self.k is not None and os.path.exists(self.path("analysis", "S_t.csv"))
         self.summary = load_json(os.path.join(self.d, "summary.json"))
@@ -138,29 +140,42 @@ def main():
         base = f["onset_S_base_grid"] if "onset_S_base_grid" in f.dtype.names else float("nan")
         Sg = S["S_grid_mean"]
         last = np.where(np.isfinite(Sg))[0][-1]
-        ens_rows.append(dict(part=p.name, K=p.K(), Q=e.get("charging_Q", float("nan")) if p.K() > 0 else float("nan"),
+        ens_rows.append(dict(part=p.name, K=p.K(),
+                             Q=e.get("charging_Q", float("nan")) if p.K() > 0 else float("nan"),
                              N=e.get("N", float("nan")), runs=runs, t_end=float(S["t"][last]),
                              S_grid_end=float(Sg[last]), S_grid_end_se=float(S["S_grid_se"][last]),
-                             S_particle_end=float(S["S_particle_mean"][last]) if col(S, "S_particle_mean") is not None else float("nan"),
-                             S_base=float(base), growth=float(Sg[last] / base) if base > 0 else float("nan"),
-                             onset=float(f["onset_time_grid"]) if "onset_time_grid" in f.dtype.names else float("nan"),
-                             onset_se=float(f["onset_time_grid_err"]) if "onset_time_grid_err" in f.dtype.names else float("nan"),
+                             S_particle_end=(float(S["S_particle_mean"][last])
+                                             if col(S, "S_particle_mean") is not None
+                                             else float("nan")),
+                             S_base=float(base),
+                             growth=float(Sg[last] / base) if base > 0 else float("nan"),
+                             onset=(float(f["onset_time_grid"])
+                                    if "onset_time_grid" in f.dtype.names else float("nan")),
+                             onset_se=(float(f["onset_time_grid_err"])
+                                       if "onset_time_grid_err" in f.dtype.names
+                                       else float("nan")),
                              zloc_min=zmin, zloc_max=zmax,
-                             charging=float(f["charging_rate_exponent"]), charging_low=float(f["charging_rate_low"]),
-                             charging_high=float(f["charging_rate_high"]), charging_expected=float(f["charging_rate_expected"]),
+                             charging=float(f["charging_rate_exponent"]),
+                             charging_low=float(f["charging_rate_low"]),
+                             charging_high=float(f["charging_rate_high"]),
+                             charging_expected=float(f["charging_rate_expected"]),
                              beta_asym=fb.get("beta_asymptotic"), fb_z=fb.get("z")))
-        keep = [c for c in ("t", "S_grid_mean", "S_grid_se", "S_particle_mean", "S_particle_se", "z_local_grid_of_mean",
-                            "z_local_particle_of_mean", "largest_grid_mean", "mean_contacts_mean") if col(S, c) is not None]
+        keep = [c for c in ("t", "S_grid_mean", "S_grid_se", "S_particle_mean", "S_particle_se",
+                            "z_local_grid_of_mean", "z_local_particle_of_mean",
+                            "largest_grid_mean", "mean_contacts_mean")
+                if col(S, c) is not None]
         with open(os.path.join(rep, f"S_{p.name}.csv"), "w") as fo:
-            fo.write(f"# ensemble S(t) of {p.label} ({runs} runs), from {p.path('analysis', 'S_t.csv')}\n")
+            fo.write(f"# ensemble S(t) of {p.label} ({runs} runs), "
+                     f"from {p.path('analysis', 'S_t.csv')}\n")
             fo.write(f"# command = {md.get('command', '?')}\n")
             fo.write(",".join(keep) + "\n")
             for k in range(len(S)):
                 fo.write(",".join(f"{S[c][k]:.6g}" for c in keep) + "\n")
     write_csv(os.path.join(rep, "ensembles.csv"), ens_rows,
-              "# one row per ensemble; onset: S_grid reaches 2 x its median over t <= 10; growth = S_grid(t_end) / that "
-              "median; zloc_min/max: local slope of the mean S_grid over the last half decade; charging: exponent of "
-              "d<|q|>/dt over t = 1..100 (bootstrap over runs) and its expectation -5/6 - 5 kappa/3")
+              "# one row per ensemble; onset: S_grid reaches 2 x its median over t <= 10; "
+              "growth = S_grid(t_end) / that median; zloc_min/max: local slope of the mean S_grid "
+              "over the last half decade; charging: exponent of d<|q|>/dt over t = 1..100 "
+              "(bootstrap over runs) and its expectation -5/6 - 5 kappa/3")
 
     # ---- windows.csv
     win_rows = []
@@ -170,14 +185,20 @@ def main():
             j = load_json(os.path.join(wd, w, "fit_beta.json"))
             if not j:
                 continue
-            win_rows.append(dict(part=p.name, column=j.get("column"), t0=j.get("t0"), t1=j.get("t1"), n=j.get("n_points"),
-                                 z=j.get("z"), z_low=j.get("z_low"), z_high=j.get("z_high"), S0=j.get("S0"), S1=j.get("S1"),
-                                 beta_from_z=j.get("beta_from_z"), beta_from_z_low=j.get("beta_from_z_low"),
-                                 beta_from_z_high=j.get("beta_from_z_high"), beta_asym=j.get("beta_asymptotic"),
-                                 beta_asym_low=j.get("beta_asymptotic_low"), beta_asym_high=j.get("beta_asymptotic_high")))
+            win_rows.append(dict(part=p.name, column=j.get("column"), t0=j.get("t0"),
+                                 t1=j.get("t1"), n=j.get("n_points"),
+                                 z=j.get("z"), z_low=j.get("z_low"), z_high=j.get("z_high"),
+                                 S0=j.get("S0"), S1=j.get("S1"),
+                                 beta_from_z=j.get("beta_from_z"),
+                                 beta_from_z_low=j.get("beta_from_z_low"),
+                                 beta_from_z_high=j.get("beta_from_z_high"),
+                                 beta_asym=j.get("beta_asymptotic"),
+                                 beta_asym_low=j.get("beta_asymptotic_low"),
+                                 beta_asym_high=j.get("beta_asymptotic_high")))
     write_csv(os.path.join(rep, "windows.csv"), win_rows,
-              "# granagg fit-beta over each window (95 % intervals, bootstrap over runs); beta_from_z: the full "
-              "Smoluchowski z(beta) at the window's S; beta_asym: 3z/(3-z); null = not available")
+              "# granagg fit-beta over each window (95 % intervals, bootstrap over runs); "
+              "beta_from_z: the full Smoluchowski z(beta) at the window's S; "
+              "beta_asym: 3z/(3-z); null = not available")
 
     # ---- fisher.csv
     fi_rows = []
@@ -190,13 +211,15 @@ def main():
             if k is None:
                 continue
             r = dict(part=p.name, t=float(fp["t"][k]))
-            for c in ("tau_grid", "tau_grid_err", "tail_grid", "tau_ls_grid", "tau_ls_grid_err", "bins_ls_grid",
-                      "tau_particle", "tau_particle_err", "tau_ls_particle", "tau_ls_particle_err"):
+            for c in ("tau_grid", "tau_grid_err", "tail_grid", "tau_ls_grid", "tau_ls_grid_err",
+                      "bins_ls_grid", "tau_particle", "tau_particle_err", "tau_ls_particle",
+                      "tau_ls_particle_err"):
                 r[c] = float(fp[c][k]) if c in fp.dtype.names else float("nan")
             fi_rows.append(r)
     write_csv(os.path.join(rep, "fisher.csv"), fi_rows,
-              "# Fisher exponent tau of N_s summed over runs (fisher_pooled.csv): MLE (Clauset et al.) and the paper's "
-              "least squares on log-binned N_s (tau_ls); the paper prints -tau")
+              "# Fisher exponent tau of N_s summed over runs (fisher_pooled.csv): MLE (Clauset "
+              "et al.) and the paper's least squares on log-binned N_s (tau_ls); the paper prints "
+              "-tau")
 
     # ---- sensitivity.csv
     se_rows = []
@@ -216,17 +239,21 @@ def main():
                 k = nearest_row(fp, t) if fp is not None else None
                 ls[t] = -float(fp["tau_ls_grid"][k]) if k is not None else float("nan")
             lst = list(ls.values())
-            se_rows.append(dict(part=name, variant=v, t0=float(f["fit_t_min"][0]), t1=float(f["fit_t_max"][0]),
+            se_rows.append(dict(part=name, variant=v, t0=float(f["fit_t_min"][0]),
+                                t1=float(f["fit_t_max"][0]),
                                 fb_z=j.get("z"), fb_z_low=j.get("z_low"), fb_z_high=j.get("z_high"),
-                                onset=float(f["onset_time_grid"][0]), S_base=float(f["onset_S_base_grid"][0]),
+                                onset=float(f["onset_time_grid"][0]),
+                                S_base=float(f["onset_S_base_grid"][0]),
                                 S_end=float(S["S_grid_mean"][last]), zloc_min=zmin, zloc_max=zmax,
                                 fisher_ls_t50=lst[0], fisher_ls_t150=lst[1], fisher_ls_end=lst[2],
-                                occupied=float(S["occupied_fraction_mean"][1]) if col(S, "occupied_fraction_mean") is not None
-                                else float("nan")))
+                                occupied=(float(S["occupied_fraction_mean"][1])
+                                          if col(S, "occupied_fraction_mean") is not None
+                                          else float("nan"))))
     write_csv(os.path.join(rep, "sensitivity.csv"), se_rows,
-              "# grid-cluster definitions: grid<spacing>_fill<filling fraction> or _count<centres per cell>; fb_z: "
-              "fit-beta z over [t0, t1] (bootstrap over runs); onset and local slope as in ensembles.csv; fisher_ls_*: "
-              "the paper's Fisher slope (-tau, log-binned least squares) at t = 50, 150 and the last frame; "
+              "# grid-cluster definitions: grid<spacing>_fill<filling fraction> or "
+              "_count<centres per cell>; fb_z: fit-beta z over [t0, t1] (bootstrap over runs); "
+              "onset and local slope as in ensembles.csv; fisher_ls_*: the paper's Fisher slope "
+              "(-tau, log-binned least squares) at t = 50, 150 and the last frame; "
               "occupied: fraction of occupied sites in the first frame after t = 0")
 
     figures(have, rep, out)
@@ -279,13 +306,15 @@ def figures(have, rep, out):
     for p in have:
         S = p.table("S_t.csv")
         m = (S["t"] > 0) & np.isfinite(S["S_grid_mean"])
-        ax.errorbar(S["t"][m], S["S_grid_mean"][m], yerr=S["S_grid_se"][m], fmt="o-", ms=2.5, lw=0.8, color=p.colour,
-                    label=f"{p.label} ({int(p.fits()['runs'])} runs)")
+        ax.errorbar(S["t"][m], S["S_grid_mean"][m], yerr=S["S_grid_se"][m], fmt="o-", ms=2.5,
+                    lw=0.8, color=p.colour, label=f"{p.label} ({int(p.fits()['runs'])} runs)")
         z = col(S, "z_local_grid_of_mean")
         mz = m & np.isfinite(z) & (S["t"] >= 5)
         ins.plot(1.0 / S["t"][mz], z[mz], ".-", ms=3, lw=0.8, color=p.colour, label=p.label)
-    ins.axhline(PAPER["z_neutral"]["value"], color="k", ls="--", lw=0.8, label="paper: 1.21 (neutral)")
-    ins.axhline(PAPER["z_charged"]["value"], color="k", ls=":", lw=0.8, label="paper: 1.49 (charged)")
+    ins.axhline(PAPER["z_neutral"]["value"], color="k", ls="--", lw=0.8,
+                label="paper: 1.21 (neutral)")
+    ins.axhline(PAPER["z_charged"]["value"], color="k", ls=":", lw=0.8,
+                label="paper: 1.49 (charged)")
     ins.set(xscale="log", xlabel="1/t", ylabel="local slope z(t) = ln[S(t)/S(t/2)]/ln 2",
             title="local slope of the mean S (the paper's Fig. 5 inset)")
     ins.legend(fontsize=7)
@@ -341,7 +370,8 @@ def figures(have, rep, out):
             ax.set(xlabel="s (grid sites)", title=f"t = {t:g}")
             ax.legend(fontsize=7)
         axs[0].set_ylabel(r"$N_s$ (summed over runs)")
-        fig.suptitle("Cluster-size distributions (paper: slopes -2.51 -> -2.45 neutral, -1.62 -> -1.34 charged)")
+        fig.suptitle("Cluster-size distributions (paper: slopes -2.51 -> -2.45 neutral, "
+                     "-1.62 -> -1.34 charged)")
         save(fig, rep, "fig_fisher")
 
     # Temperature and charge.
@@ -362,11 +392,13 @@ def figures(have, rep, out):
     if cool is not None:
         m = cool["t"] > 0
         a1.loglog(cool["t"][m], cool["T"][m], "k-", lw=0.8, label="kinetic theory, viscoelastic")
-        a1.loglog(cool["t"][m], cool["T_haff"][m], "k--", lw=0.8, label="Haff's law, same initial rate")
+        a1.loglog(cool["t"][m], cool["T_haff"][m], "k--", lw=0.8,
+                  label="Haff's law, same initial rate")
         tl = np.geomspace(30, 1000, 10)
         a1.loglog(tl, 3 * tl**(-5 / 3), "k:", lw=0.8, label=r"$\propto t^{-5/3}$")
     a1.set(xlabel="t", ylabel=r"$T_g$", title="granular temperature")
-    a2.set(xlabel="t", ylabel=r"$\langle|q|\rangle$", title="mean absolute charge (collisional charging)")
+    a2.set(xlabel="t", ylabel=r"$\langle|q|\rangle$",
+           title="mean absolute charge (collisional charging)")
     a1.legend(fontsize=7)
     a2.legend(fontsize=7)
     save(fig, rep, "fig_temperature_charge")
@@ -375,15 +407,18 @@ def figures(have, rep, out):
     sd = os.path.join(out, "sensitivity")
     if os.path.isdir(sd):
         names = sorted(os.listdir(sd))
-        fig, axs = plt.subplots(1, max(1, len(names)), figsize=(6 * max(1, len(names)), 4.2), squeeze=False)
+        fig, axs = plt.subplots(1, max(1, len(names)), figsize=(6 * max(1, len(names)), 4.2),
+                                squeeze=False)
         for ax, name in zip(axs[0], names):
             for i, v in enumerate(sorted(os.listdir(os.path.join(sd, name)))):
                 S = read(os.path.join(sd, name, v, "S_t.csv"))
                 if S is None:
                     continue
                 m = (S["t"] > 0) & np.isfinite(S["S_grid_mean"])
-                ax.loglog(S["t"][m], S["S_grid_mean"][m], "-", color=f"C{i}", label=v.replace("_", ", "))
-            ax.set(xlabel="t", ylabel="S_grid", title=f"{name}: grid spacing and occupation threshold")
+                ax.loglog(S["t"][m], S["S_grid_mean"][m], "-", color=f"C{i}",
+                          label=v.replace("_", ", "))
+            ax.set(xlabel="t", ylabel="S_grid",
+                   title=f"{name}: grid spacing and occupation threshold")
             ax.legend(fontsize=7)
         save(fig, rep, "fig_sensitivity")
 
@@ -400,31 +435,42 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
     by = {r["part"]: r for r in ens_rows}
     win = {(r["part"], r["column"], r["t0"], r["t1"]): r for r in win_rows}
     csv_rows = []
-    lines = ["| quantity | paper | granagg (95 % interval) | agree? | why not / remark |", "|---|---|---|---|---|"]
+    lines = ["| quantity | paper | granagg (95 % interval) | agree? | why not / remark |",
+             "|---|---|---|---|---|"]
 
     def zwin(part, t0, t1, column="S_grid_mean"):
         for (p, c, a, b), r in win.items():
-            if p == part and c == column and a is not None and abs(a - t0) < 0.05 * t0 and abs(b - t1) < 0.05 * t1:
+            if (p == part and c == column and a is not None and abs(a - t0) < 0.05 * t0
+                    and abs(b - t1) < 0.05 * t1):
                 return r
         return None
 
     zp = PAPER["z_neutral"]
-    for part, t0, t1 in (("neutral", 100, 1000), ("neutral", 631, 1000), ("box", 100, 1000), ("box", 631, 1000)):
+    for part, t0, t1 in (("neutral", 100, 1000), ("neutral", 631, 1000), ("box", 100, 1000),
+                         ("box", 631, 1000)):
         r, e = zwin(part, t0, t1), by.get(part)
         if r is None or e is None:
             continue
         inside = r["z_low"] <= zp["value"] + zp["pm"] and r["z_high"] >= zp["value"] - zp["pm"]
-        flat = np.isfinite(e["zloc_min"]) and e["zloc_max"] - e["zloc_min"] <= 0.25 * 0.5 * (e["zloc_max"] + e["zloc_min"])
+        flat = (np.isfinite(e["zloc_min"])
+                and e["zloc_max"] - e["zloc_min"] <= 0.25 * 0.5 * (e["zloc_max"] + e["zloc_min"]))
         lines.append(f"| z, neutral ({part}, t = {t0}..{t1}) | {zp['value']} ± {zp['pm']} | "
-                     f"{ival(r['z'], r['z_low'], r['z_high'])} | {'number: yes' if inside else 'no'}"
-                     f"{'' if flat else '; curve: no'} | local slope {fmt(e['zloc_min'])}..{fmt(e['zloc_max'])} over "
-                     f"the last half decade: {'flat' if flat else 'not a power law (onset)'}; onset t_c = "
+                     f"{ival(r['z'], r['z_low'], r['z_high'])} | "
+                     f"{'number: yes' if inside else 'no'}"
+                     f"{'' if flat else '; curve: no'} | "
+                     f"local slope {fmt(e['zloc_min'])}..{fmt(e['zloc_max'])} over "
+                     f"the last half decade: {'flat' if flat else 'not a power law (onset)'}; "
+                     f"onset t_c = "
                      f"{fmt(e['onset'])} ± {fmt(e['onset_se'], 2)} |")
-        csv_rows.append(dict(quantity_id=1 if (part, t0) == ("neutral", 100) else 2, quantity="z_grid", K=0.0, N=e["N"],
-                             runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1, value=r["z"], low=r["z_low"], high=r["z_high"],
-                             onset=e["onset"], growth_factor=e["growth"], paper=zp["value"], part=part))
+        csv_rows.append(dict(quantity_id=1 if (part, t0) == ("neutral", 100) else 2,
+                             quantity="z_grid", K=0.0, N=e["N"],
+                             runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1,
+                             value=r["z"], low=r["z_low"], high=r["z_high"],
+                             onset=e["onset"], growth_factor=e["growth"], paper=zp["value"],
+                             part=part))
     zc = PAPER["z_charged"]
-    for part in ("charged-K5", "charged-K1", "charged-K0.25", "charged-K5-Q0.025", "charged-K5-Q0.1"):
+    for part in ("charged-K5", "charged-K1", "charged-K0.25", "charged-K5-Q0.025",
+                 "charged-K5-Q0.1"):
         e = by.get(part)
         if e is None:
             continue
@@ -433,19 +479,27 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
             if r is None:
                 continue
             inside = r["z_low"] <= zc["value"] + zc["pm"] and r["z_high"] >= zc["value"] - zc["pm"]
-            flat = np.isfinite(e["zloc_min"]) and e["zloc_max"] - e["zloc_min"] <= 0.25 * 0.5 * (e["zloc_max"] + e["zloc_min"])
+            flat = (np.isfinite(e["zloc_min"])
+                    and e["zloc_max"] - e["zloc_min"]
+                    <= 0.25 * 0.5 * (e["zloc_max"] + e["zloc_min"]))
             q = e["Q"]
-            lines.append(f"| z, charged K = {e['K']:g}, Q = {q:g} (t = {t0}..{t1}) | {zc['value']} ± {zc['pm']} | "
-                         f"{ival(r['z'], r['z_low'], r['z_high'])} | {'yes' if inside else 'no'} | local slope "
-                         f"{fmt(e['zloc_min'])}..{fmt(e['zloc_max'])} over t = {fmt(e['t_end'] / math.sqrt(10))}.."
-                         f"{fmt(e['t_end'])} ({'flat' if flat else 'not flat'}); N = {e['N']:g}, {e['runs']} runs; "
+            lines.append(f"| z, charged K = {e['K']:g}, Q = {q:g} (t = {t0}..{t1}) | "
+                         f"{zc['value']} ± {zc['pm']} | "
+                         f"{ival(r['z'], r['z_low'], r['z_high'])} | {'yes' if inside else 'no'} | "
+                         f"local slope "
+                         f"{fmt(e['zloc_min'])}..{fmt(e['zloc_max'])} over "
+                         f"t = {fmt(e['t_end'] / math.sqrt(10))}.."
+                         f"{fmt(e['t_end'])} ({'flat' if flat else 'not flat'}); "
+                         f"N = {e['N']:g}, {e['runs']} runs; "
                          f"onset t_c = {fmt(e['onset'])} ± {fmt(e['onset_se'], 2)} |")
-            csv_rows.append(dict(quantity_id=1 if (t0 == 50 and "Q" not in part) else 2, quantity="z_grid", K=e["K"], N=e["N"],
-                                 runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1, value=r["z"], low=r["z_low"],
-                                 high=r["z_high"], onset=e["onset"], growth_factor=e["growth"], paper=zc["value"], part=part))
+            csv_rows.append(dict(quantity_id=1 if (t0 == 50 and "Q" not in part) else 2,
+                                 quantity="z_grid", K=e["K"], N=e["N"],
+                                 runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1, value=r["z"],
+                                 low=r["z_low"], high=r["z_high"], onset=e["onset"],
+                                 growth_factor=e["growth"], paper=zc["value"], part=part))
     # onset against K
-    ks = [(by[p]["K"], by[p]["onset"], by[p]["onset_se"]) for p in ("neutral", "charged-K0.25", "charged-K1", "charged-K5")
-          if p in by]
+    ks = [(by[p]["K"], by[p]["onset"], by[p]["onset_se"])
+          for p in ("neutral", "charged-K0.25", "charged-K1", "charged-K5") if p in by]
     if len(ks) >= 2:
         ks.sort()
         mono = all(ks[i][1] >= ks[i + 1][1] for i in range(len(ks) - 1))
@@ -459,17 +513,24 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
         if not any(vals):
             continue
         pv = PAPER[key]
-        ls = ", ".join(f"{-v['tau_ls_grid']:.2f}" if v and np.isfinite(v["tau_ls_grid"]) else "n/a" for v in vals)
-        ml = ", ".join(f"{-v['tau_grid']:.2f}" if v and np.isfinite(v["tau_grid"]) else "n/a" for v in vals)
-        lines.append(f"| Fisher slope, {part} (t = 50, 100, 150) | {pv['t50']} -> {pv['t150']} | LS: {ls}; MLE: {ml} | "
-                     f"see text | printed as -tau; LS = least squares on log-binned N_s (the paper's method) |")
+        ls = ", ".join(f"{-v['tau_ls_grid']:.2f}" if v and np.isfinite(v["tau_ls_grid"]) else "n/a"
+                       for v in vals)
+        ml = ", ".join(f"{-v['tau_grid']:.2f}" if v and np.isfinite(v["tau_grid"]) else "n/a"
+                       for v in vals)
+        lines.append(f"| Fisher slope, {part} (t = 50, 100, 150) | {pv['t50']} -> {pv['t150']} | "
+                     f"LS: {ls}; MLE: {ml} | "
+                     f"see text | printed as -tau; LS = least squares on log-binned N_s "
+                     f"(the paper's method) |")
         for v in vals:
             if v:
-                csv_rows.append(dict(quantity_id=3, quantity="fisher_slope_ls", K=by.get(part, {}).get("K", float("nan")),
-                                     N=by.get(part, {}).get("N", float("nan")), runs=by.get(part, {}).get("runs", 0),
+                csv_rows.append(dict(quantity_id=3, quantity="fisher_slope_ls",
+                                     K=by.get(part, {}).get("K", float("nan")),
+                                     N=by.get(part, {}).get("N", float("nan")),
+                                     runs=by.get(part, {}).get("runs", 0),
                                      t_end=v["t"], t0=v["t"], t1=v["t"], value=-v["tau_ls_grid"],
                                      low=-v["tau_ls_grid"] - 1.96 * v["tau_ls_grid_err"],
-                                     high=-v["tau_ls_grid"] + 1.96 * v["tau_ls_grid_err"], onset=float("nan"),
+                                     high=-v["tau_ls_grid"] + 1.96 * v["tau_ls_grid_err"],
+                                     onset=float("nan"),
                                      growth_factor=float("nan"), paper=pv["t50"], part=part))
     # charging exponent
     ce = PAPER["charging_rate_exponent"]
@@ -477,10 +538,14 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
         e = by.get(part)
         if e is None or not np.isfinite(e["charging"]):
             continue
-        lines.append(f"| charging rate exponent, {part} (t = 1..100) | -13/6 = {ce['value']:.3f} (kappa = 0.8); "
-                     f"{e['charging_expected']:.3f} at kappa = 0.83 | {ival(e['charging'], e['charging_low'], e['charging_high'])} | "
-                     f"{'yes' if e['charging_low'] <= e['charging_expected'] <= e['charging_high'] else 'no'} | "
-                     f"{'Coulomb off (K = 0): charges exchanged but no force' if e['K'] == 0 else ''} |")
+        lines.append(f"| charging rate exponent, {part} (t = 1..100) | "
+                     f"-13/6 = {ce['value']:.3f} (kappa = 0.8); "
+                     f"{e['charging_expected']:.3f} at kappa = 0.83 | "
+                     f"{ival(e['charging'], e['charging_low'], e['charging_high'])} | "
+                     f"""{'yes' if e['charging_low'] <= e['charging_expected']
+                             <= e['charging_high'] else 'no'} | """
+                     f"""{'Coulomb off (K = 0): charges exchanged but no force'
+                          if e['K'] == 0 else ''} |""")
     # cooling
     for p in have:
         th = p.table("thermo.csv")
@@ -490,35 +555,47 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
             s = late_slope(th["t"], th["T_g_mean"], lo, hi)
             if not np.isfinite(s):
                 continue
-            lines.append(f"| T_g exponent, {p.name} (t = {lo}..{hi}) | -5/3 = -1.667 (viscoelastic, neutral, "
-                         f"homogeneous) | {fmt(s)} | {'yes' if abs(s + 5 / 3) < 0.1 else 'no'} | least squares of ln T_g "
-                         f"on ln t (a check, in Python) |")
+            lines.append(f"| T_g exponent, {p.name} (t = {lo}..{hi}) | -5/3 = -1.667 "
+                         f"(viscoelastic, neutral, homogeneous) | {fmt(s)} | "
+                         f"{'yes' if abs(s + 5 / 3) < 0.1 else 'no'} | "
+                         f"least squares of ln T_g on ln t (a check, in Python) |")
     # beta
     for p in have:
         fb = p.fit_beta()
         if not fb:
             continue
-        lines.append(f"| beta ({p.name}; fit-beta, window {fmt(fb.get('t0'))}..{fmt(fb.get('t1'))}) | "
+        lines.append(f"| beta ({p.name}; fit-beta, window "
+                     f"{fmt(fb.get('t0'))}..{fmt(fb.get('t1'))}) | "
                      f"{'2 (z = 6/5)' if p.K() == 0 else '3 (z = 3/2)'} | asymptotic: "
-                     f"{ival(fb.get('beta_asymptotic'), fb.get('beta_asymptotic_low'), fb.get('beta_asymptotic_high'))}; "
-                     f"at the data's S: {ival(fb.get('beta_from_z'), fb.get('beta_from_z_low'), fb.get('beta_from_z_high'))}; "
-                     f"curve fit: {'not determined' if not fb.get('beta_fit_determined', True) else fmt(fb.get('beta_fit'))} | "
-                     f"see text | z = {ival(fb.get('z'), fb.get('z_low'), fb.get('z_high'))}; regime at the end: "
+                     f"""{ival(fb.get('beta_asymptotic'), fb.get('beta_asymptotic_low'),
+                               fb.get('beta_asymptotic_high'))}; """
+                     f"""at the data's S: {ival(fb.get('beta_from_z'), fb.get('beta_from_z_low'),
+                                                fb.get('beta_from_z_high'))}; """
+                     f"""curve fit: {'not determined' if not fb.get('beta_fit_determined', True)
+                                     else fmt(fb.get('beta_fit'))} | """
+                     f"see text | z = {ival(fb.get('z'), fb.get('z_low'), fb.get('z_high'))}; "
+                     f"regime at the end: "
                      f"{p.ens.get('regime', '?')} (the asymptotic map needs a scaling regime) |")
     # sensitivity summary
     for r in se_rows:
-        lines.append(f"| z, {r['part']}, grid {r['variant']} (t = {fmt(r['t0'])}..{fmt(r['t1'])}) | - | "
-                     f"{ival(r['fb_z'], r['fb_z_low'], r['fb_z_high'])} | - | onset {fmt(r['onset'])}, S_end "
-                     f"{fmt(r['S_end'])}, local slope {fmt(r['zloc_min'])}..{fmt(r['zloc_max'])}; Fisher slope (LS) "
-                     f"{fmt(r['fisher_ls_t50'])} (t = 50), {fmt(r['fisher_ls_t150'])} (150), {fmt(r['fisher_ls_end'])} "
+        lines.append(f"| z, {r['part']}, grid {r['variant']} "
+                     f"(t = {fmt(r['t0'])}..{fmt(r['t1'])}) | - | "
+                     f"{ival(r['fb_z'], r['fb_z_low'], r['fb_z_high'])} | - | "
+                     f"onset {fmt(r['onset'])}, S_end "
+                     f"{fmt(r['S_end'])}, local slope {fmt(r['zloc_min'])}..{fmt(r['zloc_max'])}; "
+                     f"Fisher slope (LS) "
+                     f"{fmt(r['fisher_ls_t50'])} (t = 50), {fmt(r['fisher_ls_t150'])} (150), "
+                     f"{fmt(r['fisher_ls_end'])} "
                      f"(end); occupied {fmt(r['occupied'], 2)} |")
     if missing:
-        lines.append(f"\nParts not (yet) run: {', '.join(missing)} (rerun scripts/validate.sh to resume).")
+        lines.append(f"\nParts not (yet) run: {', '.join(missing)} "
+                     f"(rerun scripts/validate.sh to resume).")
     with open(os.path.join(rep, "verdict.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     write_csv(os.path.join(rep, "verdict.csv"), csv_rows,
-              "# validation study verdict numbers (scripts/validation_report.py; docs/validation.md); quantity_id 1 = the "
-              "headline z of an ensemble (granagg pair prints it beside a demo), 2 = other windows, 3 = Fisher slopes")
+              "# validation study verdict numbers (scripts/validation_report.py; "
+              "docs/validation.md); quantity_id 1 = the headline z of an ensemble "
+              "(granagg pair prints it beside a demo), 2 = other windows, 3 = Fisher slopes")
 
 
 if __name__ == "__main__":
