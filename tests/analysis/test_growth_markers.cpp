@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analysis/stats/GrowthMarkers.h"
+#include "analysis/stats/PowerLawFit.h"
 
 using namespace granagg::analysis;
 
@@ -153,4 +154,18 @@ TEST_CASE("growth regime: none, onset and scaling", "[analysis][onset]") {
   CHECK(scaling.z_local_min > 1.4);
   CHECK(scaling.z_local_max <= 1.5 + 1e-9);
   CHECK(scaling.reason.find("flat") != std::string::npos);
+}
+
+TEST_CASE("fit windows keep a frame a rounding step past their end", "[analysis][fit]") {
+  // MD frames sit on whole time steps: the frame of a run to t = 1000 is at 1000.0011. A window
+  // [100, 1000] must hold it (it dropped out before, and with it the largest S of the run).
+  const std::vector<double> t{100.0011, 200.0, 400.0, 800.0, 1000.0011};
+  std::vector<double> S;
+  for (double x : t) S.push_back(std::pow(x, 1.5));
+  const PowerLawFitResult f = fitPowerLaw(t, S, 100.0, 1000.0);
+  CHECK(f.points == 5);
+  CHECK(f.exponent == Approx(1.5).epsilon(1e-12));
+  // ... but not a frame a whole frame spacing away
+  CHECK(fitPowerLaw(t, S, 100.0, 999.0).points == 4);
+  CHECK(fitPowerLaw(t, S, 200.0, 1000.0).points == 4);
 }

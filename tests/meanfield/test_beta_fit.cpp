@@ -306,3 +306,14 @@ TEST_CASE("fit-beta's asymptotic beta inverts z = 3 beta/(beta + 3), the full eq
     CHECK_FALSE(none.note.empty());
   }
 }
+
+TEST_CASE("fit-beta's explicit window keeps a frame a rounding step past its end", "[meanfield][fitbeta]") {
+  // The frame of an MD run to t = 1000 sits at t = 1000.0011 (whole time steps).
+  const GrowthData d = growthFromSeries({50.0, 100.0011, 200.0, 400.0, 800.0, 1000.0011},
+                                        {1.0, 2.0, 4.0, 8.0, 16.0, 20.0});
+  const SlopeWindow w = explicitWindow(d, 100.0, 1000.0);
+  CHECK(w.points == 5);
+  CHECK(w.t0 == 100.0011);
+  CHECK(w.t1 == 1000.0011);
+  CHECK(explicitWindow(d, 100.0, 999.0, 4).points == 4);
+}
