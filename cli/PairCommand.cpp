@@ -1100,6 +1100,7 @@ void Pair::writeSummary() {
       << ", \"z\": " << interval(r.fz, r.fz_low, r.fz_high) << ", \"fit_window\": [" << jsonNumber(r.w0) << ", "
       << jsonNumber(r.w1) << "],\n     \"beta_from_z\": " << interval(r.bz, r.bz_low, r.bz_high)
       << ", \"beta_asymptotic\": " << interval(r.ba, r.ba_low, r.ba_high)
+      << ", \"beta_asymptotic_applicable\": " << (r.regime.regime == "scaling" ? "true" : "false")
       << ", \"beta_fit\": " << interval(r.bf, r.bf_low, r.bf_high) << ", \"beta_fit_determined\": "
       << (r.bf_determined ? "true" : "false") << ", \"S_c\": " << jsonNumber(r.S_c)
       << ", \"tau_c\": " << jsonNumber(r.tau_c) << ", \"fit_notes\": " << jsonString(r.notes) << ",\n"
@@ -1174,10 +1175,16 @@ void Pair::printSummary() {
     const std::string v = validationLine(K);
     if (!v.empty()) std::printf("pair:           %s\n", v.c_str());
     if (r.has_fit)
-      std::printf("pair:           fit-beta: z = %s [%s, %s], beta from z = %s [%s, %s], asymptotic beta = %s [%s, %s], "
+      std::printf("pair:           fit-beta: z = %s [%s, %s], beta from z at the data's S %s, asymptotic beta %s, "
                   "full-curve beta = %s\n",
-                  fmt(r.fz).c_str(), fmt(r.fz_low).c_str(), fmt(r.fz_high).c_str(), fmt(r.bz, 2).c_str(), fmt(r.bz_low, 2).c_str(),
-                  fmt(r.bz_high, 2).c_str(), fmt(r.ba, 2).c_str(), fmt(r.ba_low, 2).c_str(), fmt(r.ba_high, 2).c_str(),
+                  fmt(r.fz).c_str(), fmt(r.fz_low).c_str(), fmt(r.fz_high).c_str(),
+                  (std::isfinite(r.bz) ? "= " + fmt(r.bz, 2) + " [" + fmt(r.bz_low, 2) + ", " + fmt(r.bz_high, 2) + "]"
+                                       : std::string("n/a (z outside the mean field's range there)"))
+                      .c_str(),
+                  (r.regime.regime == "scaling"
+                       ? "= " + fmt(r.ba, 2) + " [" + fmt(r.ba_low, 2) + ", " + fmt(r.ba_high, 2) + "]"
+                       : "not applicable (no scaling regime; 3z/(3-z) would give " + fmt(r.ba, 2) + ")")
+                      .c_str(),
                   r.bf_determined ? (fmt(r.bf, 2) + " [" + fmt(r.bf_low, 2) + ", " + fmt(r.bf_high, 2) + "]").c_str()
                                   : "not determined (at the bound of its range)");
     if (r.has_fit && !r.notes.empty())

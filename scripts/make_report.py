@@ -103,7 +103,7 @@ def main():
         w(f"<tr><td>{esc(e['K'])}</td><td>x{num(e.get('growth_factor'), 3)}</td>"
           f"<td>{num(e.get('onset_time'), 3)} &plusmn; {num(e.get('onset_time_se'), 2)}</td>"
           f"<td><b>{esc(e.get('regime', 'unknown'))}</b></td><td class='small'>{esc(e.get('regime_reason', ''))}</td>"
-          f"<td>{interval(e.get('beta_asymptotic'), 2)}</td>"
+          f"<td>{interval(e.get('beta_asymptotic'), 2) if e.get('beta_asymptotic_applicable') else 'not applicable (no scaling regime)'}</td>"
           f"<td class='small'>{esc(e.get('validation') or 'no validation row for this K')}</td></tr>")
     w("</table>")
     w("<h2>Mean field (Smoluchowski equation, beta kernel, sectional solver)</h2>")
