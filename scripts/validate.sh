@@ -92,9 +92,10 @@ sensitivity() {
     || { say "sensitivity: $OUT/$name has no finished analysis yet, skipped"; return 0; }
   mkdir -p "$dir"
   local variant spacing fill
-  # threshold by filling fraction (0.25: 4 centres in the 2 d cell of L = 70; 0.2 gives the same
-  # integer count, so the threshold scan is by count: 3, 4, 5 centres = filling 0.20, 0.26, 0.33)
-  for variant in "1.5 fill0.25" "2 fill0.25" "3 fill0.25" "2 count3" "2 count5"; do
+  # The threshold is an integer count of centres per cell: filling 0.25 is 4 centres in the 2.003 d
+  # cells of L = 70 but 5 in the 2.05 d cells of L = 41 (N = 1e4), and 0.2 gives the same count as
+  # 0.25 at L = 70; so the threshold scan is by count (3, 4, 5 centres) beside the default.
+  for variant in "1.5 fill0.25" "2 fill0.25" "3 fill0.25" "2 count3" "2 count4" "2 count5"; do
     read -r spacing thr <<< "$variant"
     local v="grid${spacing}_${thr}" opt
     case "$thr" in
