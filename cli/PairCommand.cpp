@@ -973,13 +973,19 @@ std::string validationLine(double K) {
       const common::CsvTable t = common::readCsv(p.string());
       for (const auto& row : t.rows) {
         if (std::abs(row[t.column("K")] - K) > 1e-12 || row[t.column("quantity_id")] != 1.0) continue;
-        char buf[400];
+        char buf[600];
         std::snprintf(buf, sizeof buf,
                       "validation study (docs/validation.md; N = %.0f, %.0f runs to t = %.0f): z = %.2f [%.2f, %.2f] over "
-                      "t = %.0f..%.0f, onset t_c = %.0f, growth x%.0f",
+                      "t = %.0f..%.0f, onset t_c = %.0f, growth x%.0f; local slope %.2f..%.2f over the last half "
+                      "decade%s",
                       row[t.column("N")], row[t.column("runs")], row[t.column("t_end")], row[t.column("value")],
                       row[t.column("low")], row[t.column("high")], row[t.column("t0")], row[t.column("t1")],
-                      row[t.column("onset")], row[t.column("growth_factor")]);
+                      row[t.column("onset")], row[t.column("growth_factor")], row[t.column("zloc_min")],
+                      row[t.column("zloc_max")],
+                      row[t.column("zloc_max")] - row[t.column("zloc_min")] >
+                              0.125 * (row[t.column("zloc_max")] + row[t.column("zloc_min")])
+                          ? ": not a power law"
+                          : "");
         return buf;
       }
     } catch (const std::exception&) {

@@ -463,11 +463,10 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
                      f"onset t_c = "
                      f"{fmt(e['onset'])} ± {fmt(e['onset_se'], 2)} |")
         csv_rows.append(dict(quantity_id=1 if (part, t0) == ("neutral", 100) else 2,
-                             quantity="z_grid", K=0.0, N=e["N"],
+                             K=0.0, N=e["N"],
                              runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1,
                              value=r["z"], low=r["z_low"], high=r["z_high"],
-                             onset=e["onset"], growth_factor=e["growth"], paper=zp["value"],
-                             part=part))
+                             onset=e["onset"], growth_factor=e["growth"], paper=zp["value"], zloc_min=e["zloc_min"], zloc_max=e["zloc_max"]))
     zc = PAPER["z_charged"]
     for part in ("charged-K5", "charged-K1", "charged-K0.25", "charged-K5-Q0.025",
                  "charged-K5-Q0.1"):
@@ -493,10 +492,10 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
                          f"N = {e['N']:g}, {e['runs']} runs; "
                          f"onset t_c = {fmt(e['onset'])} ± {fmt(e['onset_se'], 2)} |")
             csv_rows.append(dict(quantity_id=1 if (t0 == 50 and "Q" not in part) else 2,
-                                 quantity="z_grid", K=e["K"], N=e["N"],
+                                 K=e["K"], N=e["N"],
                                  runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1, value=r["z"],
                                  low=r["z_low"], high=r["z_high"], onset=e["onset"],
-                                 growth_factor=e["growth"], paper=zc["value"], part=part))
+                                 growth_factor=e["growth"], paper=zc["value"], zloc_min=e["zloc_min"], zloc_max=e["zloc_max"]))
     # onset against K
     ks = [(by[p]["K"], by[p]["onset"], by[p]["onset_se"])
           for p in ("neutral", "charged-K0.25", "charged-K1", "charged-K5") if p in by]
@@ -523,7 +522,7 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
                      f"(the paper's method) |")
         for v in vals:
             if v:
-                csv_rows.append(dict(quantity_id=3, quantity="fisher_slope_ls",
+                csv_rows.append(dict(quantity_id=3, 
                                      K=by.get(part, {}).get("K", float("nan")),
                                      N=by.get(part, {}).get("N", float("nan")),
                                      runs=by.get(part, {}).get("runs", 0),
@@ -531,7 +530,7 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
                                      low=-v["tau_ls_grid"] - 1.96 * v["tau_ls_grid_err"],
                                      high=-v["tau_ls_grid"] + 1.96 * v["tau_ls_grid_err"],
                                      onset=float("nan"),
-                                     growth_factor=float("nan"), paper=pv["t50"], part=part))
+                                     growth_factor=float("nan"), paper=pv["t50"], zloc_min=float("nan"), zloc_max=float("nan")))
     # charging exponent
     ce = PAPER["charging_rate_exponent"]
     for part in ("charged-K5", "charged-K1", "charged-K0.25", "neutral"):
@@ -595,7 +594,9 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
     write_csv(os.path.join(rep, "verdict.csv"), csv_rows,
               "# validation study verdict numbers (scripts/validation_report.py; "
               "docs/validation.md); quantity_id 1 = the headline z of an ensemble "
-              "(granagg pair prints it beside a demo), 2 = other windows, 3 = Fisher slopes")
+              "(granagg pair prints it beside a demo), 2 = other windows of z, 3 = Fisher slopes "
+              "(-tau, log-binned least squares, at t = t0); numeric columns only "
+              "(granagg's common::readCsv reads it)")
 
 
 if __name__ == "__main__":
