@@ -983,7 +983,8 @@ std::string validationLine(double K) {
                       row[t.column("onset")], row[t.column("growth_factor")], row[t.column("zloc_min")],
                       row[t.column("zloc_max")],
                       row[t.column("zloc_max")] - row[t.column("zloc_min")] >
-                              0.125 * (row[t.column("zloc_max")] + row[t.column("zloc_min")])
+                              granagg::analysis::FLAT_SLOPE_TOLERANCE * 0.5 *
+                                  (row[t.column("zloc_max")] + row[t.column("zloc_min")])
                           ? ": not a power law"
                           : "");
         return buf;

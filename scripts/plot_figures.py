@@ -20,7 +20,6 @@ A missing input (no charged ensemble, no fit-beta output...) leaves a note in th
 script does not fail for it. Exit status 1 only when a figure failed for another reason (the
 figure then holds the error). Debian's python3-matplotlib, python3-numpy and python3-h5py only.
 """
-import io
 import json
 import os
 import sys
@@ -33,28 +32,15 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
 import numpy as np  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from granagg_tables import col, read  # noqa: E402
+
 FAILED = []
-
-
-def read(path):
-    """A granagg CSV table as a numpy structured array (None if absent or empty); '#' lines dropped."""
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
-        lines = [line for line in f if not line.startswith("#")]
-    if len(lines) < 2:
-        return None
-    a = np.genfromtxt(io.StringIO("".join(lines)), delimiter=",", names=True)
-    return np.atleast_1d(a)
 
 
 def note(ax, text):
     """Marks a panel whose input is missing."""
     ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", fontsize=9, color="0.3", wrap=True)
-
-
-def col(tab, name):
-    return tab[name] if tab is not None and name in tab.dtype.names else None
 
 
 class Study:

@@ -50,6 +50,11 @@ struct OnsetTime {
 OnsetTime onsetTime(const std::vector<double>& t, const std::vector<double>& S, double factor = 2.0,
                     double t_base = 10.0);
 
+/// Relative spread (max - min) / mean of the local slope over the last half decade below which S(t)
+/// counts as a power law ("scaling"): the paper's own local slopes vary by about this much over
+/// its plateau (Singh & Mazza 2018, Fig. 5 inset).
+constexpr double FLAT_SLOPE_TOLERANCE = 0.25;
+
 /// Which regime a measured S(t) is in at its end, so that a short run is not read as a result.
 struct GrowthRegime {
   double growth_factor = 0.0;  ///< S at the last sample / S_base (NaN without a baseline)
@@ -69,6 +74,6 @@ struct GrowthRegime {
 /// about that much over its plateau). Throws std::invalid_argument for mismatched lengths.
 GrowthRegime classifyGrowth(const std::vector<double>& t, const std::vector<double>& S,
                             const std::vector<double>& z_local, double factor = 2.0,
-                            double t_base = 10.0, double flat_tolerance = 0.25);
+                            double t_base = 10.0, double flat_tolerance = FLAT_SLOPE_TOLERANCE);
 
 }  // namespace granagg::analysis
