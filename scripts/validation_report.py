@@ -11,6 +11,8 @@ windows: OUT/<part>/windows; grid variants: OUT/sensitivity) and writes OUT/repo
   windows.csv         z, beta from z and asymptotic beta over every fitted window
   fisher.csv          Fisher tau at t = 50, 100, 150: MLE and the paper's log-binned least squares
   sensitivity.csv     z and onset for each grid definition
+  kscan.csv           the charged gas against K (0.25, 1, 5; neutral beside): onset, S, slopes, z
+  qscan.csv           K = 5 against the charge scale Q (0.025, 0.05, 0.1) at t = 50 and 100
   S_<part>.csv        ensemble S(t) (grid and particle, standard errors, local slope of the mean)
   fig_*.png           the figures (docs/validation.md shows them)
 With --publish ROOT, copies the CSV tables to ROOT/docs/validation/, the figures to
@@ -256,8 +258,9 @@ def main():
               "(-tau, log-binned least squares) at t = 50, 150 and the last frame; "
               "occupied: fraction of occupied sites in the first frame after t = 0")
 
+    k_rows, q_rows = scan_tables(have, ens_rows, win_rows, rep)
     figures(have, rep, out)
-    verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing)
+    verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_rows)
 
     if publish:
         dd = os.path.join(publish, "docs", "validation")
@@ -275,6 +278,79 @@ def main():
         print(f"validation_report: published to {dd}, {di}, {dv}")
     print(f"validation_report: wrote {rep}")
     return 0
+
+
+def at(tab, name, t):
+    """Column `name` of `tab` at the frame nearest t (within 3 %), or nan."""
+    c = col(tab, name)
+    k = nearest_row(tab, t) if c is not None else None
+    return float(c[k]) if k is not None else float("nan")
+
+
+def window_z(win_rows, part, t0, t1, column="S_grid_mean"):
+    """The fit-beta row of `part` over [t0, t1] (within 5 %), or None."""
+    for r in win_rows:
+        if (r["part"] == part and r["column"] == column and r["t0"] is not None
+                and abs(r["t0"] - t0) < 0.05 * t0 and abs(r["t1"] - t1) < 0.05 * t1):
+            return r
+    return None
+
+
+def scan_tables(have, ens_rows, win_rows, rep):
+    """kscan.csv (the paper's claim: z does not depend on K; t_c falls as K grows) and qscan.csv
+    (how K = 5 depends on the charge scale Q, which the paper does not give)."""
+    by = {p.name: p for p in have}
+    ens = {r["part"]: r for r in ens_rows}
+
+    def common(p, t_list):
+        S, th = p.table("S_t.csv"), p.table("thermo.csv")
+        e = ens[p.name]
+        r = dict(part=p.name, K=p.K(), Q=e["Q"], N=e["N"], runs=e["runs"], t_end=e["t_end"],
+                 onset=e["onset"], onset_se=e["onset_se"])
+        for t in t_list:
+            r[f"S_grid_{t}"] = at(S, "S_grid_mean", t)
+            r[f"S_grid_{t}_se"] = at(S, "S_grid_se", t)
+            r[f"S_particle_{t}"] = at(S, "S_particle_mean", t)
+            r[f"zloc_{t}"] = at(S, "z_local_grid_of_mean", t)
+            # the largest particle cluster as a fraction of all particles: finite size
+            r[f"largest_particle_frac_{t}"] = at(S, "largest_particle_mean", t) / e["N"]
+            r[f"mean_abs_q_{t}"] = at(th, "mean_abs_q_mean", t) if th is not None else float("nan")
+            r[f"T_g_{t}"] = at(th, "T_g_mean", t) if th is not None else float("nan")
+        r.update(charging=e["charging"], charging_low=e["charging_low"],
+                 charging_high=e["charging_high"])
+        return r
+
+    k_rows = []
+    for name in ("neutral", "charged-K0.25", "charged-K1", "charged-K5"):
+        if name not in by:
+            continue
+        r = common(by[name], (50, 100, 150))
+        for t0, t1 in ((10, 150), (50, 150), (100, 1000)):
+            w = window_z(win_rows, name, t0, t1)
+            r[f"z_{t0}_{t1}"], r[f"z_{t0}_{t1}_low"], r[f"z_{t0}_{t1}_high"] = (
+                (w["z"], w["z_low"], w["z_high"]) if w else (None, None, None))
+        k_rows.append(r)
+    write_csv(os.path.join(rep, "kscan.csv"), k_rows,
+              "# the gas against K (neutral K = 0 at N = 50016 beside the charged N = 1e4): onset "
+              "t_c (+- s.e. over runs), S_grid (+- s.e.), S_particle, local slope of the mean "
+              "(zloc), largest particle cluster / N, <|q|>, T_g at t = 50, 100, 150; z over "
+              "windows (fit-beta, 95 % bootstrap over runs); charging exponent of d<|q|>/dt")
+    q_rows = []
+    for name in ("charged-K5-Q0.025", "charged-K5", "charged-K5-Q0.1"):
+        if name not in by:
+            continue
+        r = common(by[name], (50, 100))
+        for t0, t1 in ((10, 100), (50, 100)):
+            w = window_z(win_rows, name, t0, t1)
+            r[f"z_{t0}_{t1}"], r[f"z_{t0}_{t1}_low"], r[f"z_{t0}_{t1}_high"] = (
+                (w["z"], w["z_low"], w["z_high"]) if w else (None, None, None))
+        q_rows.append(r)
+    q_rows.sort(key=lambda r: r["Q"])
+    write_csv(os.path.join(rep, "qscan.csv"), q_rows,
+              "# K = 5, N = 1e4 against the charge scale Q of collisional charging (charging.Q); "
+              "Q = 0.05 is the 5-run ensemble to t = 150, the others 2 runs (seeds 1-2) to "
+              "t = 100; columns as in kscan.csv")
+    return k_rows, q_rows
 
 
 def write_csv(path, rows, header):
@@ -423,6 +499,38 @@ def figures(have, rep, out):
         save(fig, rep, "fig_sensitivity")
 
 
+    # The charged gas against K and against Q: grid and particle S(t) and the mean charge.
+    for fname, names, what in (
+            ("fig_kscan", ("charged-K0.25", "charged-K1", "charged-K5"), "K (Q = 0.05)"),
+            ("fig_qscan", ("charged-K5-Q0.025", "charged-K5", "charged-K5-Q0.1"), "Q (K = 5)")):
+        show = [by[n] for n in names if n in by]
+        if len(show) < 2:
+            continue
+        fig, axs = plt.subplots(1, 3, figsize=(14, 4.2))
+        for p in show:
+            S, th = p.table("S_t.csv"), p.table("thermo.csv")
+            runs = int(p.fits()["runs"])
+            m = (S["t"] > 0) & np.isfinite(S["S_grid_mean"])
+            lab = f"{p.label} ({runs} runs)"
+            axs[0].errorbar(S["t"][m], S["S_grid_mean"][m], yerr=S["S_grid_se"][m], fmt="o-",
+                            ms=2.5, lw=0.8, color=p.colour, label=lab)
+            if col(S, "S_particle_mean") is not None:
+                axs[1].errorbar(S["t"][m], S["S_particle_mean"][m], yerr=S["S_particle_se"][m],
+                                fmt="o-", ms=2.5, lw=0.8, color=p.colour, label=lab)
+            if th is not None and col(th, "mean_abs_q_mean") is not None:
+                mt = th["t"] > 0
+                axs[2].loglog(th["t"][mt], th["mean_abs_q_mean"][mt], "-", color=p.colour,
+                              label=lab)
+        axs[0].set(xscale="log", yscale="log", xlabel="t", ylabel="S_grid (grid sites)",
+                   title=f"grid clusters against {what}")
+        axs[1].set(xscale="log", yscale="log", xlabel="t", ylabel="S_particle (particles)",
+                   title="particle clusters (contact within 1.05 d)")
+        axs[2].set(xlabel="t", ylabel=r"$\langle|q|\rangle$", title="mean absolute charge")
+        for ax in axs:
+            ax.legend(fontsize=7)
+        save(fig, rep, fname)
+
+
 def save(fig, rep, name):
     fig.tight_layout()
     fig.savefig(os.path.join(rep, name + ".png"), dpi=110)
@@ -431,7 +539,7 @@ def save(fig, rep, name):
 
 # ---------------------------------------------------------------- verdict
 
-def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
+def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_rows):
     by = {r["part"]: r for r in ens_rows}
     win = {(r["part"], r["column"], r["t0"], r["t1"]): r for r in win_rows}
     csv_rows = []
@@ -473,7 +581,11 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
         e = by.get(part)
         if e is None:
             continue
-        for t0, t1 in ((50, 150), (10, 150)):
+        # the Q scan ends at t = 100; K = 5 at Q = 0.05 is shown over its window too
+        windows = (((50, 100), (10, 100)) if "Q" in part
+                   else ((50, 150), (10, 150), (50, 100)) if part == "charged-K5"
+                   else ((50, 150), (10, 150)))
+        for t0, t1 in windows:
             r = zwin(part, t0, t1)
             if r is None:
                 continue
@@ -491,11 +603,32 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing):
                          f"{fmt(e['t_end'])} ({'flat' if flat else 'not flat'}); "
                          f"N = {e['N']:g}, {e['runs']} runs; "
                          f"onset t_c = {fmt(e['onset'])} ± {fmt(e['onset_se'], 2)} |")
-            csv_rows.append(dict(quantity_id=1 if (t0 == 50 and "Q" not in part) else 2,
+            csv_rows.append(dict(quantity_id=1 if (t0, t1) == (50, 150) else 2,
                                  K=e["K"], N=e["N"],
                                  runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1, value=r["z"],
                                  low=r["z_low"], high=r["z_high"], onset=e["onset"],
                                  growth_factor=e["growth"], paper=zc["value"], zloc_min=e["zloc_min"], zloc_max=e["zloc_max"]))
+    # z against K: the paper finds the same z for K = 0.25, 1 and 5
+    kz = [r for r in k_rows if r["K"] > 0 and r.get("z_50_150") is not None]
+    if len(kz) >= 2:
+        lows, highs = [r["z_50_150_low"] for r in kz], [r["z_50_150_high"] for r in kz]
+        overlap = max(lows) <= min(highs)
+        lines.append("| z independent of K (t = 50..150) | yes (1.49 for K = 0.25, 1, 5) | " +
+                     "; ".join(f"K = {r['K']:g}: "
+                               + ival(r["z_50_150"], r["z_50_150_low"], r["z_50_150_high"])
+                               for r in kz) +
+                     f" | {'intervals overlap' if overlap else 'no: intervals disjoint'} | "
+                     "local slope at t = 150: " +
+                     ", ".join(f"{fmt(r['zloc_150'])} (K = {r['K']:g})" for r in kz) +
+                     "; onset: " + ", ".join(f"{fmt(r['onset'])} ± {fmt(r['onset_se'], 2)}"
+                                             for r in kz) + " |")
+    # Q: not in the paper; how much the charged results depend on it
+    if len(q_rows) >= 2:
+        lines.append("| dependence on the charge scale Q (K = 5, t = 100) | Q not given | " +
+                     "; ".join(f"Q = {r['Q']:g}: t_c {fmt(r['onset'])} ± "
+                               f"{fmt(r['onset_se'], 2)}, S_grid {fmt(r['S_grid_100'])}, "
+                               f"<abs q> {fmt(r['mean_abs_q_100'])}" for r in q_rows) +
+                     " | - | qscan.csv; Q = 0.05 is 5 runs, the others 2 |")
     # onset against K
     ks = [(by[p]["K"], by[p]["onset"], by[p]["onset_se"])
           for p in ("neutral", "charged-K0.25", "charged-K1", "charged-K5") if p in by]
