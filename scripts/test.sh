@@ -23,15 +23,28 @@ NVCC=${NVCC:-$(command -v nvcc || echo /usr/local/cuda/bin/nvcc)}
 if [ -x "$NVCC" ]; then
   echo "== CUDA build (compile and link only; $("$NVCC" --version | tail -n 1))"
   CUDA_DIR=${GRANAGG_CUDA_BUILD_DIR:-build-cuda}
-  if [ ! -f "$CUDA_DIR/CMakeCache.txt" ]; then
-    cmake -S . -B "$CUDA_DIR" -DCMAKE_BUILD_TYPE=Release -DENABLE_CUDA=ON -DBUILD_TESTING=OFF \
-          -DCMAKE_CUDA_COMPILER="$NVCC" -DCMAKE_CUDA_ARCHITECTURES=90 >/dev/null
-  fi
-  cmake --build "$CUDA_DIR" -j "$JOBS"
-  test -x "$CUDA_DIR/bin/granagg"
-  echo "CUDA build OK: $CUDA_DIR/bin/granagg"
+  # granagg and the GPU test suite (test_md_gpu; run by scripts/gpu_check.sh on a GPU machine)
+  cmake -S . -B "$CUDA_DIR" -DCMAKE_BUILD_TYPE=Release -DENABLE_CUDA=ON -DBUILD_TESTING=ON \
+        -DCMAKE_CUDA_COMPILER="$NVCC" -DCMAKE_CUDA_ARCHITECTURES=90 >/dev/null
+  cmake --build "$CUDA_DIR" -j "$JOBS" --target granagg test_md_gpu
+  test -x "$CUDA_DIR/bin/granagg" && test -x "$CUDA_DIR/tests/test_md_gpu"
+  echo "CUDA build OK: $CUDA_DIR/bin/granagg, $CUDA_DIR/tests/test_md_gpu"
 else
   echo "== nvcc not found: CUDA build skipped"
+fi
+
+# The GPU check script's dry run (the CPU build in place of the CUDA one), so that it cannot rot
+echo "== scripts/gpu_check.sh --dry-run"
+TOTAL=$((TOTAL + 1))   # counted as one more test in the summary line
+GPU_DRY_RC=0
+bash scripts/gpu_check.sh --dry-run --out "$BUILD_DIR/gpu_check_dry" \
+  > "$BUILD_DIR/gpu_check_dry.log" 2>&1 || GPU_DRY_RC=$?
+if [ "$GPU_DRY_RC" -ne 0 ]; then
+  cat "$BUILD_DIR/gpu_check_dry.log"
+  echo "scripts/gpu_check.sh --dry-run failed (exit $GPU_DRY_RC)"
+  FAILED=$((FAILED + 1)); CTEST_RC=1
+else
+  echo "gpu_check dry run OK: $BUILD_DIR/gpu_check_dry/summary.md"
 fi
 
 echo "tests: $((TOTAL - FAILED)) passed, $FAILED failed"
