@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -37,6 +38,7 @@ struct MdArgs {
   int threads = 0;
   bool force = false;
   bool quiet = false;
+  bool profile = false;
 };
 
 std::string presetPath(const std::string& name) {
@@ -122,6 +124,45 @@ class Progress {
   clock::time_point m_start, m_last;
 };
 
+/// `--profile`: wall time by phase of the MD loop, printed (stderr) and written to `path` as one
+/// row (seconds per phase; `other` = the loop's time not in any phase: observables, output,
+/// checkpoints). Benchmarks read the CSV (scripts/bench_coulomb_lammps.sh), people the table.
+void writeProfile(const md::Engine& engine, const fs::path& path, const CliContext& ctx,
+                  std::int64_t steps, double loop_seconds) {
+  const auto phases = engine.phaseSeconds();
+  std::vector<std::string> columns = {"steps", "N", "loop_s"};
+  std::vector<double> row = {static_cast<double>(steps), static_cast<double>(engine.size()),
+                             loop_seconds};
+  double sum = 0.0;
+  std::fprintf(stderr, "md: time by phase (--profile), %lld steps, loop %.4g s:\n",
+               static_cast<long long>(steps), loop_seconds);
+  auto line = [&](const std::string& name, double s) {
+    std::fprintf(stderr, "md:   %-22s %10.4g s  %5.1f %%  %8.3g us/step\n", name.c_str(), s,
+                 loop_seconds > 0 ? 100.0 * s / loop_seconds : 0.0,
+                 steps > 0 ? 1e6 * s / steps : 0.0);
+  };
+  for (const auto& [name, s] : phases) {
+    std::string col;  // "PPPM k-space" -> "pppm_k_space_s"
+    for (char c : name)
+      col += std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::tolower(c)) : '_';
+    while (col.find("__") != std::string::npos) col.erase(col.find("__"), 1);
+    if (!col.empty() && col.back() == '_') col.pop_back();
+    columns.push_back(col + "_s");
+    row.push_back(s);
+    sum += s;
+    if (s > 0.0) line(name, s);
+  }
+  columns.push_back("other_s");
+  row.push_back(loop_seconds - sum);
+  line("other (output, obs.)", loop_seconds - sum);
+  common::Provenance prov(ctx.command_line);
+  prov.add("version", common::versionString());
+  prov.add("backend", md::Engine::backendDescription());
+  common::CsvWriter w(path.string(), prov, columns, /*overwrite=*/true);
+  w.row(row);
+  w.close();
+}
+
 void runMd(const MdArgs& a, const CliContext& ctx) {
   if (a.threads < 0) throw std::invalid_argument("--threads must be >= 1.");
   if (a.threads > 0) md::Engine::setThreads(a.threads);
@@ -166,6 +207,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     md::Engine::assignInitialCharges(cfg, init);
   }
   md::Engine engine(cfg, init, /*allow_contacts=*/restart);
+  engine.enableProfile(a.profile);
   if (restart) {
     std::vector<double> f = ck.extra.fx;
     f.insert(f.end(), ck.extra.fy.begin(), ck.extra.fy.end());
@@ -305,6 +347,8 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   const double loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   checkpoint();
   writer->close();
+  if (a.profile)
+    writeProfile(engine, out / "profile.csv", ctx, engine.step() - first_step, loop_seconds);
   if (!quiet) {
     const auto o = engine.observables();
     const std::int64_t steps = engine.step() - first_step, builds = engine.neighborBuilds() - first_builds;
@@ -335,6 +379,10 @@ void registerMdCommand(CLI::App& app, const CliContext& ctx) {
   md->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)");
   md->add_flag("--force", a->force, "Overwrite an existing output folder");
   md->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
+  md->add_flag(
+      "--profile", a->profile,
+      "Time the MD loop by phase (contact pass, lists, Coulomb, PPPM parts); prints a table "
+      "and writes OUT/profile.csv. Changes no result");
   md->callback([a, ctx]() { runMd(*a, ctx); });
 }
 

@@ -1,6 +1,7 @@
 #include "md/coulomb/Pppm.h"
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -12,6 +13,7 @@
 
 #include "common/HostDevice.h"
 #include "md/engine/ParticleData.h"  // DVec, raw
+#include "md/engine/PhaseTimer.h"
 #include "md/fft/Fft3d.h"
 
 namespace granagg::md {
@@ -319,6 +321,7 @@ struct Pppm::Impl {
   double self_correction = 0.0;      // mean P3M self-energy error per unit q^2 (SelfEnergyTerm)
   PppmEnergies energies;
   bool computed = false;
+  PhaseTimer* timer = nullptr;       // setPhaseTimer
 
   /// compute() for particle data with `stride` doubles between consecutive particles.
   double run(const double* x, const double* y, const double* z, const double* q, long stride, std::size_t n,
@@ -418,7 +421,9 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   s.energies.self = EwaldReference::selfEnergy(s.params.alpha, s.K, sum_q2);
   s.energies.background = EwaldReference::backgroundEnergy(s.params.alpha, s.K, s.L, sum_q);
 
+  using Scope = PhaseTimer::Scope;
   // 1. sort particles by (stencil cell, id)
+  std::optional<Scope> phase(std::in_place, s.timer, PhaseTimer::PppmSort);
   s.key.resize(n);
   s.order.resize(n);
   thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(N),
@@ -435,6 +440,7 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
                    CellStart{raw(s.cell), static_cast<long>(n), nr, raw(s.start)});
 
   // 2. charge assignment (tiles by colour, see ScatterTile) and forward FFT
+  phase.emplace(s.timer, PhaseTimer::PppmAssign);
   thrust::fill(s.mesh.begin(), s.mesh.end(), 0.0);
   const int T = s.tiles;
   const int colours = T == 1 ? 1 : 2;
@@ -445,7 +451,9 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
         thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(tiles_per_pass),
                          ScatterTile{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx), raw(s.jy), raw(s.jz),
                                      raw(s.start), M, P, T, cx, cy, cz, raw(s.mesh)});
+  phase.emplace(s.timer, PhaseTimer::PppmFft);
   s.fft.forward(raw(s.mesh), raw(s.spectrum));
+  phase.emplace(s.timer, PhaseTimer::PppmKspace);
 
   // 3. energy (K / 2V) sum_k G |Q|^2
   thrust::for_each(counting_iterator<long>(0), counting_iterator<long>(nc),
@@ -455,10 +463,13 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   // 4. field by ik-differentiation: one inverse FFT per component (backward overwrites `work`)
   DVec<double>* field[3] = {&s.ex, &s.ey, &s.ez};
   for (int d = 0; d < 3; ++d) {
+    phase.emplace(s.timer, PhaseTimer::PppmKspace);
     thrust::for_each(counting_iterator<long>(0), counting_iterator<long>(nc),
                      FieldSpectrum{raw(s.G), raw(s.spectrum), M, d, 2.0 * PI / s.L / s.V, raw(s.work)});
+    phase.emplace(s.timer, PhaseTimer::PppmFft);
     s.fft.backward(raw(s.work), raw(*field[d]));
   }
+  phase.emplace(s.timer, PhaseTimer::PppmInterpolate);
 
   // 5. interpolation back to the particles
   thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(N),
@@ -496,5 +507,6 @@ const PppmEnergies& Pppm::lastEnergies() const {
 }
 const PppmParams& Pppm::params() const { return m_impl->params; }
 double Pppm::boxLength() const { return m_impl->L; }
+void Pppm::setPhaseTimer(PhaseTimer* timer) { m_impl->timer = timer; }
 
 }  // namespace granagg::md

@@ -38,6 +38,8 @@ struct PppmEnergies {
   double total() const { return kspace + self + background; }
 };
 
+class PhaseTimer;
+
 class Pppm {
  public:
   /// Precomputes the influence function and plans the FFTs. \param params alpha > 0, mesh >= order,
@@ -69,6 +71,8 @@ class Pppm {
   const PppmEnergies& lastEnergies() const;
   const PppmParams& params() const;
   double boxLength() const;
+  /// Times the phases of compute() into `timer` (md/engine/PhaseTimer.h; null: none).
+  void setPhaseTimer(PhaseTimer* timer);
 
  private:
   struct Impl;

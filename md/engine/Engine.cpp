@@ -33,6 +33,7 @@
 #include "md/coulomb/EwaldParams.h"
 #include "md/coulomb/Pppm.h"
 #include "md/engine/ParticleData.h"
+#include "md/engine/PhaseTimer.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/neighbor/NeighborList.h"
 #include "md/potentials/HertzViscoelastic.h"
@@ -139,6 +140,7 @@ struct Engine::Impl {
   bool hertz = true;
   HertzViscoelastic::Params hertz_params{};
   SpringDashpot::Params sd_params{};
+  PhaseTimer timer;                         // Engine::enableProfile
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
     nl.keepPairs(true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
@@ -185,6 +187,7 @@ struct Engine::Impl {
   /// cost is a gather per array, far less than the cache misses of neighbours scattered in memory).
   /// A re-sort moves slots, so it rebuilds every list.
   void rebuildList(bool sort) {
+    PhaseTimer::Scope phase(&timer, nl_coul ? PhaseTimer::CoulombList : PhaseTimer::ContactList);
     const bool sorted = sort && sortByCell();
     if (nl_coul) {
       nl_coul->build(p, box);
@@ -207,6 +210,7 @@ struct Engine::Impl {
     if (!nl_coul) {
       rebuildList(true);
     } else if (nl.listRange() <= nl_coul->listRange() - 2.0 * drift_since_coul_build) {
+      PhaseTimer::Scope phase(&timer, PhaseTimer::ContactList);
       nl.buildFrom(*nl_coul, p, box);
       drift_since_build = 0.0;
     } else {
@@ -256,6 +260,7 @@ struct Engine::Impl {
         prm.estimated_error_kspace = pppmKspaceError(prm.alpha, prm.mesh, prm.order, N, L, sum_q2_design);
       }
       pppm = std::make_unique<Pppm>(prm, L, cc.K);
+      pppm->setPhaseTimer(&timer);
       csetup.alpha = prm.alpha;
       csetup.r_cut = prm.r_cut;
       csetup.mesh = prm.mesh;
@@ -314,11 +319,16 @@ struct Engine::Impl {
     const std::size_t N = p.size();
     kspace_step = step;
     if (pppm) {
-      coulombRealForces(p, *nl_coul, box, realParams(), ext_fx, ext_fy, ext_fz);
+      {
+        PhaseTimer::Scope phase(&timer, PhaseTimer::CoulombReal);
+        coulombRealForces(p, *nl_coul, box, realParams(), ext_fx, ext_fy, ext_fz);
+      }
       coulomb_ext_energy = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), N, raw(ext_fx), raw(ext_fy),
                                          raw(ext_fz), raw(p.id));
       return;
     }
+    // the plain-Ewald reference: all of its evaluation counts as the slow real space
+    PhaseTimer::Scope phase(&timer, PhaseTimer::CoulombReal);
     const CoulombResult r = ewaldOnHost();
     toDevice(r.fx, ext_fx);
     toDevice(r.fy, ext_fy);
@@ -373,6 +383,7 @@ struct Engine::Impl {
     st.dq = dqOrNull();
     st.displacement_bound = drift_since_build;
     if (advance) st.advance_dt = dt;
+    PhaseTimer::Scope phase(&timer, PhaseTimer::ContactPass);
     const ContactStepResult r = hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
                                       : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
     if (r.worst != 0) abort(r.worst);
@@ -399,6 +410,7 @@ struct Engine::Impl {
   /// Applies a deferred closing kick: afterwards v = v(t).
   void finishStep() {
     if (!close_pending) return;
+    PhaseTimer::Scope phase(&timer, PhaseTimer::KickDrift);
     closeKick(p, 0.5 * dt, dqOrNull());
     close_pending = false;
   }
@@ -508,6 +520,7 @@ struct Engine::Impl {
 
   /// [Previous closing kick +] opening kick + drift (VelocityVerlet.h).
   void openStep() {
+    PhaseTimer::Scope phase(&timer, PhaseTimer::KickDrift);
     driftTaken(kickDrift(p, 0.5 * dt, dt, box, close_pending, dqOrNull(), block_max));
     close_pending = false;
   }
@@ -748,6 +761,11 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
     }
   }
   d.rebuildList(false);
+}
+
+void Engine::enableProfile(bool on) { m_impl->timer.enable(on); }
+std::vector<std::pair<std::string, double>> Engine::phaseSeconds() const {
+  return m_impl->timer.seconds();
 }
 
 Observables Engine::observables() const {

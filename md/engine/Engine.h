@@ -33,6 +33,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "md/config/MdConfig.h"
@@ -145,6 +146,11 @@ class Engine {
   std::size_t size() const;
   /// Number of neighbour-list builds so far (diagnostics).
   std::int64_t neighborBuilds() const;
+  /// Times the phases of every following step (md/engine/PhaseTimer.h; `granagg md --profile`).
+  /// Changes no result; on the CUDA backend each phase then waits for the device.
+  void enableProfile(bool on);
+  /// Wall seconds per phase since profiling was enabled, in PhaseTimer's order (zeros if never).
+  std::vector<std::pair<std::string, double>> phaseSeconds() const;
   /// The Coulomb parameters in use, or null when coulomb.K = 0.
   const CoulombSetup* coulombSetup() const;
   /// Re-chooses the Coulomb parameters for sum_q2_design (a restart passes the stored value, so
