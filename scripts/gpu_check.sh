@@ -47,7 +47,7 @@ CUDA_DIR=${GRANAGG_CUDA_BUILD_DIR:-build-cuda}
 
 build_cuda() {  # configure and build granagg + test_md_gpu in $CUDA_DIR; log to $1
   [ -x "$NVCC" ] || { echo "gpu_check: nvcc not found (set NVCC)" >&2; exit 2; }
-  bash scripts/setup.sh > "$1" 2>&1   # Debian packages (and the CPU build, used by nothing here)
+  GRANAGG_SETUP_NO_BUILD=1 bash scripts/setup.sh > "$1" 2>&1   # the Debian packages
   cmake -S . -B "$CUDA_DIR" -DCMAKE_BUILD_TYPE=Release -DENABLE_CUDA=ON -DBUILD_TESTING=ON \
         -DCMAKE_CUDA_COMPILER="$NVCC" -DCMAKE_CUDA_ARCHITECTURES=90 >> "$1" 2>&1
   cmake --build "$CUDA_DIR" -j "$JOBS" --target granagg test_md_gpu >> "$1" 2>&1 \
@@ -59,11 +59,13 @@ if [ "$MODE" = bundle ]; then
   mkdir -p "$BUNDLE/bin" "$BUNDLE/lib"
   build_cuda "$BUNDLE/build.log"
   cp "$CUDA_DIR/bin/granagg" "$CUDA_DIR/tests/test_md_gpu" "$BUNDLE/bin/"
-  # glibc and the dynamic loader come from the GPU machine (newer glibc runs binaries built on an
-  # older one); libcuda is the driver's; the CUDA toolkit's libraries (cudart, cufft) must be the
-  # GPU machine's own toolkit of the same major version (CUDA 13 here).
+  strip "$BUNDLE/bin/granagg" "$BUNDLE/bin/test_md_gpu"   # ~56 MB in all: fits a 64 MiB transfer
+  # glibc, the dynamic loader, libstdc++ and libgcc_s come from the GPU machine (newer versions
+  # run binaries built against older ones); libcuda is the driver's; the CUDA toolkit's libraries
+  # (cudart, cufft) must be the GPU machine's own toolkit of the same major version (CUDA 13 here).
   ldd "$BUNDLE/bin/granagg" "$BUNDLE/bin/test_md_gpu" | awk '/=> \// {print $3}' | sort -u |
-    grep -Ev '/(libc|libm|libdl|librt|libpthread|ld-linux[^/]*|libcuda|libcudart|libcufft)\.so' |
+    grep -Ev '/(libc|libm|libdl|librt|libpthread|ld-linux[^/]*|libstdc\+\+|libgcc_s)\.so' |
+    grep -Ev '/(libcuda|libcudart|libcufft)\.so' |
     while read -r lib; do cp -L "$lib" "$BUNDLE/lib/"; done
   git rev-parse HEAD > "$BUNDLE/commit" 2>/dev/null || true
   echo "gpu_check: bundle in $BUNDLE ($(du -sh "$BUNDLE" | cut -f1)); on the GPU machine, from a" \

@@ -3,6 +3,7 @@
 # configures + builds the CPU build in ./build. Used by scripts/test.sh and scripts/demo.sh.
 #   GRANAGG_BUILD_DIR   build folder (default: build)
 #   GRANAGG_JOBS        parallel compile jobs (default: nproc)
+#   GRANAGG_SETUP_NO_BUILD=1   install the packages only (scripts/gpu_check.sh builds its own)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,6 +22,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+
+[ "${GRANAGG_SETUP_NO_BUILD:-0}" = 1 ] && exit 0
 
 BUILD_DIR=${GRANAGG_BUILD_DIR:-build}
 JOBS=${GRANAGG_JOBS:-$(nproc)}
