@@ -50,6 +50,7 @@ LOG="$OUT/validate.log"
 say() { echo "[$(date -u +%FT%TZ)] $*" | tee -a "$LOG" >&2; }
 
 PAIR_OPTS=(-q)
+FAILED_PARTS=()
 [ -n "${VALIDATE_JOBS:-}" ] && PAIR_OPTS+=(--jobs "$VALIDATE_JOBS")
 [ -n "${VALIDATE_THREADS:-}" ] && PAIR_OPTS+=(--threads "$VALIDATE_THREADS")
 
@@ -67,7 +68,14 @@ pair() {
     [ -f "$f" ] && ! grep -q beta_asymptotic "$f" && rm -f "${f%/fit_beta.json}.done"
   done
   say "part $name: granagg pair $* --out $OUT/$name"
-  "$G" pair "$@" --out "$OUT/$name" "${PAIR_OPTS[@]}"
+  if ! "$G" pair "$@" --out "$OUT/$name" "${PAIR_OPTS[@]}"; then
+    # a part whose runs stop (e.g. a Coulomb collapse at a large Q) is a result, not the end of
+    # the study: recorded, the other parts still run, and the script exits 1 at the end
+    say "part $name: FAILED after $(( $(date +%s) - t0 )) s (see $OUT/$name/pair.log)"
+    echo "$name,failed,$(date -u +%FT%TZ)" >> "$OUT/cost.csv"
+    FAILED_PARTS+=("$name")
+    return 0
+  fi
   local dt=$(( $(date +%s) - t0 ))
   say "part $name: done in $dt s (wall time of this call; resumed parts count only what was left)"
   echo "$name,$dt,$(date -u +%FT%TZ)" >> "$OUT/cost.csv"
@@ -167,6 +175,10 @@ for part in "${PARTS[@]}"; do
                 "$PY" scripts/validation_report.py "$OUT" ;;
   esac
 done
+if [ ${#FAILED_PARTS[@]} -gt 0 ]; then
+  say "validate.sh: parts ${PARTS[*]} done; FAILED: ${FAILED_PARTS[*]} (rerun to retry their runs)"
+  exit 1
+fi
 say "validate.sh: parts ${PARTS[*]} finished; report in $OUT/report/"
 exit
 }

@@ -13,6 +13,7 @@ windows: OUT/<part>/windows; grid variants: OUT/sensitivity) and writes OUT/repo
   sensitivity.csv     z and onset for each grid definition
   kscan.csv           the charged gas against K (0.25, 1, 5; neutral beside): onset, S, slopes, z
   qscan.csv           K = 5 against the charge scale Q (0.025, 0.05, 0.1) at t = 50 and 100
+  fig_onset.png       S and its local slope against t / t_c (is growth one curve shifted in time?)
   S_<part>.csv        ensemble S(t) (grid and particle, standard errors, local slope of the mean)
   fig_*.png           the figures (docs/validation.md shows them)
 With --publish ROOT, copies the CSV tables to ROOT/docs/validation/, the figures to
@@ -287,6 +288,18 @@ def at(tab, name, t):
     return float(c[k]) if k is not None else float("nan")
 
 
+def at_log(tab, name, t):
+    """Column `name` of `tab` interpolated linearly in ln t at t (nan outside the frames)."""
+    c = col(tab, name)
+    if c is None or not np.isfinite(t) or t <= 0:
+        return float("nan")
+    m = (tab["t"] > 0) & np.isfinite(c)
+    ts, ys = tab["t"][m], c[m]
+    if len(ts) < 2 or t < ts[0] or t > ts[-1] * (1 + 1e-4):
+        return float("nan")
+    return float(np.interp(np.log(t), np.log(ts), ys))
+
+
 def window_z(win_rows, part, t0, t1, column="S_grid_mean"):
     """The fit-beta row of `part` over [t0, t1] (within 5 %), or None."""
     for r in win_rows:
@@ -294,6 +307,23 @@ def window_z(win_rows, part, t0, t1, column="S_grid_mean"):
                 and abs(r["t0"] - t0) < 0.05 * t0 and abs(r["t1"] - t1) < 0.05 * t1):
             return r
     return None
+
+
+def collapsed_runs(d):
+    """[(t, reason)] of the MD runs that stopped in the pair study at `d` (its pair.log), or []."""
+    log = os.path.join(d, "pair.log")
+    if not os.path.exists(log):
+        return []
+    out = []
+    with open(log) as f:
+        for line in f:
+            if "FAILED" not in line or "(t = " not in line:
+                continue
+            t = line.split("(t = ", 1)[1].split(")", 1)[0]
+            reason = ("overlap beyond run.max_overlap: Coulomb collapse"
+                      if "attractive Coulomb pair" in line else "run stopped")
+            out.append((t, reason))
+    return out
 
 
 def scan_tables(have, ens_rows, win_rows, rep):
@@ -316,6 +346,11 @@ def scan_tables(have, ens_rows, win_rows, rep):
             r[f"largest_particle_frac_{t}"] = at(S, "largest_particle_mean", t) / e["N"]
             r[f"mean_abs_q_{t}"] = at(th, "mean_abs_q_mean", t) if th is not None else float("nan")
             r[f"T_g_{t}"] = at(th, "T_g_mean", t) if th is not None else float("nan")
+        # the local slope at a fixed multiple of the onset time: equal along the ensembles if
+        # their growth is one curve shifted in time (S(t) = F(t / t_c))
+        for f in (1.25, 1.5, 2.0):
+            key = f"zloc_at_{f:g}tc".replace(".", "p")  # zloc_at_1p25tc
+            r[key] = at_log(S, "z_local_grid_of_mean", f * e["onset"])
         r.update(charging=e["charging"], charging_low=e["charging_low"],
                  charging_high=e["charging_high"])
         return r
@@ -338,8 +373,15 @@ def scan_tables(have, ens_rows, win_rows, rep):
     q_rows = []
     for name in ("charged-K5-Q0.025", "charged-K5", "charged-K5-Q0.1"):
         if name not in by:
+            stopped = collapsed_runs(os.path.join(os.path.dirname(rep), name))
+            if stopped:  # every run stopped: a result (a Coulomb collapse), not a missing part
+                q_rows.append(dict(part=name, K=5.0, Q=float(name.split("-Q")[1]),
+                                   status="all %d runs stopped at t = %s: %s" % (
+                                       len(stopped), " / ".join(t for t, _ in stopped),
+                                       stopped[0][1])))
             continue
         r = common(by[name], (50, 100))
+        r["status"] = "ok"
         for t0, t1 in ((10, 100), (50, 100)):
             w = window_z(win_rows, name, t0, t1)
             r[f"z_{t0}_{t1}"], r[f"z_{t0}_{t1}_low"], r[f"z_{t0}_{t1}_high"] = (
@@ -358,7 +400,9 @@ def write_csv(path, rows, header):
         f.write(header + "\n")
         if not rows:
             return
-        keys = list(rows[0].keys())
+        keys = []
+        for r in rows:  # rows may differ (a collapsed Q has no numbers): the union, in order
+            keys += [k for k in r if k not in keys]
         f.write(",".join(keys) + "\n")
         for r in rows:
             f.write(",".join(cell(r.get(k)) for k in keys) + "\n")
@@ -531,6 +575,32 @@ def figures(have, rep, out):
         save(fig, rep, fname)
 
 
+    # Time measured from the onset: S_grid / S_base and the local slope against t / t_c
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.4))
+    for p in have:
+        S, f = p.table("S_t.csv"), p.fits()
+        tc = float(f["onset_time_grid"]) if "onset_time_grid" in f.dtype.names else float("nan")
+        base = (float(f["onset_S_base_grid"]) if "onset_S_base_grid" in f.dtype.names
+                else float("nan"))
+        if not (np.isfinite(tc) and base > 0):
+            continue
+        m = (S["t"] > 0) & np.isfinite(S["S_grid_mean"])
+        lab = f"{p.label} (t_c = {tc:.3g})"
+        a1.loglog(S["t"][m] / tc, S["S_grid_mean"][m] / base, "o-", ms=2.5, lw=0.8,
+                  color=p.colour, label=lab)
+        z = col(S, "z_local_grid_of_mean")
+        mz = m & np.isfinite(z) & (S["t"] >= 5)
+        a2.plot(S["t"][mz] / tc, z[mz], ".-", ms=3, lw=0.8, color=p.colour, label=lab)
+    a1.set(xlabel="t / t_c", ylabel="S_grid / (its median over t <= 10)",
+           title="growth against time from the onset")
+    a2.set(xscale="log", xlabel="t / t_c", ylabel="local slope of the mean S_grid",
+           title="local slope against t / t_c")
+    a2.axhline(1.21, color="k", ls="--", lw=0.7)
+    a2.axhline(1.49, color="k", ls=":", lw=0.7)
+    a1.legend(fontsize=7)
+    save(fig, rep, "fig_onset")
+
+
 def save(fig, rep, name):
     fig.tight_layout()
     fig.savefig(os.path.join(rep, name + ".png"), dpi=110)
@@ -625,9 +695,10 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_
     # Q: not in the paper; how much the charged results depend on it
     if len(q_rows) >= 2:
         lines.append("| dependence on the charge scale Q (K = 5, t = 100) | Q not given | " +
-                     "; ".join(f"Q = {r['Q']:g}: t_c {fmt(r['onset'])} ± "
-                               f"{fmt(r['onset_se'], 2)}, S_grid {fmt(r['S_grid_100'])}, "
-                               f"<abs q> {fmt(r['mean_abs_q_100'])}" for r in q_rows) +
+                     "; ".join((f"Q = {r['Q']:g}: t_c {fmt(r['onset'])} ± "
+                                f"{fmt(r['onset_se'], 2)}, S_grid {fmt(r['S_grid_100'])}, "
+                                f"<abs q> {fmt(r['mean_abs_q_100'])}") if r["status"] == "ok"
+                               else f"Q = {r['Q']:g}: {r['status']}" for r in q_rows) +
                      " | - | qscan.csv; Q = 0.05 is 5 runs, the others 2 |")
     # onset against K
     ks = [(by[p]["K"], by[p]["onset"], by[p]["onset_se"])
