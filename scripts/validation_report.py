@@ -701,13 +701,17 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_
                                else f"Q = {r['Q']:g}: {r['status']}" for r in q_rows) +
                      " | - | qscan.csv; Q = 0.05 is 5 runs, the others 2 |")
     # onset against K
-    ks = [(by[p]["K"], by[p]["onset"], by[p]["onset_se"])
+    # an onset not reached by t_end is later than t_end (a lower bound, for the order)
+    ks = [(by[p]["K"], by[p]["onset"], by[p]["onset_se"], by[p]["t_end"])
           for p in ("neutral", "charged-K0.25", "charged-K1", "charged-K5") if p in by]
     if len(ks) >= 2:
         ks.sort()
-        mono = all(ks[i][1] >= ks[i + 1][1] for i in range(len(ks) - 1))
+        lower = [t if np.isfinite(t) else te for _, t, _, te in ks]
+        mono = all(lower[i] >= lower[i + 1] for i in range(len(ks) - 1))
         lines.append("| onset time t_c against K | falls as K grows | " +
-                     ", ".join(f"K = {k:g}: {fmt(t)} ± {fmt(s, 2)}" for k, t, s in ks) +
+                     ", ".join(f"K = {k:g}: {fmt(t)} ± {fmt(s, 2)}" if np.isfinite(t)
+                               else f"K = {k:g}: > {fmt(te)} (not reached)"
+                               for k, t, s, te in ks) +
                      f" | {'yes' if mono else 'no'} | t_c: S_grid reaches twice its early median |")
     # Fisher
     fp = {(r["part"], round(r["t"] / 50) * 50): r for r in fi_rows}
