@@ -355,15 +355,19 @@ def scan_tables(have, ens_rows, win_rows, rep):
                  charging_high=e["charging_high"])
         return r
 
+    def add_windows(r, name, windows):
+        """z_T0_T1 (and _low, _high) of each fitted window into row r (None if not fitted)."""
+        for t0, t1 in windows:
+            w = window_z(win_rows, name, t0, t1)
+            r[f"z_{t0}_{t1}"], r[f"z_{t0}_{t1}_low"], r[f"z_{t0}_{t1}_high"] = (
+                (w["z"], w["z_low"], w["z_high"]) if w else (None, None, None))
+
     k_rows = []
     for name in ("neutral", "charged-K0.25", "charged-K1", "charged-K5"):
         if name not in by:
             continue
         r = common(by[name], (50, 100, 150))
-        for t0, t1 in ((10, 150), (50, 150), (100, 1000)):
-            w = window_z(win_rows, name, t0, t1)
-            r[f"z_{t0}_{t1}"], r[f"z_{t0}_{t1}_low"], r[f"z_{t0}_{t1}_high"] = (
-                (w["z"], w["z_low"], w["z_high"]) if w else (None, None, None))
+        add_windows(r, name, ((10, 150), (50, 150), (100, 1000)))
         k_rows.append(r)
     write_csv(os.path.join(rep, "kscan.csv"), k_rows,
               "# the gas against K (neutral K = 0 at N = 50016 beside the charged N = 1e4): onset "
@@ -382,10 +386,7 @@ def scan_tables(have, ens_rows, win_rows, rep):
             continue
         r = common(by[name], (50, 100))
         r["status"] = "ok"
-        for t0, t1 in ((10, 100), (50, 100)):
-            w = window_z(win_rows, name, t0, t1)
-            r[f"z_{t0}_{t1}"], r[f"z_{t0}_{t1}_low"], r[f"z_{t0}_{t1}_high"] = (
-                (w["z"], w["z_low"], w["z_high"]) if w else (None, None, None))
+        add_windows(r, name, ((10, 100), (50, 100)))
         q_rows.append(r)
     q_rows.sort(key=lambda r: r["Q"])
     write_csv(os.path.join(rep, "qscan.csv"), q_rows,
@@ -611,17 +612,12 @@ def save(fig, rep, name):
 
 def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_rows):
     by = {r["part"]: r for r in ens_rows}
-    win = {(r["part"], r["column"], r["t0"], r["t1"]): r for r in win_rows}
     csv_rows = []
     lines = ["| quantity | paper | granagg (95 % interval) | agree? | why not / remark |",
              "|---|---|---|---|---|"]
 
-    def zwin(part, t0, t1, column="S_grid_mean"):
-        for (p, c, a, b), r in win.items():
-            if (p == part and c == column and a is not None and abs(a - t0) < 0.05 * t0
-                    and abs(b - t1) < 0.05 * t1):
-                return r
-        return None
+    def zwin(part, t0, t1):
+        return window_z(win_rows, part, t0, t1)
 
     zp = PAPER["z_neutral"]
     for part, t0, t1 in (("neutral", 100, 1000), ("neutral", 631, 1000), ("box", 100, 1000),
