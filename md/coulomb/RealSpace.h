@@ -86,46 +86,66 @@ inline double slowPairForceOverR(double r, double alpha, const RealSpaceSwitch& 
   return (std::erfc(ar) / r + TWO_OVER_SQRT_PI * alpha * std::exp(-ar * ar)) / (r * r) - sw.fastFraction(r) / (r * r * r);
 }
 
-/// Linear interpolation in r^2 of a table of a smooth function g (here slowPairForceOverR) on
-/// [0, r2_max]: entry k holds g(k h) and g((k+1) h) - g(k h), h = r2_max / n. Tabulating in r^2
-/// needs no square root; LAMMPS tabulates its coul/long force the same way (pair_modify table).
+/// Piecewise-cubic interpolation in r^2 of a smooth function g (the slow or fast pair force over
+/// r) on [0, r2_max] with n intervals of width h = r2_max / n. Interval k holds the monomial
+/// coefficients of the cubic through g at r^2 = (k + t) h for t = 0, 1/3, 2/3, 1, so the table is
+/// continuous and its error falls as h^4: a few hundred intervals (8-16 KiB, resident in the
+/// first-level cache) are as accurate as 2^13 linear ones were (128 KiB, in the second level, whose
+/// latency dominated the pair loops). Tabulating in r^2 needs no square root (LAMMPS's
+/// `pair_modify table` does the same, linearly). Interval n repeats g(r2_max), so a lookup at
+/// exactly r2_max is defined.
 struct PairTable {
-  const double* data = nullptr;  ///< 2 (n + 1) values (device pointer)
-  double inv_h = 0.0;
+  const double* data = nullptr;  ///< 4 (n + 1) coefficients (device pointer)
+  double inv_h = 0.0;            ///< n / r2_max
   HD double operator()(double r2) const {
     const double x = r2 * inv_h;
     const int k = static_cast<int>(x);
-    const double* e = data + 2 * k;
-    return e[0] + (x - k) * e[1];
+    const double t = x - k;
+    const double* c = data + 4 * k;
+    return c[0] + t * (c[1] + t * (c[2] + t * c[3]));
   }
 };
+/// Intervals of the engine's tables (PairTable; errors in tests/md/test_coulomb_md.cpp): the slow
+/// force is smooth everywhere; the fast one is steep (1 / r^3) at deep overlaps.
+constexpr int SLOW_PAIR_TABLE_INTERVALS = 256;
+constexpr int FAST_PAIR_TABLE_INTERVALS = 512;
+
 /// The fast pair force of the split divided by K q_i q_j and by r: S(r) / r^3, held at its value at
 /// r = 0.3 below that (no pair gets that close: an overlap of 0.7 aborts a run long before).
 inline double fastPairForceOverR(double r, const RealSpaceSwitch& sw) {
   const double rr = r < 0.3 ? 0.3 : r;
   return sw.fastFraction(rr) / (rr * rr * rr);
 }
-/// Host values of a PairTable of g with n intervals on [0, r2_max] (g of r^2 at the nodes).
+/// Host coefficients of a PairTable of g (a function of r^2) with n intervals on [0, r2_max]: the
+/// cubic through the samples v0..v3 at t = 0, 1/3, 2/3, 1, from their forward differences
+/// (Newton's form in u = 3 t, expanded in t).
 template <class G>
 std::vector<double> pairTableValues(G g_of_r2, double r2_max, int n) {
   const double h = r2_max / n;
-  std::vector<double> g(n + 2), out(2 * (n + 1));
-  for (int k = 0; k <= n + 1; ++k) g[k] = g_of_r2(k * h, k);
-  for (int k = 0; k <= n; ++k) {
-    out[2 * k] = g[k];
-    out[2 * k + 1] = g[k + 1] - g[k];
+  std::vector<double> out(4 * static_cast<std::size_t>(n + 1));
+  for (int k = 0; k < n; ++k) {
+    const double v0 = g_of_r2(k * h), v1 = g_of_r2((k + 1.0 / 3.0) * h), v2 = g_of_r2((k + 2.0 / 3.0) * h),
+                 v3 = g_of_r2((k + 1) * h);
+    const double d1 = v1 - v0, d2 = v2 - 2.0 * v1 + v0, d3 = v3 - 3.0 * v2 + 3.0 * v1 - v0;
+    out[4 * k] = v0;
+    out[4 * k + 1] = 3.0 * (d1 - 0.5 * d2 + d3 / 3.0);
+    out[4 * k + 2] = 4.5 * (d2 - d3);
+    out[4 * k + 3] = 4.5 * d3;
   }
+  out[4 * static_cast<std::size_t>(n)] = g_of_r2(r2_max);  // constant beyond (t = 0 at r2_max)
   return out;
 }
-/// Table of fastPairForceOverR on [0, r2^2]; entries from r2^2 on are 0 (S(r2) = 0), so a lookup
-/// at min(r^2, r2^2) is the force for any r.
-inline std::vector<double> fastPairTableValues(const RealSpaceSwitch& sw, int n) {
-  return pairTableValues([&](double r2, int k) { return k >= n ? 0.0 : fastPairForceOverR(std::sqrt(r2), sw); },
-                         sw.r2 * sw.r2, n);
+/// A PairTable over host or device coefficients from pairTableValues(..., r2_max, n).
+inline PairTable pairTable(const double* data, double r2_max, int n) { return PairTable{data, n / r2_max}; }
+/// Table of fastPairForceOverR on [0, r2^2]; zero from r2^2 on (S(r2) = 0), so a lookup at
+/// min(r^2, r2^2) is the force for any r.
+inline std::vector<double> fastPairTableValues(const RealSpaceSwitch& sw, int n = FAST_PAIR_TABLE_INTERVALS) {
+  return pairTableValues([&](double r2) { return fastPairForceOverR(std::sqrt(r2), sw); }, sw.r2 * sw.r2, n);
 }
 /// Table of slowPairForceOverR on [0, r2_max].
-inline std::vector<double> slowPairTableValues(double alpha, const RealSpaceSwitch& sw, double r2_max, int n) {
-  return pairTableValues([&](double r2, int) { return slowPairForceOverR(std::sqrt(r2), alpha, sw); }, r2_max, n);
+inline std::vector<double> slowPairTableValues(double alpha, const RealSpaceSwitch& sw, double r2_max,
+                                               int n = SLOW_PAIR_TABLE_INTERVALS) {
+  return pairTableValues([&](double r2) { return slowPairForceOverR(std::sqrt(r2), alpha, sw); }, r2_max, n);
 }
 
 }  // namespace granagg::md

@@ -44,9 +44,6 @@ namespace granagg::md {
 
 namespace {
 constexpr double M_EFF = 0.5;  // reduced mass of two unit masses
-// intervals of the tables of the fast and slow Coulomb pair forces (PairTable): interpolation
-// errors ~1e-7 relative to K (tests)
-constexpr int PAIR_TABLE_INTERVALS = 1 << 13;
 // coulomb.every = "auto": time between evaluations of the slow Coulomb part (Engine::coulombEvery)
 constexpr double SLOW_INTERVAL = 0.016;
 
@@ -279,9 +276,9 @@ struct Engine::Impl {
         fast_switch = RealSpaceSwitch{std::max(0.0, r2 - 1.0), r2};
         csetup.r_fast = r2;
         csetup.every = every;
-        const auto t = slowPairTableValues(prm.alpha, fast_switch, prm.r_cut * prm.r_cut, PAIR_TABLE_INTERVALS);
+        const auto t = slowPairTableValues(prm.alpha, fast_switch, prm.r_cut * prm.r_cut);
         slow_table.assign(t.begin(), t.end());
-        const auto f = fastPairTableValues(fast_switch, PAIR_TABLE_INTERVALS);
+        const auto f = fastPairTableValues(fast_switch);
         fast_table.assign(f.begin(), f.end());
       }
       nl = NeighborList(std::max(1.0, fast_switch.r2), skin);
@@ -300,7 +297,8 @@ struct Engine::Impl {
 
   CoulombRealParams realParams() const {
     CoulombRealParams prm{cfg.coulomb.K, csetup.alpha, csetup.r_cut, fast_switch};
-    if (!slow_table.empty()) prm.table = PairTable{raw(slow_table), PAIR_TABLE_INTERVALS / (csetup.r_cut * csetup.r_cut)};
+    if (!slow_table.empty())
+      prm.table = pairTable(raw(slow_table), csetup.r_cut * csetup.r_cut, SLOW_PAIR_TABLE_INTERVALS);
     return prm;
   }
 
@@ -358,7 +356,7 @@ struct Engine::Impl {
       st.fast = fast_switch;
       st.coulomb_K = cfg.coulomb.K;
       if (!fast_table.empty())
-        st.fast_table = PairTable{raw(fast_table), PAIR_TABLE_INTERVALS / (fast_switch.r2 * fast_switch.r2)};
+        st.fast_table = pairTable(raw(fast_table), fast_switch.r2 * fast_switch.r2, FAST_PAIR_TABLE_INTERVALS);
     }
     return st;
   }
@@ -760,7 +758,7 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
                                   "(coulomb.every > 1): it was written by an older granagg; restart with coulomb.every = 1");
     }
   }
-  d.rebuildList(false);
+  d.rebuildList(true);  // storage in cell order from the first step on (locality), as after any build
 }
 
 void Engine::enableProfile(bool on) { m_impl->timer.enable(on); }
