@@ -241,8 +241,12 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                                        : ("k_max " + std::to_string(cs->k_max)).c_str(),
                   cs->estimated_error, cs->sum_q2_design);
     if (const md::CoulombSetup* cs = engine.coulombSetup(); cs && cs->r_fast > 0.0)
-      std::printf("md: multiple time stepping: slow Coulomb part every %d steps; pair force within r_fast = %g every step\n",
-                  cs->every, cs->r_fast);
+      std::printf("md: multiple time stepping: slow Coulomb part every %d steps%s; pair force within r_fast = %g every step\n",
+                  cs->every,
+                  cs->every_max > cs->every
+                      ? (", growing to at most " + std::to_string(cs->every_max) + " as the gas cools").c_str()
+                      : "",
+                  cs->r_fast);
     if (restart) std::printf("md: restarting from step %lld of %s\n", static_cast<long long>(engine.step()), out.c_str());
   }
 
@@ -269,6 +273,7 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
       params.emplace_back("coulomb_sum_q2_design", common::formatReal(cs->sum_q2_design));
       params.emplace_back("coulomb_r_fast_used", common::formatReal(cs->r_fast));
       params.emplace_back("coulomb_every_used", std::to_string(cs->every));
+      params.emplace_back("coulomb_every_max_used", std::to_string(cs->every_max));
     }
     writer = std::make_unique<md::H5mdWriter>(traj.string(), engine.size(), params, md::toToml(cfg), a.force,
                                               cfg.output.write_velocities, cfg.output.write_forces);
@@ -358,6 +363,11 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                 static_cast<long long>(builds), builds > 0 ? static_cast<double>(steps) / builds : 0.0);
     std::printf("md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max overlap %.3g\n", o.time,
                 o.temperature, static_cast<long long>(o.collisions), o.contacts_per_particle, o.max_overlap);
+    if (const md::CoulombSetup* cs = engine.coulombSetup(); cs && cs->r_fast > 0.0)
+      std::printf("md: slow Coulomb part evaluated %lld times (every %.3g steps on average; interval now %d steps)\n",
+                  static_cast<long long>(engine.slowEvaluations()),
+                  engine.slowEvaluations() > 0 ? static_cast<double>(steps) / engine.slowEvaluations() : 0.0,
+                  engine.slowInterval());
     std::printf("md: wrote %s (%zu frames), %s\n", traj.c_str(), writer->frames(), cpath.c_str());
   }
 }

@@ -18,6 +18,9 @@
 #                EVERY_ALSO="1" (also time granagg with coulomb.every = 1: the total force at every
 #                step, as LAMMPS integrates; the default rows use granagg's default multiple time
 #                stepping, coulomb.every = 8, whose accuracy the tests check)
+#                LMP_RESPA="8" (also time LAMMPS's own multiple time stepping, run_style respa
+#                2 k with the contacts every step and coul/long + pppm every k steps, for each k
+#                listed, at each cutoff and rank count; "" skips it)
 #                LMP_ACC (default ACC*K, see below)  ISSUE_LITERAL=1 (also time the issue's literal
 #                `kspace_style pppm 1e-4` at cutoff 8 on one rank)  SKIP_CHECKS=1
 #
@@ -53,6 +56,7 @@ K=${K:-5}
 ACC=${ACC:-1e-4}
 RC_ISSUE=${RC_ISSUE:-8}
 RC_SCAN=${RC_SCAN-"3 4 5 6"}
+LMP_RESPA=${LMP_RESPA-8}
 EVERY_ALSO=${EVERY_ALSO-1}  # also time granagg with these coulomb.every values (default: 1)
 E=278.6; D=27.7; PHI=0.076; SKIN=0.3
 calc() { awk "BEGIN {printf \"%.10g\", $1}"; }
@@ -245,14 +249,15 @@ EOF
   calc "$t1 - $t0"
 }
 
-lammps_time() {  # N n1 n2 ranks rc acc -> loop seconds of steps n1..n2
-  local N=$1 n1=$2 n2=$3 np=$4 rc=$5 acc=$6
+lammps_time() {  # N n1 n2 ranks rc acc [respa] -> loop seconds of steps n1..n2
+  local N=$1 n1=$2 n2=$3 np=$4 rc=$5 acc=$6 respa=${7:-1}
   local launch
   mapfile -t launch < <(lmp_launch "$np")
   (cd "$TMP" && OMP_NUM_THREADS=1 "${launch[@]}" "$LMP" -in "$ROOT/scripts/lammps/charged.in" -log none -nocite -echo none \
      -var data "$TMP/state_$N.data" -var rc "$rc" -var acc "$acc" -var K "$K" -var kn "$KN" -var gn "$GN" \
-     -var dt "$DT" -var skin "$SKIN" -var n1 "$n1" -var n2 "$n2" > lmp.log 2>&1) || { cat "$TMP/lmp.log" >&2; exit 1; }
-  cp "$TMP/lmp.log" "$TMP/lmp_${N}_${np}_${rc}_${acc}.log"
+     -var dt "$DT" -var skin "$SKIN" -var n1 "$n1" -var n2 "$n2" -var respa "$respa" > lmp.log 2>&1) \
+    || { cat "$TMP/lmp.log" >&2; exit 1; }
+  cp "$TMP/lmp.log" "$TMP/lmp_${N}_${np}_${rc}_${acc}$([ "$respa" = 1 ] || echo "_respa$respa").log"
   grep '^Loop time' "$TMP/lmp.log" | tail -n 1 | awk '{print $4}'
 }
 lammps_info() {  # log -> "grid, G, estimated accuracy; time split of the timed run"
@@ -273,9 +278,9 @@ for N in $SIZES; do
   echo "N = $N: generating the initial state, timing steps $n1..$n2 ($REPEATS repeats; load $(cut -d' ' -f1 /proc/loadavg))" >&2
   gen_state "$N"
   declare -A T=() R=() LR=()
-  tl() {  # key ranks rc acc: one LAMMPS timing appended to T[key], R[key]
+  tl() {  # key ranks rc acc [respa]: one LAMMPS timing appended to T[key], R[key]
     local t
-    t=$(lammps_time "$N" "$n1" "$n2" "$2" "$3" "$4")
+    t=$(lammps_time "$N" "$n1" "$n2" "$2" "$3" "$4" "${5:-1}")
     T[$1]+="$t "; R[$1]+="$(calc "$N * ($n2 - $n1) / $t") "
   }
   # cutoff scan on one rank (one run each), then repeats of the issue's cutoff and the fastest one
@@ -293,7 +298,10 @@ for N in $SIZES; do
   RCS="$RC_ISSUE"; [ "$best_rc" = "$RC_ISSUE" ] || RCS+=" $best_rc"
   for rep in $(seq "$REPEATS"); do
     for rc in $RCS; do
-      for np in $LMP_RANKS; do tl "l${np}_$rc" "$np" "$rc" "$LMP_ACC"; done
+      for np in $LMP_RANKS; do
+        tl "l${np}_$rc" "$np" "$rc" "$LMP_ACC"
+        for k in $LMP_RESPA; do tl "r${k}_${np}_$rc" "$np" "$rc" "$LMP_ACC" "$k"; done
+      done
     done
     if [ -n "${ISSUE_LITERAL:-}" ]; then tl "lit" 1 "$RC_ISSUE" 1e-4; fi
     for th in $THREADS; do
@@ -314,6 +322,13 @@ for N in $SIZES; do
       # shellcheck disable=SC2086
       ROWS+=("| $N | LAMMPS pppm $LMP_ACC, $which | $rc | $np | $(printf '%.3g' "${LR[${np}_$rc]}") | | $(range ${R[l${np}_$rc]}) |")
       NOTES+=("- N = $N, LAMMPS cutoff $rc, $np rank(s): $(lammps_info "$TMP/lmp_${N}_${np}_${rc}_${LMP_ACC}.log")")
+      for k in $LMP_RESPA; do
+        # shellcheck disable=SC2086
+        LR[r${k}_${np}_$rc]=$(calc "$N * ($n2 - $n1) / $(mins ${T[r${k}_${np}_$rc]})")
+        # shellcheck disable=SC2086
+        ROWS+=("| $N | LAMMPS pppm $LMP_ACC, run_style respa 2 $k (coul/long + pppm every $k steps), $which | $rc | $np | $(printf '%.3g' "${LR[r${k}_${np}_$rc]}") | | $(range ${R[r${k}_${np}_$rc]}) |")
+        NOTES+=("- N = $N, LAMMPS respa 2 $k, cutoff $rc, $np rank(s): $(lammps_info "$TMP/lmp_${N}_${np}_${rc}_${LMP_ACC}_respa$k.log")")
+      done
     done
   done
   if [ -n "${ISSUE_LITERAL:-}" ]; then
@@ -327,6 +342,9 @@ for N in $SIZES; do
     ratios=""
     for rc in $RCS; do
       [ -z "${LR[${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[${th}_$rc]}" | xargs printf '%.2f') (cutoff $rc); "
+      for k in $LMP_RESPA; do
+        [ -z "${LR[r${k}_${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[r${k}_${th}_$rc]}" | xargs printf '%.2f') (respa $k, cutoff $rc); "
+      done
     done
     # shellcheck disable=SC2086
     ROWS+=("| $N | granagg pppm $ACC, own choice, coulomb.every = 8 (default) | $(sed 's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' "$rate") | ${ratios%; } | $(range ${R[g$th]}) |")

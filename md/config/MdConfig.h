@@ -15,7 +15,7 @@
 ///     [charging]    mode ("exchange" | "fixed"), initial ("neutral" | "monopolar" | "bipolar" | "file"),
 ///                   q0, Q, kappa, psi1_min, psi1_max, psi2_fraction
 ///     [coulomb]     K, method ("pppm" | "ewald"), accuracy, r_cut, mesh, order ("auto" or numbers),
-///                   every, skin, r_fast
+///                   every, every_max, skin, r_fast
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
 ///                   checkpoint_wall_seconds, write_velocities, write_forces
@@ -82,6 +82,9 @@ struct CoulombConfig {
   /// and applied as an impulse; 1 = every step (plain velocity Verlet with the total force);
   /// 0 = "auto": every 0.016 time units (Engine::coulombEvery; 8 steps at dt = 0.002)
   int every = 0;
+  /// > every: the slow interval follows the gas, from every up to this many steps (Engine.h,
+  /// "multiple time stepping"); 0 = off (the interval stays `every`)
+  int every_max = 0;
   double skin = 0.0;               ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or neighbor.skin when every = 1)
   double r_fast = 0.0;             ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (3.5)
 };

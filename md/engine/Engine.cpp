@@ -44,6 +44,19 @@ namespace granagg::md {
 
 namespace {
 constexpr double M_EFF = 0.5;  // reduced mass of two unit masses
+
+/// |u|^2 of a velocity (the fastest particle, for the slow interval that follows the gas)
+struct Speed2 {
+  HD double operator()(const Vec3& u) const { return u.x * u.x + u.y * u.y + u.z * u.z; }
+};
+
+/// The fastest impact the time step resolves: integrator.impact_speed_max, or "auto": exceeded by
+/// a fraction 1e-6 of collisions in a Maxwellian gas at the initial temperature (collision-
+/// weighted P(g) = g/(2T) exp(-g^2/(4T)), tail exp(-g^2/(4T))).
+double impactSpeedMax(const MdConfig& c) {
+  return c.integrator.impact_speed_max > 0.0 ? c.integrator.impact_speed_max
+                                             : std::sqrt(4.0 * c.system.temperature * std::log(1e6));
+}
 // coulomb.every = "auto": time between evaluations of the slow Coulomb part (Engine::coulombEvery)
 constexpr double SLOW_INTERVAL = 0.016;
 
@@ -123,7 +136,13 @@ struct Engine::Impl {
   // (Engine.h), evaluated every coulomb.every steps into ext_f*: PPPM's real space over its own
   // neighbour list nl_coul plus its mesh part, or a whole plain-Ewald evaluation
   bool coulomb = false;
-  int every = 1;                            // coulomb.every
+  int every = 1;                            // steps from the last evaluation to the next
+  // the slow interval that follows the gas (coulomb.every_max > every): between every_base and
+  // every_cap steps, chosen at each evaluation (chooseEvery); fixed: every_cap = every_base
+  int every_base = 1, every_cap = 1;
+  double slow_speed_ref = 0.0;              // integrator.impact_speed_max: the base interval's speed
+  int every_prev = 1;                       // the interval that ended at the last evaluation
+  std::int64_t slow_evaluations = 0;        // in this process (Engine::slowEvaluations)
   CoulombSetup csetup;
   std::unique_ptr<Pppm> pppm;
   std::unique_ptr<EwaldReference> ewald;
@@ -238,7 +257,7 @@ struct Engine::Impl {
     if (cc.method == "pppm") {
       // "auto": a longer skin than the contact list's when the list is used every k-th step only
       // (fewer builds of a long list; measured optimum at N = 1e4, K = 5: docs/benchmarks-coulomb.md)
-      const double coul_skin = cc.skin > 0.0 ? cc.skin : (every > 1 ? 0.8 : skin);
+      const double coul_skin = cc.skin > 0.0 ? cc.skin : (every_base > 1 ? 0.8 : skin);
       const double rc_max = 0.5 * L - coul_skin;  // the list must reach r_cut + skin within L/2
       if (cc.r_cut > rc_max)
         throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) + " exceeds L/2 - coulomb.skin = " +
@@ -267,7 +286,7 @@ struct Engine::Impl {
       // multiple time stepping: the near real space, which changes as fast as pairs approach, is
       // computed at every step in the contact pass (its list then reaches r_fast), the rest is slow
       fast_switch = RealSpaceSwitch{};
-      if (every > 1) {
+      if (every_base > 1) {
         const double r2 = std::min(cc.r_fast > 0.0 ? cc.r_fast : 3.5, prm.r_cut);
         if (r2 < 2.0)
           throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(prm.r_cut) + " leaves coulomb.r_fast = " +
@@ -275,7 +294,8 @@ struct Engine::Impl {
                                       "use a larger r_cut or coulomb.every = 1");
         fast_switch = RealSpaceSwitch{std::max(0.0, r2 - 1.0), r2};
         csetup.r_fast = r2;
-        csetup.every = every;
+        csetup.every = every_base;
+        csetup.every_max = every_cap;
         const auto t = slowPairTableValues(prm.alpha, fast_switch, prm.r_cut * prm.r_cut);
         slow_table.assign(t.begin(), t.end());
         const auto f = fastPairTableValues(fast_switch);
@@ -315,7 +335,12 @@ struct Engine::Impl {
   /// everything for plain Ewald (host, O(N^2) real space).
   void evaluateCoulomb() {
     const std::size_t N = p.size();
+    // the interval that ends here (a fresh start has none: its impulse opens an interval only)
+    every_prev = kspace_step < 0 ? -1 : static_cast<int>(step - kspace_step);
     kspace_step = step;
+    every = chooseEvery();
+    if (every_prev < 0) every_prev = every;
+    ++slow_evaluations;
     if (pppm) {
       {
         PhaseTimer::Scope phase(&timer, PhaseTimer::CoulombReal);
@@ -334,9 +359,29 @@ struct Engine::Impl {
     coulomb_ext_energy = r.energy;
   }
 
-  /// Weight of the Coulomb force in the force of step `at` (Engine.h): k at evaluation steps, 0
-  /// between (1 at every step when k = 1).
-  double slowWeight(std::int64_t at) const { return at == kspace_step ? static_cast<double>(every) : 0.0; }
+  /// The next slow interval (Engine.h, "multiple time stepping"). Fixed: every_base. Following
+  /// the gas: the interval over which the fastest pair, approaching at 2 max|u| (a bound on every
+  /// relative speed), moves as far as a pair at the impact speed the time step resolves
+  /// (integrator.impact_speed_max) moves in every_base steps, within [every_base, every_cap].
+  /// A maximum is exact, so the choice does not depend on the thread count; it reads only the
+  /// drift velocities, which a checkpoint restores to the bit.
+  int chooseEvery() const {
+    if (every_cap <= every_base) return every_base;
+    const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0, thrust::maximum<double>());
+    const double v_rel = 2.0 * std::sqrt(u2);
+    const double k = v_rel > 0.0 ? std::floor(every_base * slow_speed_ref / v_rel) : every_cap;
+    return static_cast<int>(std::min<double>(every_cap, std::max<double>(every_base, k)));
+  }
+
+  /// Weight of the Coulomb force in the force of step `at` (Engine.h): at an evaluation step the
+  /// mean of the interval that ends there and the one that starts (k when the interval is fixed:
+  /// the impulse k dt F, half closing each interval and half opening the next; a fresh start has
+  /// only the opening half); 0 between evaluations; 1 at every step when k = 1. The two halves
+  /// act at the same instant, so only their sum reaches the drift velocities: weighting both
+  /// halves by the mean is the impulse integrator with a varying outer step, to the bit.
+  double slowWeight(std::int64_t at) const {
+    return at == kspace_step ? 0.5 * (static_cast<double>(every_prev) + static_cast<double>(every)) : 0.0;
+  }
 
   /// \param slow_weight weight of ext_f* in this step's force (0: not added)
   ContactStep makeStep(double dt_taken, double slow_weight, double prev_weight) const {
@@ -422,9 +467,11 @@ struct Engine::Impl {
   /// force: (k/2 - j) dt at j = 1..k-1 steps after an evaluation, 0 at the evaluation step itself
   /// (whose v(t) holds half the impulse) and with k = 1 (Engine.h).
   double velocityOffset() const {
-    if (!coulomb || every == 1 || kspace_step < 0) return 0.0;
+    if (!coulomb || (every == 1 && every_prev == 1) || kspace_step < 0) return 0.0;
     const std::int64_t j = step - kspace_step;
-    return j == 0 ? 0.0 : (0.5 * every - static_cast<double>(j)) * dt;
+    // at the evaluation step v(t) holds half the mean weight where the closing half of the
+    // interval that ended would hold half of that interval (the two differ when it changes)
+    return j == 0 ? 0.25 * (every - every_prev) * dt : (0.5 * every - static_cast<double>(j)) * dt;
   }
   /// v - velocityOffset() * F_coulomb, per slot.
   void smoothVelocities(DVec<double>& sx, DVec<double>& sy, DVec<double>& sz) const {
@@ -559,10 +606,7 @@ double Engine::chooseTimeStep(const MdConfig& c, std::string* reason) {
     tc = SpringDashpot::contactTime(sp, M_EFF);
     why << "spring-dashpot contact time " << tc;
   } else {
-    // fastest expected impact: exceeded by a fraction 1e-6 of collisions in a Maxwellian gas at the
-    // initial temperature (collision-weighted P(g) = g/(2T) exp(-g^2/(4T)), tail exp(-g^2/(4T)))
-    const double v = c.integrator.impact_speed_max > 0.0 ? c.integrator.impact_speed_max
-                                                         : std::sqrt(4.0 * c.system.temperature * std::log(1e6));
+    const double v = impactSpeedMax(c);
     if (!(c.contact.E > 0.0))
       throw std::invalid_argument("integrator.dt = \"auto\" needs contact.E > 0 (the Hertz contact time is infinite for E = 0); give integrator.dt explicitly.");
     tc = HertzViscoelastic::contactTime(v, {c.contact.E, c.contact.D, c.contact.clamp}, M_EFF);
@@ -596,7 +640,9 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
   if (!d.hertz)
     d.sd_params = SpringDashpot::makeParams(config.contact.stiffness, config.contact.restitution, config.contact.clamp, M_EFF);
   d.dt = chooseTimeStep(config);
-  d.every = coulombEvery(config, d.dt);
+  d.every = d.every_prev = d.every_base = d.every_cap = coulombEvery(config, d.dt);
+  if (d.every_base > 1 && config.coulomb.every_max > d.every_base) d.every_cap = config.coulomb.every_max;
+  d.slow_speed_ref = impactSpeedMax(config);
 
   Frame f = init;
   if (f.charge.size() != N) f.charge.assign(N, 0.0);
@@ -718,6 +764,8 @@ EngineExtra Engine::extraState() const {
   e.arrays["coulomb_fy"] = toHostById(d.ext_fy, d.p.id);
   e.arrays["coulomb_fz"] = toHostById(d.ext_fz, d.p.id);
   e.ints["coulomb_eval_step"] = d.kspace_step;
+  e.ints["coulomb_every"] = d.every;  // the slow interval in force and the one before it
+  e.ints["coulomb_every_prev"] = d.every_prev;
   e.reals["coulomb_energy_ext"] = d.coulomb_ext_energy;
   return e;
 }
@@ -751,6 +799,15 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
       toDevice(fz->second, d.ext_fz);
       d.kspace_step = at->second;
       d.coulomb_ext_energy = en->second;
+      const auto k = extra.ints.find("coulomb_every"), kp = extra.ints.find("coulomb_every_prev");
+      if (k != extra.ints.end() && kp != extra.ints.end()) {
+        if (k->second < d.every_base || k->second > d.every_cap || kp->second < 1)
+          throw std::invalid_argument("checkpoint: slow Coulomb interval " + std::to_string(k->second) +
+                                      " outside this run's " + std::to_string(d.every_base) + ".." +
+                                      std::to_string(d.every_cap));
+        d.every = static_cast<int>(k->second);
+        d.every_prev = static_cast<int>(kp->second);
+      }  // (older checkpoints: a fixed interval, as configured)
     } else if (d.every == 1) {
       d.kspace_step = -1;  // evaluated afresh at the next step, as every step
     } else {
@@ -814,6 +871,8 @@ std::size_t Engine::size() const { return m_impl->p.size(); }
 std::int64_t Engine::neighborBuilds() const { return m_impl->nl.builds(); }
 
 const CoulombSetup* Engine::coulombSetup() const { return m_impl->coulomb ? &m_impl->csetup : nullptr; }
+int Engine::slowInterval() const { return m_impl->coulomb ? m_impl->every : 0; }
+std::int64_t Engine::slowEvaluations() const { return m_impl->slow_evaluations; }
 
 void Engine::useCoulombDesign(double sum_q2_design) {
   Impl& d = *m_impl;

@@ -28,6 +28,15 @@
 /// coulomb.md). k = 1 is plain velocity Verlet with the total force. Between evaluations the
 /// integrator's velocities differ from the smooth trajectory's by (k/2 - j) dt F_C (j steps after
 /// the evaluation); output uses the smooth ones (StateKind::Physical).
+///
+/// The slow interval can follow the gas (coulomb.every_max > k): at each evaluation the next
+/// interval k' is chosen so that the fastest pair (relative speed at most 2 max|u|) moves no
+/// further in it than a pair at integrator.impact_speed_max moves in k steps -- the displacement
+/// per interval at which the fixed interval's accuracy was measured -- within [k, every_max]. A
+/// cooling gas thus evaluates its slow part less and less often. The impulse at an evaluation is
+/// then (k_before + k_after)/2 dt F_C: half closes the interval that ends, half opens the next
+/// (Verlet-I with a varying outer step; both halves act at one instant, so the drift velocities
+/// are exactly those of the split halves).
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -71,6 +80,8 @@ struct CoulombSetup {
   double sum_q2_design = 0.0;      ///< sum q^2 the parameters were chosen for
   double r_fast = 0.0;             ///< multiple time stepping: real space within this is fast (switched over 1 d); 0: none
   int every = 1;                   ///< multiple time stepping: steps between evaluations of the slow part
+  /// > every: the interval follows the gas up to this many steps (coulomb.every_max); = every: fixed
+  int every_max = 1;
 };
 
 /// Which velocities and forces a host copy holds. They differ only with Coulomb forces on a
@@ -153,6 +164,11 @@ class Engine {
   std::vector<std::pair<std::string, double>> phaseSeconds() const;
   /// The Coulomb parameters in use, or null when coulomb.K = 0.
   const CoulombSetup* coulombSetup() const;
+  /// Steps from the last evaluation of the slow Coulomb part to the next (the interval in force;
+  /// it changes only with coulomb.every_max); 0 without Coulomb.
+  int slowInterval() const;
+  /// Evaluations of the slow Coulomb part so far in this process (0 without Coulomb).
+  std::int64_t slowEvaluations() const;
   /// Re-chooses the Coulomb parameters for sum_q2_design (a restart passes the stored value, so
   /// that it continues with the same parameters as the uninterrupted run). No-op without Coulomb.
   void useCoulombDesign(double sum_q2_design);

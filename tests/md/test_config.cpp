@@ -352,6 +352,7 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
       {"coulomb.method=p3m", "--set coulomb.method=p3m: coulomb.method = \"p3m\" is invalid"},
       {"coulomb.mesh=0", "--set coulomb.mesh=0: coulomb.mesh = 0 is invalid: must be > 0 or \"auto\""},
       {"coulomb.order=9", "--set coulomb.order=9: coulomb.order = 9 is invalid: must lie in 2..7"},
+      {"coulomb.every_max=-1", "--set coulomb.every_max=-1: coulomb.every_max = -1 is invalid: must lie in 0..1000"},
   };
   for (const auto& [set, message] : bad) {
     INFO(set);
@@ -414,7 +415,7 @@ TEST_CASE("flatten lists every key with round-trip numbers", "[md][config]") {
   MdConfig c;
   c.system.phi = 0.1 + 0.2;
   const auto f = flatten(c);
-  REQUIRE(f.size() == 42);
+  REQUIRE(f.size() == 43);
   CHECK(f.front() == std::make_pair(std::string("input.version"), std::string("1")));
   CHECK(f[1] == std::make_pair(std::string("system.N"), std::string("1000")));
   CHECK(f[2] == std::make_pair(std::string("system.phi"), std::string("0.30000000000000004")));

@@ -1,0 +1,182 @@
+#!/usr/bin/python3
+"""Compares ensembles of the charged gas that differ only in their Coulomb settings with the
+tight reference ensemble (scripts/coulomb_accuracy.sh writes them; issue 15).
+
+For each setting and each observable at t = 50, 100, 150 -- T_g, mean |q|, S_grid, S_particle,
+the number of particle clusters and of monomers N_1 -- the runs' values are compared with the
+reference runs' by Welch's t test (unequal variances; the runs are independent: different seeds
+within an ensemble, and each setting's run from seed k decorrelates from the reference's run from
+seed k long before t = 50, so the ensembles are treated as unpaired). A setting is called
+indistinguishable from the reference when no p value falls below 0.05 / m (Bonferroni over its
+m tests). With few runs the test only sees large differences: the table also gives the smallest
+difference it would detect (80 % power at the 5 % level, about 2.8 standard errors of the
+difference), relative to the reference mean, so a pass says how close, not just "equal".
+
+  usage: /usr/bin/python3 scripts/coulomb_accuracy.py DIR [--docs]
+    DIR     the study folder (results/coulomb_accuracy)
+    --docs  also copy the table and figure to docs/validation/ and docs/img/validation/
+Writes DIR/comparison.csv, DIR/comparison.md and DIR/comparison.png.
+"""
+import os
+import shutil
+import sys
+
+import numpy as np
+from scipy import stats
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import granagg_tables as gt  # noqa: E402
+
+TIMES = (50.0, 100.0, 150.0)
+SETS = ("ref", "default", "fast")
+LABELS = {
+    "ref": "reference (accuracy 1e-5, every 1)",
+    "default": "default (1e-4, every 4, r_fast 3.5)",
+    "fast": "candidate (1e-3, every 8, r_fast 2.5)",
+}
+OBSERVABLES = ("T_g", "mean_abs_q", "S_grid", "S_particle", "clusters_particle", "N_1")
+
+
+def per_run_values(folder):
+    """{observable: array (runs, len(TIMES))} and the run count, from OUT/SET/analysis/per_run."""
+    pr = os.path.join(folder, "analysis", "per_run")
+    thermo = gt.read(os.path.join(pr, "thermo.csv"))
+    st = gt.read(os.path.join(pr, "S_t.csv"))
+    ns = gt.read(os.path.join(pr, "N_s_particle.csv"))
+    if thermo is None or st is None or ns is None:
+        return None, 0
+    runs = sorted(set(int(r) for r in thermo["run"]))
+    out = {o: np.full((len(runs), len(TIMES)), np.nan) for o in OBSERVABLES}
+    for a, run in enumerate(runs):
+        for b, t in enumerate(TIMES):
+            def row(tab):
+                sel = (tab["run"] == run) & (np.abs(tab["t"] - t) < 1e-3 * t)
+                return tab[sel]
+            th, s = row(thermo), row(st)
+            if len(th) != 1 or len(s) != 1:
+                raise SystemExit(f"coulomb_accuracy.py: {folder} run {run} has no frame at t = {t}")
+            out["T_g"][a, b] = th["T_g"][0]
+            out["mean_abs_q"][a, b] = th["mean_abs_q"][0]
+            for o in ("S_grid", "S_particle", "clusters_particle"):
+                out[o][a, b] = s[o][0]
+            n1 = ns[(ns["run"] == run) & (np.abs(ns["t"] - t) < 1e-3 * t) & (ns["s"] == 1)]
+            out["N_1"][a, b] = n1["N_s"][0] if len(n1) else 0.0
+    return out, len(runs)
+
+
+def wall_seconds(folder):
+    """Wall seconds of each finished run (the `done` files of coulomb_accuracy.sh)."""
+    w = []
+    for d in sorted(os.listdir(folder)):
+        f = os.path.join(folder, d, "done")
+        if d.startswith("run") and os.path.exists(f):
+            w.append(float(open(f).read()))
+    return np.array(w)
+
+
+def main():
+    if len(sys.argv) < 2 or sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return 0 if len(sys.argv) >= 2 else 2
+    top = sys.argv[1]
+    docs = "--docs" in sys.argv[2:]
+    data, nruns, wall = {}, {}, {}
+    for s in SETS:
+        if os.path.isdir(os.path.join(top, s)):
+            v, n = per_run_values(os.path.join(top, s))
+            if v is not None:
+                data[s], nruns[s], wall[s] = v, n, wall_seconds(os.path.join(top, s))
+    if "ref" not in data:
+        print("coulomb_accuracy.py: no analysed reference ensemble yet in " + top)
+        return 1
+    ref = data["ref"]
+    rows = []
+    verdict = {}
+    for s in data:
+        if s == "ref":
+            continue
+        m = len(OBSERVABLES) * len(TIMES)
+        pmin, nsig = 1.0, 0
+        for o in OBSERVABLES:
+            for b, t in enumerate(TIMES):
+                x, y = data[s][o][:, b], ref[o][:, b]
+                se = np.sqrt(x.var(ddof=1) / len(x) + y.var(ddof=1) / len(y))
+                if se > 0:
+                    tstat, p = stats.ttest_ind(x, y, equal_var=False)
+                else:  # identical constant values
+                    tstat, p = 0.0, 1.0
+                pmin = min(pmin, p)
+                nsig += p < 0.05
+                rows.append((s, o, t, x.mean(), y.mean(), x.std(ddof=1), y.std(ddof=1),
+                             (x.mean() - y.mean()) / y.mean() if y.mean() != 0 else np.nan,
+                             2.8 * se / abs(y.mean()) if y.mean() != 0 else np.nan, tstat, p))
+        verdict[s] = (pmin, nsig, m, pmin >= 0.05 / m)
+    os.makedirs(top, exist_ok=True)
+    csv = os.path.join(top, "comparison.csv")
+    with open(csv, "w") as f:
+        f.write("# scripts/coulomb_accuracy.py: each setting's ensemble against the reference "
+                "(accuracy 1e-5, every 1); Welch's t test per observable and time\n")
+        f.write("# runs: " + ", ".join(f"{s} {nruns[s]}" for s in data) + "\n")
+        f.write("setting,observable,t,mean,ref_mean,sd,ref_sd,rel_diff,rel_detectable,t_stat,p\n")
+        for r in rows:
+            f.write("%s,%s,%g,%.6g,%.6g,%.4g,%.4g,%.4g,%.4g,%.3f,%.4g\n" % r)
+    md = os.path.join(top, "comparison.md")
+    with open(md, "w") as f:
+        f.write("| setting | runs | wall per run (s, 1 thread) | tests | p < 0.05 | smallest p "
+                "| Bonferroni (p >= 0.05 / m) |\n|---|---|---|---|---|---|---|\n")
+        for s in data:
+            w = wall[s]
+            ws = f"{w.mean():.0f} ({w.min():.0f}-{w.max():.0f})" if len(w) else "-"
+            if s == "ref":
+                f.write(f"| {LABELS[s]} | {nruns[s]} | {ws} | | | | reference |\n")
+            else:
+                pmin, nsig, m, ok = verdict[s]
+                f.write(f"| {LABELS[s]} | {nruns[s]} | {ws} | {m} | {nsig} | {pmin:.3g} | "
+                        f"{'indistinguishable' if ok else 'DIFFERS'} |\n")
+        f.write("\n| setting | observable | t | mean | reference | rel. difference "
+                "| detectable (80 % power) | p |\n|---|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            f.write(f"| {r[0]} | {r[1]} | {r[2]:g} | {r[3]:.4g} | {r[4]:.4g} | {100 * r[7]:+.1f} % "
+                    f"| {100 * r[8]:.1f} % | {r[10]:.2g} |\n")
+    print(open(md).read())
+    png = os.path.join(top, "comparison.png")
+    plot(top, data, png)
+    if docs:
+        os.makedirs("docs/validation", exist_ok=True)
+        os.makedirs("docs/img/validation", exist_ok=True)
+        shutil.copy(csv, "docs/validation/coulomb_accuracy.csv")
+        shutil.copy(md, "docs/validation/coulomb_accuracy.md")
+        shutil.copy(png, "docs/img/validation/coulomb_accuracy.png")
+    return 0
+
+
+def plot(top, data, png):
+    """Ensemble means (bands: +- one standard error) of T_g, mean |q| and S(t) per setting."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    for s in data:
+        pr = os.path.join(top, s, "analysis", "per_run")
+        th, st = gt.read(os.path.join(pr, "thermo.csv")), gt.read(os.path.join(pr, "S_t.csv"))
+        for ax, tab, name in ((axes[0], th, "T_g"), (axes[1], th, "mean_abs_q"),
+                              (axes[2], st, "S_grid")):
+            ts = np.unique(tab["t"])
+            ts = ts[ts > 0]
+            vals = np.array([[tab[name][(tab["run"] == r) & (tab["t"] == t)][0]
+                              for t in ts] for r in np.unique(tab["run"])])
+            mean, se = vals.mean(0), vals.std(0, ddof=1) / np.sqrt(len(vals))
+            line, = ax.plot(ts, mean, label=LABELS[s])
+            ax.fill_between(ts, mean - se, mean + se, color=line.get_color(), alpha=0.25)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlabel("t")
+            ax.set_ylabel(name)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("K = 5, Q = 0.05: ensembles at different Coulomb settings (bands: +- 1 SE)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
