@@ -28,11 +28,13 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import granagg_tables as gt  # noqa: E402
 
 TIMES = (50.0, 100.0, 150.0)
-SETS = ("ref", "default", "fast")
+SETS = ("ref", "default", "fast", "follow", "fastfollow")
 LABELS = {
     "ref": "reference (accuracy 1e-5, every 1)",
     "default": "default (1e-4, every 4, r_fast 3.5)",
     "fast": "candidate (1e-3, every 8, r_fast 2.5)",
+    "follow": "default, interval follows the gas (every_max 16)",
+    "fastfollow": "1e-3, r_fast 2.5, interval follows the gas (every_max 16)",
 }
 OBSERVABLES = ("T_g", "mean_abs_q", "S_grid", "S_particle", "clusters_particle", "N_1")
 

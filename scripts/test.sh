@@ -4,7 +4,9 @@
 # so that it never rots (no GPU on the CI machines).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+T0=$SECONDS
 bash scripts/setup.sh
+T_BUILD=$((SECONDS - T0))
 BUILD_DIR=${GRANAGG_BUILD_DIR:-build}
 JOBS=${GRANAGG_JOBS:-$(nproc)}
 
@@ -14,6 +16,7 @@ set +e
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" | tee "$LOG"
 CTEST_RC=${PIPESTATUS[0]}
 set -e
+T_CTEST=$((SECONDS - T0 - T_BUILD))
 # "N tests passed, M failed out of T" -> the plain summary printed last (after the CUDA build)
 TOTAL=$(sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' "$LOG" | tail -n 1)
 FAILED=$(sed -n 's/.*tests passed, \([0-9]*\) tests failed out of.*/\1/p' "$LOG" | tail -n 1)
@@ -33,6 +36,7 @@ else
   echo "== nvcc not found: CUDA build skipped"
 fi
 
+T_CUDA=$((SECONDS - T0 - T_BUILD - T_CTEST))
 # The GPU check script's dry run (the CPU build in place of the CUDA one), so that it cannot rot
 echo "== scripts/gpu_check.sh --dry-run"
 TOTAL=$((TOTAL + 1))   # counted as one more test in the summary line
@@ -47,5 +51,6 @@ else
   echo "gpu_check dry run OK: $BUILD_DIR/gpu_check_dry/summary.md"
 fi
 
+echo "time: set-up and build ${T_BUILD} s, tests ${T_CTEST} s, CUDA build ${T_CUDA} s, GPU dry run $((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA)) s"
 echo "tests: $((TOTAL - FAILED)) passed, $FAILED failed"
 exit "$CTEST_RC"

@@ -77,7 +77,7 @@ const std::vector<Section>& schema() {
         Key{"mesh", +[](MdConfig& c) -> int& { return c.coulomb.mesh; }, true},
         Key{"order", +[](MdConfig& c) -> int& { return c.coulomb.order; }, true},
         Key{"every", +[](MdConfig& c) -> int& { return c.coulomb.every; }, true},
-        GRANAGG_KEY(coulomb, every_max),
+        Key{"every_max", +[](MdConfig& c) -> int& { return c.coulomb.every_max; }, true},
         Key{"skin", +[](MdConfig& c) -> double& { return c.coulomb.skin; }, true},
         Key{"r_fast", +[](MdConfig& c) -> double& { return c.coulomb.r_fast; }, true}}},
       {"run", {GRANAGG_KEY(run, t_end), GRANAGG_KEY(run, max_overlap)}},
@@ -566,10 +566,8 @@ void validateConfig(const MdConfig& c) {
     invalid("coulomb.every", std::to_string(e.every), "lie in 1..100 (steps between Coulomb evaluations) or be \"auto\"");
   if (e.every_max < 0 || e.every_max > 1000)
     invalid("coulomb.every_max", std::to_string(e.every_max),
-            "lie in 0..1000 (0: the slow interval stays coulomb.every)");
-  if (e.every_max > 0 && e.every > e.every_max)
-    invalid("coulomb.every_max", std::to_string(e.every_max),
-            "be 0 or >= coulomb.every = " + std::to_string(e.every));
+            "lie in 1..1000 (the longest slow interval in steps; <= coulomb.every keeps it fixed) or be "
+            "\"auto\" (4 x coulomb.every)");
   if (!(e.skin >= 0.0 && e.skin <= 5.0)) invalid("coulomb.skin", formatReal(e.skin), "lie in (0, 5] or be \"auto\"");
   if (!(e.r_fast == 0.0 || (e.r_fast >= 2.0 && finite(e.r_fast))))
     invalid("coulomb.r_fast", formatReal(e.r_fast), "be >= 2 (the switch [r_fast - 1, r_fast] starts beyond contact) or \"auto\"");

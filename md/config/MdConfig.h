@@ -82,8 +82,8 @@ struct CoulombConfig {
   /// and applied as an impulse; 1 = every step (plain velocity Verlet with the total force);
   /// 0 = "auto": every 0.016 time units (Engine::coulombEvery; 8 steps at dt = 0.002)
   int every = 0;
-  /// > every: the slow interval follows the gas, from every up to this many steps (Engine.h,
-  /// "multiple time stepping"); 0 = off (the interval stays `every`)
+  /// The slow interval follows the gas, from every up to this many steps (Engine.h, "multiple
+  /// time stepping"); <= every: fixed; 0 = "auto": 4 x every (docs/benchmarks-coulomb.md)
   int every_max = 0;
   double skin = 0.0;               ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or neighbor.skin when every = 1)
   double r_fast = 0.0;             ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (3.5)

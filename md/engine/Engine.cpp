@@ -59,6 +59,10 @@ double impactSpeedMax(const MdConfig& c) {
 }
 // coulomb.every = "auto": time between evaluations of the slow Coulomb part (Engine::coulombEvery)
 constexpr double SLOW_INTERVAL = 0.016;
+// coulomb.every_max = "auto": the slow interval grows to at most this many times coulomb.every,
+// the setting the ensemble comparison found indistinguishable from the tight reference
+// (docs/benchmarks-coulomb.md, "Accuracy behind the settings")
+constexpr int SLOW_INTERVAL_GROWTH = 4;
 
 template <class T>
 std::vector<T> toHost(const DVec<T>& d) {
@@ -641,7 +645,10 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
     d.sd_params = SpringDashpot::makeParams(config.contact.stiffness, config.contact.restitution, config.contact.clamp, M_EFF);
   d.dt = chooseTimeStep(config);
   d.every = d.every_prev = d.every_base = d.every_cap = coulombEvery(config, d.dt);
-  if (d.every_base > 1 && config.coulomb.every_max > d.every_base) d.every_cap = config.coulomb.every_max;
+  if (d.every_base > 1) {
+    const int cap = config.coulomb.every_max > 0 ? config.coulomb.every_max : SLOW_INTERVAL_GROWTH * d.every_base;
+    d.every_cap = std::max(d.every_base, cap);
+  }
   d.slow_speed_ref = impactSpeedMax(config);
 
   Frame f = init;
