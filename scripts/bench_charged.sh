@@ -59,6 +59,7 @@ say "load $(cut -d' ' -f1-3 /proc/loadavg); $THREADS threads, $REPEATS repeats; 
 for b in "${!BINS[@]}"; do
   G=${BINS[$b]}
   echo "$b $("$G" --version | head -n 1) $G" >> "$OUT/binaries.txt"
+  mkdir -p "$OUT/bin$b"
   for rep in $(seq "$REPEATS"); do
     d=$OUT/bin$b/early$rep
     "$G" md --preset paper --set coulomb.K=5 --set charging.Q=0.05 --set run.t_end="$EARLY_T" \
