@@ -241,12 +241,15 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                                        : ("k_max " + std::to_string(cs->k_max)).c_str(),
                   cs->estimated_error, cs->sum_q2_design);
     if (const md::CoulombSetup* cs = engine.coulombSetup(); cs && cs->r_fast > 0.0)
-      std::printf("md: multiple time stepping: slow Coulomb part every %d steps%s; pair force within r_fast = %g every step\n",
-                  cs->every,
-                  cs->every_max > cs->every
-                      ? (", growing to at most " + std::to_string(cs->every_max) + " as the gas cools").c_str()
-                      : "",
-                  cs->r_fast);
+      std::printf(
+          "md: multiple time stepping: slow Coulomb part every %d steps%s; pair force within "
+          "r_fast = %g every step\n",
+          cs->every,
+          cs->every_max > cs->every
+              ? (", growing to at most " + std::to_string(cs->every_max) + " as the gas cools")
+                    .c_str()
+              : "",
+          cs->r_fast);
     if (restart) std::printf("md: restarting from step %lld of %s\n", static_cast<long long>(engine.step()), out.c_str());
   }
 
@@ -364,10 +367,13 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     std::printf("md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max overlap %.3g\n", o.time,
                 o.temperature, static_cast<long long>(o.collisions), o.contacts_per_particle, o.max_overlap);
     if (const md::CoulombSetup* cs = engine.coulombSetup(); cs && cs->r_fast > 0.0)
-      std::printf("md: slow Coulomb part evaluated %lld times (every %.3g steps on average; interval now %d steps)\n",
-                  static_cast<long long>(engine.slowEvaluations()),
-                  engine.slowEvaluations() > 0 ? static_cast<double>(steps) / engine.slowEvaluations() : 0.0,
-                  engine.slowInterval());
+      std::printf(
+          "md: slow Coulomb part evaluated %lld times (every %.3g steps on average; interval "
+          "now %d steps)\n",
+          static_cast<long long>(engine.slowEvaluations()),
+          engine.slowEvaluations() > 0 ? static_cast<double>(steps) / engine.slowEvaluations()
+                                       : 0.0,
+          engine.slowInterval());
     std::printf("md: wrote %s (%zu frames), %s\n", traj.c_str(), writer->frames(), cpath.c_str());
   }
 }

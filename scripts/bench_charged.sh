@@ -32,7 +32,8 @@ while [ $# -gt 0 ]; do
        BINS+=("$(realpath "$1")"); shift ;;
   esac
 done
-[ ${#BINS[@]} -gt 0 ] || { echo "bench_charged.sh: give at least one granagg binary (see --help)" >&2; exit 2; }
+[ ${#BINS[@]} -gt 0 ] \
+  || { echo "bench_charged.sh: give at least one granagg binary (see --help)" >&2; exit 2; }
 THREADS=${THREADS:-2}
 REPEATS=${REPEATS:-2}
 EARLY_T=${EARLY_T:-2}
@@ -52,10 +53,12 @@ if [ ! -f "$LATE_STATE/checkpoint.h5" ]; then
 fi
 T_STATE=$(/usr/bin/python3 -c "
 import h5py, sys
-print(repr(float(h5py.File(sys.argv[1] + '/checkpoint.h5', 'r')['state'].attrs['time'])))" "$LATE_STATE")
+f = h5py.File(sys.argv[1] + '/checkpoint.h5', 'r')
+print(repr(float(f['state'].attrs['time'])))" "$LATE_STATE")
 T_LATE=$(awk "BEGIN {print $T_STATE + $LATE_DT}")
 
-say "load $(cut -d' ' -f1-3 /proc/loadavg); $THREADS threads, $REPEATS repeats; late state $LATE_STATE (t = $T_STATE)"
+say "load $(cut -d' ' -f1-3 /proc/loadavg); $THREADS threads, $REPEATS repeats;" \
+  "late state $LATE_STATE (t = $T_STATE)"
 for b in "${!BINS[@]}"; do
   G=${BINS[$b]}
   echo "$b $("$G" --version | head -n 1) $G" >> "$OUT/binaries.txt"
@@ -63,7 +66,8 @@ for b in "${!BINS[@]}"; do
   for rep in $(seq "$REPEATS"); do
     d=$OUT/bin$b/early$rep
     "$G" md --preset paper --set coulomb.K=5 --set charging.Q=0.05 --set run.t_end="$EARLY_T" \
-      --set output.frames_per_decade=0 --set output.frame_interval=0 --profile --threads "$THREADS" \
+      --set output.frames_per_decade=0 --set output.frame_interval=0 --profile \
+      --threads "$THREADS" \
       --out "$d" > "$d.log" 2>&1
     d=$OUT/bin$b/late$rep
     mkdir -p "$d"
@@ -86,11 +90,12 @@ phases = ["contact_pass_s", "coulomb_real_slow_s", "pppm_sort_s", "pppm_assignme
 for phase in ("early", "late"):
     best = []
     for b in range(nb):
-        runs = [gt.read(os.path.join(out, f"bin{b}", f"{phase}{r}", "profile.csv")) for r in range(1, reps + 1)]
+        runs = [gt.read(os.path.join(out, f"bin{b}", f"{phase}{r}", "profile.csv"))
+                for r in range(1, reps + 1)]
         runs = [r for r in runs if r is not None]
         best.append(min(runs, key=lambda r: r["loop_s"][0]))
-    print(f"\n{phase}: N = {int(best[0]['N'][0])}, {int(best[0]['steps'][0])} steps; fastest of {reps}; "
-          "ms per step (share of the loop)\n")
+    print(f"\n{phase}: N = {int(best[0]['N'][0])}, {int(best[0]['steps'][0])} steps; "
+          f"fastest of {reps}; ms per step (share of the loop)\n")
     print("| phase | " + " | ".join(f"binary {b}" for b in range(nb)) + " |")
     print("|---|" + "---|" * nb)
     for p in phases:
@@ -99,8 +104,8 @@ for phase in ("early", "late"):
             s = r[p][0]
             cells.append(f"{1e3 * s / r['steps'][0]:.2f} ({100 * s / r['loop_s'][0]:.0f} %)")
         print(f"| {p[:-2].replace('_', ' ')} | " + " | ".join(cells) + " |")
-    cells = [f"**{1e3 * r['loop_s'][0] / r['steps'][0]:.2f}** ({r['N'][0] * r['steps'][0] / r['loop_s'][0]:.3g} "
-             "particle-steps/s)" for r in best]
+    cells = [f"**{1e3 * r['loop_s'][0] / r['steps'][0]:.2f}** "
+             f"({r['N'][0] * r['steps'][0] / r['loop_s'][0]:.3g} particle-steps/s)" for r in best]
     print("| **loop** | " + " | ".join(cells) + " |")
 print("\nbinaries: " + "; ".join(f"{b}: {n}" for b, n in enumerate(names)))
 EOF

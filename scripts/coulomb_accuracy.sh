@@ -44,7 +44,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ ${#SETS[@]} -gt 0 ] || SETS=(ref default fast follow fastfollow)
-[ -x "$G" ] || { echo "coulomb_accuracy.sh: no granagg at $G (run bash scripts/setup.sh)" >&2; exit 2; }
+[ -x "$G" ] \
+  || { echo "coulomb_accuracy.sh: no granagg at $G (run bash scripts/setup.sh)" >&2; exit 2; }
 
 settings() {
   case "$1" in
@@ -52,7 +53,8 @@ settings() {
     default) echo "" ;;
     fast) echo "--set coulomb.accuracy=1e-3 --set coulomb.every=8 --set coulomb.r_fast=2.5" ;;
     follow) echo "--set coulomb.every_max=16" ;;
-    fastfollow) echo "--set coulomb.accuracy=1e-3 --set coulomb.r_fast=2.5 --set coulomb.every_max=16" ;;
+    fastfollow)
+      echo "--set coulomb.accuracy=1e-3 --set coulomb.r_fast=2.5 --set coulomb.every_max=16" ;;
   esac
 }
 
@@ -90,7 +92,9 @@ fi
 
 for s in "${SETS[@]}"; do
   runs=()
-  for seed in $(seq 1 "$RUNS"); do [ -f "$OUT/$s/run$seed/done" ] && runs+=("$OUT/$s/run$seed"); done
+  for seed in $(seq 1 "$RUNS"); do
+    [ -f "$OUT/$s/run$seed/done" ] && runs+=("$OUT/$s/run$seed")
+  done
   [ ${#runs[@]} -ge 2 ] || { say "$s: fewer than 2 finished runs, not analysed"; continue; }
   "$G" analyze "${runs[@]}" --out "$OUT/$s/analysis" --force --threads "$JOBS" -q \
     && say "$s: analysed ${#runs[@]} runs"

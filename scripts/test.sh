@@ -51,6 +51,8 @@ else
   echo "gpu_check dry run OK: $BUILD_DIR/gpu_check_dry/summary.md"
 fi
 
-echo "time: set-up and build ${T_BUILD} s, tests ${T_CTEST} s, CUDA build ${T_CUDA} s, GPU dry run $((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA)) s"
+T_DRY=$((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA))
+echo "time: set-up and build ${T_BUILD} s, tests ${T_CTEST} s, CUDA build ${T_CUDA} s," \
+  "GPU dry run ${T_DRY} s"
 echo "tests: $((TOTAL - FAILED)) passed, $FAILED failed"
 exit "$CTEST_RC"

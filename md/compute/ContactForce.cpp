@@ -182,8 +182,9 @@ struct ContactForceFunctor {
   }
 
   /// The contact work of the entries touching[0..nt) of i's row (operator()).
-  HD_INLINE void contacts(int i, const Scalar4& ri, const int* row, const int* touching, int nt, double& f0,
-                          double& f1, double& f2, double& mx, int& nnew, double& dqi) const {
+  HD_INLINE void contacts(int i, const Scalar4& ri, const int* row, const int* touching, int nt,
+                          double& f0, double& f1, double& f2, double& mx, int& nnew,
+                          double& dqi) const {
     for (int t = 0; t < nt; ++t) {
       const int j = row[touching[t]];
       double rx, ry, rz;

@@ -566,8 +566,8 @@ void validateConfig(const MdConfig& c) {
     invalid("coulomb.every", std::to_string(e.every), "lie in 1..100 (steps between Coulomb evaluations) or be \"auto\"");
   if (e.every_max < 0 || e.every_max > 1000)
     invalid("coulomb.every_max", std::to_string(e.every_max),
-            "lie in 1..1000 (the longest slow interval in steps; <= coulomb.every keeps it fixed) or be "
-            "\"auto\" (4 x coulomb.every)");
+            "lie in 1..1000 (the longest slow interval in steps; <= coulomb.every keeps it "
+            "fixed) or be \"auto\" (4 x coulomb.every)");
   if (!(e.skin >= 0.0 && e.skin <= 5.0)) invalid("coulomb.skin", formatReal(e.skin), "lie in (0, 5] or be \"auto\"");
   if (!(e.r_fast == 0.0 || (e.r_fast >= 2.0 && finite(e.r_fast))))
     invalid("coulomb.r_fast", formatReal(e.r_fast), "be >= 2 (the switch [r_fast - 1, r_fast] starts beyond contact) or \"auto\"");

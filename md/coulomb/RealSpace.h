@@ -124,8 +124,8 @@ std::vector<double> pairTableValues(G g_of_r2, double r2_max, int n) {
   const double h = r2_max / n;
   std::vector<double> out(4 * static_cast<std::size_t>(n + 1));
   for (int k = 0; k < n; ++k) {
-    const double v0 = g_of_r2(k * h), v1 = g_of_r2((k + 1.0 / 3.0) * h), v2 = g_of_r2((k + 2.0 / 3.0) * h),
-                 v3 = g_of_r2((k + 1) * h);
+    const double v0 = g_of_r2(k * h), v1 = g_of_r2((k + 1.0 / 3.0) * h),
+                 v2 = g_of_r2((k + 2.0 / 3.0) * h), v3 = g_of_r2((k + 1) * h);
     const double d1 = v1 - v0, d2 = v2 - 2.0 * v1 + v0, d3 = v3 - 3.0 * v2 + 3.0 * v1 - v0;
     out[4 * k] = v0;
     out[4 * k + 1] = 3.0 * (d1 - 0.5 * d2 + d3 / 3.0);
@@ -136,16 +136,21 @@ std::vector<double> pairTableValues(G g_of_r2, double r2_max, int n) {
   return out;
 }
 /// A PairTable over host or device coefficients from pairTableValues(..., r2_max, n).
-inline PairTable pairTable(const double* data, double r2_max, int n) { return PairTable{data, n / r2_max}; }
+inline PairTable pairTable(const double* data, double r2_max, int n) {
+  return PairTable{data, n / r2_max};
+}
 /// Table of fastPairForceOverR on [0, r2^2]; zero from r2^2 on (S(r2) = 0), so a lookup at
 /// min(r^2, r2^2) is the force for any r.
-inline std::vector<double> fastPairTableValues(const RealSpaceSwitch& sw, int n = FAST_PAIR_TABLE_INTERVALS) {
-  return pairTableValues([&](double r2) { return fastPairForceOverR(std::sqrt(r2), sw); }, sw.r2 * sw.r2, n);
+inline std::vector<double> fastPairTableValues(const RealSpaceSwitch& sw,
+                                               int n = FAST_PAIR_TABLE_INTERVALS) {
+  return pairTableValues([&](double r2) { return fastPairForceOverR(std::sqrt(r2), sw); },
+                         sw.r2 * sw.r2, n);
 }
 /// Table of slowPairForceOverR on [0, r2_max].
-inline std::vector<double> slowPairTableValues(double alpha, const RealSpaceSwitch& sw, double r2_max,
-                                               int n = SLOW_PAIR_TABLE_INTERVALS) {
-  return pairTableValues([&](double r2) { return slowPairForceOverR(std::sqrt(r2), alpha, sw); }, r2_max, n);
+inline std::vector<double> slowPairTableValues(double alpha, const RealSpaceSwitch& sw,
+                                               double r2_max, int n = SLOW_PAIR_TABLE_INTERVALS) {
+  return pairTableValues(
+      [&](double r2) { return slowPairForceOverR(std::sqrt(r2), alpha, sw); }, r2_max, n);
 }
 
 }  // namespace granagg::md

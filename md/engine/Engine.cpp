@@ -54,8 +54,8 @@ struct Speed2 {
 /// a fraction 1e-6 of collisions in a Maxwellian gas at the initial temperature (collision-
 /// weighted P(g) = g/(2T) exp(-g^2/(4T)), tail exp(-g^2/(4T))).
 double impactSpeedMax(const MdConfig& c) {
-  return c.integrator.impact_speed_max > 0.0 ? c.integrator.impact_speed_max
-                                             : std::sqrt(4.0 * c.system.temperature * std::log(1e6));
+  if (c.integrator.impact_speed_max > 0.0) return c.integrator.impact_speed_max;
+  return std::sqrt(4.0 * c.system.temperature * std::log(1e6));
 }
 // coulomb.every = "auto": time between evaluations of the slow Coulomb part (Engine::coulombEvery)
 constexpr double SLOW_INTERVAL = 0.016;
@@ -144,7 +144,7 @@ struct Engine::Impl {
   // the slow interval that follows the gas (coulomb.every_max > every): between every_base and
   // every_cap steps, chosen at each evaluation (chooseEvery); fixed: every_cap = every_base
   int every_base = 1, every_cap = 1;
-  double slow_speed_ref = 0.0;              // integrator.impact_speed_max: the base interval's speed
+  double slow_speed_ref = 0.0;  // integrator.impact_speed_max: the base interval's speed
   int every_prev = 1;                       // the interval that ended at the last evaluation
   std::int64_t slow_evaluations = 0;        // in this process (Engine::slowEvaluations)
   CoulombSetup csetup;
@@ -322,7 +322,8 @@ struct Engine::Impl {
   CoulombRealParams realParams() const {
     CoulombRealParams prm{cfg.coulomb.K, csetup.alpha, csetup.r_cut, fast_switch};
     if (!slow_table.empty())
-      prm.table = pairTable(raw(slow_table), csetup.r_cut * csetup.r_cut, SLOW_PAIR_TABLE_INTERVALS);
+      prm.table =
+          pairTable(raw(slow_table), csetup.r_cut * csetup.r_cut, SLOW_PAIR_TABLE_INTERVALS);
     return prm;
   }
 
@@ -371,7 +372,8 @@ struct Engine::Impl {
   /// drift velocities, which a checkpoint restores to the bit.
   int chooseEvery() const {
     if (every_cap <= every_base) return every_base;
-    const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0, thrust::maximum<double>());
+    const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0,
+                                               thrust::maximum<double>());
     const double v_rel = 2.0 * std::sqrt(u2);
     const double k = v_rel > 0.0 ? std::floor(every_base * slow_speed_ref / v_rel) : every_cap;
     return static_cast<int>(std::min<double>(every_cap, std::max<double>(every_base, k)));
@@ -384,7 +386,8 @@ struct Engine::Impl {
   /// act at the same instant, so only their sum reaches the drift velocities: weighting both
   /// halves by the mean is the impulse integrator with a varying outer step, to the bit.
   double slowWeight(std::int64_t at) const {
-    return at == kspace_step ? 0.5 * (static_cast<double>(every_prev) + static_cast<double>(every)) : 0.0;
+    if (at != kspace_step) return 0.0;
+    return 0.5 * (static_cast<double>(every_prev) + static_cast<double>(every));
   }
 
   /// \param slow_weight weight of ext_f* in this step's force (0: not added)
@@ -405,7 +408,8 @@ struct Engine::Impl {
       st.fast = fast_switch;
       st.coulomb_K = cfg.coulomb.K;
       if (!fast_table.empty())
-        st.fast_table = pairTable(raw(fast_table), fast_switch.r2 * fast_switch.r2, FAST_PAIR_TABLE_INTERVALS);
+        st.fast_table = pairTable(raw(fast_table), fast_switch.r2 * fast_switch.r2,
+                                  FAST_PAIR_TABLE_INTERVALS);
     }
     return st;
   }
@@ -646,7 +650,8 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
   d.dt = chooseTimeStep(config);
   d.every = d.every_prev = d.every_base = d.every_cap = coulombEvery(config, d.dt);
   if (d.every_base > 1) {
-    const int cap = config.coulomb.every_max > 0 ? config.coulomb.every_max : SLOW_INTERVAL_GROWTH * d.every_base;
+    const int cap = config.coulomb.every_max > 0 ? config.coulomb.every_max
+                                                 : SLOW_INTERVAL_GROWTH * d.every_base;
     d.every_cap = std::max(d.every_base, cap);
   }
   d.slow_speed_ref = impactSpeedMax(config);
@@ -809,9 +814,10 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
       const auto k = extra.ints.find("coulomb_every"), kp = extra.ints.find("coulomb_every_prev");
       if (k != extra.ints.end() && kp != extra.ints.end()) {
         if (k->second < d.every_base || k->second > d.every_cap || kp->second < 1)
-          throw std::invalid_argument("checkpoint: slow Coulomb interval " + std::to_string(k->second) +
-                                      " outside this run's " + std::to_string(d.every_base) + ".." +
-                                      std::to_string(d.every_cap));
+          throw std::invalid_argument(
+              "checkpoint: slow Coulomb interval " + std::to_string(k->second) +
+              " outside this run's " + std::to_string(d.every_base) + ".." +
+              std::to_string(d.every_cap));
         d.every = static_cast<int>(k->second);
         d.every_prev = static_cast<int>(kp->second);
       }  // (older checkpoints: a fixed interval, as configured)
@@ -822,7 +828,7 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
                                   "(coulomb.every > 1): it was written by an older granagg; restart with coulomb.every = 1");
     }
   }
-  d.rebuildList(true);  // storage in cell order from the first step on (locality), as after any build
+  d.rebuildList(true);  // storage in cell order from the first step on, as after any build
 }
 
 void Engine::enableProfile(bool on) { m_impl->timer.enable(on); }

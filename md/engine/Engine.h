@@ -80,7 +80,8 @@ struct CoulombSetup {
   double sum_q2_design = 0.0;      ///< sum q^2 the parameters were chosen for
   double r_fast = 0.0;             ///< multiple time stepping: real space within this is fast (switched over 1 d); 0: none
   int every = 1;                   ///< multiple time stepping: steps between evaluations of the slow part
-  /// > every: the interval follows the gas up to this many steps (coulomb.every_max); = every: fixed
+  /// > every: the interval follows the gas up to this many steps (coulomb.every_max);
+  /// = every: fixed
   int every_max = 1;
 };
 

@@ -352,8 +352,10 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
       {"coulomb.method=p3m", "--set coulomb.method=p3m: coulomb.method = \"p3m\" is invalid"},
       {"coulomb.mesh=0", "--set coulomb.mesh=0: coulomb.mesh = 0 is invalid: must be > 0 or \"auto\""},
       {"coulomb.order=9", "--set coulomb.order=9: coulomb.order = 9 is invalid: must lie in 2..7"},
-      {"coulomb.every_max=2000", "--set coulomb.every_max=2000: coulomb.every_max = 2000 is invalid: must lie in 1..1000"},
-      {"coulomb.every_max=-1", "--set coulomb.every_max=-1: coulomb.every_max = -1 is invalid: must be > 0 or \"auto\""},
+      {"coulomb.every_max=2000",
+       "--set coulomb.every_max=2000: coulomb.every_max = 2000 is invalid: must lie in 1..1000"},
+      {"coulomb.every_max=-1",
+       "--set coulomb.every_max=-1: coulomb.every_max = -1 is invalid: must be > 0 or \"auto\""},
   };
   for (const auto& [set, message] : bad) {
     INFO(set);

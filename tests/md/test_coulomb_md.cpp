@@ -293,7 +293,8 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
   }
 }
 
-TEST_CASE("multiple time stepping that follows the gas: bounded interval, energy, restart bit for bit", "[md][coulomb]") {
+TEST_CASE("multiple time stepping that follows the gas: bounded interval, energy, restart bit for bit",
+          "[md][coulomb]") {
   // coulomb.every_max > every: at each evaluation the next interval is floor(k_base v_ref / (2
   // max|u|)) within [k_base, every_max] (Engine.h). impact_speed_max = v_ref = 16 (the time step
   // is fixed, so it sets only this reference) makes the interval vary between 8 and 16 steps in a
