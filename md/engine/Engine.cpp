@@ -144,9 +144,8 @@ struct Engine::Impl {
   // the slow interval that follows the gas (coulomb.every_max > every): between every_base and
   // every_cap steps, chosen at each evaluation (chooseEvery); fixed: every_cap = every_base
   int every_base = 1, every_cap = 1;
-  double slow_speed_ref = 0.0;  // integrator.impact_speed_max: the base interval's speed
-  int every_prev = 1;                       // the interval that ended at the last evaluation
-  std::int64_t slow_evaluations = 0;        // in this process (Engine::slowEvaluations)
+  int every_prev = 1;                 // the interval that ended at the last evaluation
+  std::int64_t slow_evaluations = 0;  // in this process (Engine::slowEvaluations)
   CoulombSetup csetup;
   std::unique_ptr<Pppm> pppm;
   std::unique_ptr<EwaldReference> ewald;
@@ -375,7 +374,7 @@ struct Engine::Impl {
     const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0,
                                                thrust::maximum<double>());
     const double v_rel = 2.0 * std::sqrt(u2);
-    const double k = v_rel > 0.0 ? std::floor(every_base * slow_speed_ref / v_rel) : every_cap;
+    const double k = v_rel > 0.0 ? std::floor(every_base * impactSpeedMax(cfg) / v_rel) : every_cap;
     return static_cast<int>(std::min<double>(every_cap, std::max<double>(every_base, k)));
   }
 
@@ -654,7 +653,6 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
                                                  : SLOW_INTERVAL_GROWTH * d.every_base;
     d.every_cap = std::max(d.every_base, cap);
   }
-  d.slow_speed_ref = impactSpeedMax(config);
 
   Frame f = init;
   if (f.charge.size() != N) f.charge.assign(N, 0.0);
