@@ -15,17 +15,14 @@
 #include "analysis/pipeline/RunAnalyzer.h"
 #include "TestTrajectories.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempDir;
+
 using namespace granagg::analysis;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("granagg_analysis_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 /// A small dense gas (so that clusters exist) at log-spaced times.
 std::vector<Frame> sampleFrames(std::size_t count = 8) {

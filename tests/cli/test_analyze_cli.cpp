@@ -12,16 +12,13 @@
 
 #include "common/Csv.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempDir;
+
 namespace fs = std::filesystem;
 
 namespace {
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("granagg_analyze_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 /// A small `granagg md` run (300 particles to t = 1); returns its folder.
 fs::path mdRun(const fs::path& dir, const std::string& name, int seed) {
   const fs::path cfg = dir / (name + ".toml");

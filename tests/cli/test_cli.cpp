@@ -12,11 +12,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace {
-std::string tempPath(const std::string& name) {
-  return "/tmp/granagg_cli_" + std::to_string(::getpid()) + "_" + name;
-}
+#include "TestUtil.h"
 
+using granagg::test::tempPath;
+
+namespace {
 int countLines(const std::string& s) {
   int n = 0;
   for (char c : s) n += (c == '\n');

@@ -14,14 +14,13 @@
 
 #include "md/io/H5mdReader.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempDir;
+
 namespace fs = std::filesystem;
 
 namespace {
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("granagg_md_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  return d;
-}
 std::string writeConfig(const fs::path& dir, const std::string& body) {
   fs::create_directories(dir);
   const fs::path p = dir / "run.toml";

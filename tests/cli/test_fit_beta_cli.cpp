@@ -20,16 +20,14 @@
 #include "analysis/io/Hdf5Lite.h"
 #include "common/Csv.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempDir;
+using granagg::test::slurp;
+
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("granagg_fitbeta_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 /// Writes a CSV: header row, then rows.
 void writeCsv(const fs::path& p, const std::string& header, const std::vector<std::vector<double>>& rows,
@@ -63,13 +61,6 @@ std::map<std::string, double> readRow(const fs::path& p) {
   std::map<std::string, double> m;
   for (std::size_t j = 0; j < t.columns.size(); ++j) m[t.columns[j]] = t.rows[0][j];
   return m;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 /// Mean-field S(t) for `beta` from `granagg smol` (sectional, grid ratio 1.05 -- finer than

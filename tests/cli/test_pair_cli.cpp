@@ -12,22 +12,14 @@
 #include <string>
 #include <unistd.h>
 
+#include "TestUtil.h"
+
+using granagg::test::tempDir;
+using granagg::test::slurp;
+
 namespace fs = std::filesystem;
 
 namespace {
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("granagg_pair_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 }  // namespace
 
 TEST_CASE("pair rejects bad input with exit status 2 and a message naming it", "[cli][pair]") {

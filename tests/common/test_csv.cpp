@@ -9,12 +9,13 @@
 #include "common/Csv.h"
 #include "common/Version.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempPath;
+
 using namespace granagg::common;
 
 namespace {
-std::string tempPath(const std::string& name) {
-  return "/tmp/granagg_test_" + std::to_string(::getpid()) + "_" + name;
-}
 }  // namespace
 
 TEST_CASE("CSV round trip keeps provenance, columns and exact values", "[common][csv]") {

@@ -16,20 +16,16 @@
 #include "md/io/Checkpoint.h"
 #include "md/io/H5mdWriter.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempPath;
+using granagg::test::sameBits;
+using granagg::test::slurp;
+using granagg::test::spit;
+
 using namespace granagg::md;
 
 namespace {
-
-std::string tempPath(const std::string& name) {
-  return "/tmp/granagg_test_ckpt_" + std::to_string(::getpid()) + "_" + name;
-}
-
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
-bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 /// A state with awkward doubles (signed zero, subnormal, huge) so that any rounding shows.
 Checkpoint makeCheckpoint(std::size_t n, unsigned seed) {
@@ -87,16 +83,6 @@ bool sameCheckpoint(const Checkpoint& a, const Checkpoint& b) {
 bool fileExists(const std::string& p) {
   struct stat st;
   return ::stat(p.c_str(), &st) == 0;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void spit(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 }  // namespace

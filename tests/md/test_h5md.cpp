@@ -23,14 +23,16 @@
 #include "md/io/H5mdWriter.h"
 #include "md/io/Hdf5Util.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempPath;
+using granagg::test::sameBits;
+using granagg::test::slurp;
+
 using namespace granagg::md;
 namespace h5 = granagg::md::h5;
 
 namespace {
-
-std::string tempPath(const std::string& name) {
-  return "/tmp/granagg_test_h5md_" + std::to_string(::getpid()) + "_" + name;
-}
 
 void removeTrajectory(const std::string& path) {
   std::remove(path.c_str());
@@ -66,11 +68,6 @@ Frame makeFrame(std::size_t n, std::int64_t step, unsigned seed, double L = 7.5)
   return f;
 }
 
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
 bool sameFrame(const Frame& a, const Frame& b) {
   return a.step == b.step && std::memcmp(&a.time, &b.time, sizeof(double)) == 0 && a.box == b.box &&
          sameBits(a.x, b.x) && sameBits(a.y, b.y) && sameBits(a.z, b.z) && sameBits(a.vx, b.vx) &&
@@ -97,11 +94,6 @@ std::vector<Frame> writeTrajectory(const std::string& path, std::size_t n, int f
   }
   w.close();
   return written;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 /// Number of hard links to the object at `path` (H5O reference count).

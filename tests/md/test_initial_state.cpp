@@ -12,13 +12,13 @@
 #include "md/io/H5mdWriter.h"
 #include "md/io/InitialState.h"
 
+#include "TestUtil.h"
+
+using granagg::test::tempPath;
+
 using namespace granagg::md;
 
 namespace {
-
-std::string tempPath(const std::string& name) {
-  return "/tmp/granagg_test_init_" + std::to_string(::getpid()) + "_" + name;
-}
 
 std::string writeText(const std::string& name, const std::string& text) {
   const std::string p = tempPath(name);
