@@ -7,6 +7,7 @@
 /// sentence naming the option and the allowed range; main() prints it on one line and exits 2.
 /// Other failures (I/O, a solver that cannot continue) throw std::runtime_error: exit 1.
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -15,6 +16,14 @@ namespace granagg::cli {
 struct CliContext {
   std::string command_line;  ///< argv joined, recorded in every output's provenance header
 };
+
+/// Where data/ is looked for: $GRANAGG_DATA first (if set), then the source tree's data/.
+std::vector<std::string> dataDirs();
+
+/// The file `<data>/<sub>/<name>.toml` from the first of dataDirs() that has it (presets of md
+/// runs and of pair studies). An unknown name throws std::invalid_argument naming `what` (the
+/// option or key) and listing the names available.
+std::string findPreset(const std::string& sub, const std::string& name, const std::string& what);
 
 /// Registers `granagg smol ...` (cli/SmolCommand.cpp).
 void registerSmolCommand(CLI::App& app, const CliContext& ctx);

@@ -79,28 +79,6 @@ struct PairConfig {
   std::string fit_column;
 };
 
-std::vector<std::string> dataDirs() {
-  std::vector<std::string> dirs;
-  if (const char* env = std::getenv("GRANAGG_DATA")) dirs.emplace_back(env);
-  dirs.emplace_back(GRANAGG_DATA_DIR);
-  return dirs;
-}
-
-std::string findPreset(const std::string& sub, const std::string& name, const std::string& what) {
-  std::set<std::string> available;
-  for (const auto& d : dataDirs()) {
-    const fs::path p = fs::path(d) / sub / (name + ".toml");
-    if (fs::exists(p)) return p.string();
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(fs::path(d) / sub, ec))
-      if (e.path().extension() == ".toml") available.insert(e.path().stem().string());
-  }
-  std::string list;
-  for (const auto& a : available) list += (list.empty() ? "" : ", ") + a;
-  throw std::invalid_argument(what + ": no preset named '" + name + "' in " + dataDirs().back() + "/" + sub +
-                              " (available: " + list + ")");
-}
-
 /// scripts/ of the source tree: GRANAGG_SCRIPTS, else GRANAGG_DATA_DIR/../scripts.
 fs::path scriptsDir() {
   if (const char* env = std::getenv("GRANAGG_SCRIPTS")) return env;

@@ -371,7 +371,7 @@ struct SummaryFunctor {
       const double xi = 1.0 - sqrt(r2);
       s.elastic_energy += 0.5 * Potential::elasticEnergy(xi, params);  // half per partner
       ++s.contacts;
-      if (j > i) s.overlap_sum += xi;
+      s.overlap_sum += 0.5 * xi;  // half per partner (not "j > i": slots, not ids)
       s.max_overlap = xi > s.max_overlap ? xi : s.max_overlap;
     }
     return s;
@@ -487,8 +487,10 @@ ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, con
                               const typename Potential::Params& params) {
   const int N = static_cast<int>(p.size());
   SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
-  return thrust::transform_reduce(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), s, ContactSummary{},
-                                  CombineSummary{});
+  DVec<ContactSummary> per_slot(p.size());
+  thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+                    per_slot.begin(), s);
+  return reduceById(per_slot, p.id, ContactSummary{}, CombineSummary{});  // restart: same bits
 }
 
 template <class Potential>

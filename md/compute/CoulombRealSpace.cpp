@@ -4,6 +4,7 @@
 
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
 #include "md/coulomb/RealSpace.h"
@@ -108,10 +109,12 @@ void coulombRealForces(const ParticleData& p, const NeighborList& nl, const comm
 double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const common::Box& box, const CoulombRealParams& prm) {
   checkRange(nl, prm);
   const int N = static_cast<int>(p.size());
-  return thrust::transform_reduce(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
-                                  RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K,
-                                                    prm.alpha, prm.r_cut * prm.r_cut},
-                                  0.0, thrust::plus<double>());
+  DVec<double> per_slot(p.size());
+  thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+                    per_slot.begin(),
+                    RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box,
+                                      prm.K, prm.alpha, prm.r_cut * prm.r_cut});
+  return reduceById(per_slot, p.id, 0.0, thrust::plus<double>());  // restart: same bits
 }
 
 }  // namespace granagg::md

@@ -416,11 +416,6 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   const double inv_h = 1.0 / s.h;
   using thrust::counting_iterator;
 
-  // self and background energies from sum q, sum q^2
-  const double sum_q = s.sum(q, N, false, stride), sum_q2 = s.sum(q, N, true, stride);
-  s.energies.self = EwaldReference::selfEnergy(s.params.alpha, s.K, sum_q2);
-  s.energies.background = EwaldReference::backgroundEnergy(s.params.alpha, s.K, s.L, sum_q);
-
   using Scope = PhaseTimer::Scope;
   // 1. sort particles by (stencil cell, id)
   std::optional<Scope> phase(std::in_place, s.timer, PhaseTimer::PppmSort);
@@ -438,6 +433,11 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
                                raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx), raw(s.jy), raw(s.jz), raw(s.cell)});
   thrust::for_each(counting_iterator<long>(0), counting_iterator<long>(static_cast<long>(n) + 1),
                    CellStart{raw(s.cell), static_cast<long>(n), nr, raw(s.start)});
+  // self and background energies from sum q, sum q^2, summed in the sorted order (cell, id):
+  // the same bits whatever the order the caller stores its particles in (a restart's differs)
+  const double sum_q = s.sum(raw(s.qs), N, false), sum_q2 = s.sum(raw(s.qs), N, true);
+  s.energies.self = EwaldReference::selfEnergy(s.params.alpha, s.K, sum_q2);
+  s.energies.background = EwaldReference::backgroundEnergy(s.params.alpha, s.K, s.L, sum_q);
 
   // 2. charge assignment (tiles by colour, see ScatterTile) and forward FFT
   phase.emplace(s.timer, PhaseTimer::PppmAssign);

@@ -32,6 +32,7 @@
 #include "md/coulomb/Ewald.h"
 #include "md/coulomb/EwaldParams.h"
 #include "md/coulomb/Pppm.h"
+#include "md/engine/Launch.h"
 #include "md/engine/ParticleData.h"
 #include "md/engine/PhaseTimer.h"
 #include "md/integrate/VelocityVerlet.h"
@@ -89,9 +90,6 @@ void permute(DVec<T>& d, const DVec<int>& order, DVec<T>& scratch) {
   d.swap(scratch);
 }
 
-struct Square {
-  HD double operator()(double v) const { return v * v; }
-};
 struct ChargeSums {
   double total = 0.0, abs_sum = 0.0, abs_max = 0.0;
 };
@@ -110,9 +108,30 @@ struct Axpy {  // v + a f
   double a;
   HD double operator()(double v, double f) const { return v + a * f; }
 };
-struct Abs3 {
+/// Per particle: momentum, v^2 and |v| (sums over particles in id order: Engine::observables).
+struct VelocitySums {
+  double p[3] = {0.0, 0.0, 0.0}, v2 = 0.0, abs = 0.0;
+};
+struct VelocitySumsOf {
   const double *vx, *vy, *vz;
-  HD double operator()(int i) const { return sqrt(vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]); }
+  HD VelocitySums operator()(int i) const {
+    VelocitySums r;
+    r.p[0] = vx[i];
+    r.p[1] = vy[i];
+    r.p[2] = vz[i];
+    r.v2 = vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i];
+    r.abs = sqrt(r.v2);
+    return r;
+  }
+};
+struct CombineVelocitySums {
+  HD VelocitySums operator()(const VelocitySums& a, const VelocitySums& b) const {
+    VelocitySums r;
+    for (int c = 0; c < 3; ++c) r.p[c] = a.p[c] + b.p[c];
+    r.v2 = a.v2 + b.v2;
+    r.abs = a.abs + b.abs;
+    return r;
+  }
 };
 }  // namespace
 
@@ -699,6 +718,44 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
   d.computeInitialForces();
 }
 
+Engine::Engine(const MdConfig& config, const Checkpoint& ck)
+    : Engine(config, ck.state, /*allow_contacts=*/true) {
+  const CheckpointExtra& c = ck.extra;
+  // the Coulomb parameters first: restore() sizes the multiple-time-step state for them
+  if (const auto design = c.real_scalars.find("coulomb_sum_q2_design");
+      design != c.real_scalars.end())
+    useCoulombDesign(design->second);
+  std::vector<double> f = c.fx;
+  f.insert(f.end(), c.fy.begin(), c.fy.end());
+  f.insert(f.end(), c.fz.begin(), c.fz.end());
+  const auto collisions = c.int_scalars.find("collisions");
+  EngineExtra extra;
+  extra.arrays = c.arrays;
+  extra.ints = c.int_scalars;
+  extra.reals = c.real_scalars;
+  restore(ck.state, f, collisions == c.int_scalars.end() ? 0 : collisions->second, extra);
+}
+
+Checkpoint Engine::checkpoint() const {
+  Checkpoint ck;
+  ck.state = frame(StateKind::Integrator);
+  const std::vector<double> f = forces(StateKind::Integrator);
+  const std::size_t N = size();
+  CheckpointExtra& c = ck.extra;
+  c.fx.assign(f.begin(), f.begin() + N);
+  c.fy.assign(f.begin() + N, f.begin() + 2 * N);
+  c.fz.assign(f.begin() + 2 * N, f.end());
+  c.dt = dt();
+  c.int_scalars["collisions"] = m_impl->collisions;
+  if (const CoulombSetup* cs = coulombSetup())
+    c.real_scalars["coulomb_sum_q2_design"] = cs->sum_q2_design;
+  EngineExtra extra = extraState();
+  c.arrays = std::move(extra.arrays);
+  c.int_scalars.insert(extra.ints.begin(), extra.ints.end());
+  c.real_scalars.insert(extra.reals.begin(), extra.reals.end());
+  return ck;
+}
+
 Engine::~Engine() = default;
 
 void Engine::run(std::int64_t steps) {
@@ -848,17 +905,20 @@ Observables Engine::observables() const {
     d.smoothVelocities(sx, sy, sz);
     v[0] = &sx, v[1] = &sy, v[2] = &sz;
   }
-  double sum2 = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    o.momentum[c] = thrust::reduce(v[c]->begin(), v[c]->end(), 0.0);
-    sum2 += thrust::transform_reduce(v[c]->begin(), v[c]->end(), Square(), 0.0, thrust::plus<double>());
-  }
+  // Every sum runs over the particles in id order (reduceById): a restart, whose storage order
+  // differs from the uninterrupted run's, then samples the same observables to the bit.
+  DVec<VelocitySums> per_slot(N);
+  thrust::transform(thrust::counting_iterator<int>(0),
+                    thrust::counting_iterator<int>(static_cast<int>(N)), per_slot.begin(),
+                    VelocitySumsOf{raw(*v[0]), raw(*v[1]), raw(*v[2])});
+  const VelocitySums vs = reduceById(per_slot, d.p.id, VelocitySums{}, CombineVelocitySums{});
+  for (int c = 0; c < 3; ++c) o.momentum[c] = vs.p[c];
+  const double sum2 = vs.v2;
   o.kinetic_energy = 0.5 * sum2;
-  const double p2 = o.momentum[0] * o.momentum[0] + o.momentum[1] * o.momentum[1] + o.momentum[2] * o.momentum[2];
+  const double p2 = o.momentum[0] * o.momentum[0] + o.momentum[1] * o.momentum[1] +
+                    o.momentum[2] * o.momentum[2];
   o.temperature = (sum2 - p2 / N) / (3.0 * N);  // (1/3N) sum (v - <v>)^2, unit mass
-  o.momentum_abs_sum = thrust::transform_reduce(thrust::counting_iterator<int>(0),
-                                                thrust::counting_iterator<int>(static_cast<int>(N)),
-                                                Abs3{raw(*v[0]), raw(*v[1]), raw(*v[2])}, 0.0, thrust::plus<double>());
+  o.momentum_abs_sum = vs.abs;
   const ContactSummary c = d.summary();
   // (a cache: re-evaluating the energy, or re-building the Coulomb list, changes no trajectory)
   o.coulomb_energy = const_cast<Impl&>(d).coulombEnergyNow();
@@ -867,7 +927,9 @@ Observables Engine::observables() const {
   o.collisions = d.collisions;
   o.mean_overlap = c.contacts > 0 ? c.overlap_sum / (0.5 * c.contacts) : 0.0;
   o.max_overlap = c.max_overlap;
-  const ChargeSums q = thrust::transform_reduce(d.p.pos.begin(), d.p.pos.end(), ChargeOf{}, ChargeSums{}, CombineCharges{});
+  DVec<ChargeSums> q_slot(N);
+  thrust::transform(d.p.pos.begin(), d.p.pos.end(), q_slot.begin(), ChargeOf{});
+  const ChargeSums q = reduceById(q_slot, d.p.id, ChargeSums{}, CombineCharges{});
   o.total_charge = q.total;
   o.mean_abs_charge = q.abs_sum / N;
   o.max_abs_charge = q.abs_max;

@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "md/config/MdConfig.h"
+#include "md/io/Checkpoint.h"
 #include "md/io/Frame.h"
 
 namespace granagg::md {
@@ -121,6 +122,11 @@ class Engine {
   /// contacts are legitimate), wrong sizes, non-finite values, or a box too small for the neighbour
   /// cutoff.
   Engine(const MdConfig& config, const Frame& initial, bool allow_contacts = false);
+  /// Continues a checkpoint (checkpoint()) bit for bit: the state, forces, collision counter,
+  /// Coulomb parameters and multiple-time-step state it holds, under `config` (the run's own
+  /// configuration, as stored with the checkpoint; run.t_end may differ). Throws
+  /// std::invalid_argument if the checkpoint does not fit the configuration.
+  Engine(const MdConfig& config, const Checkpoint& checkpoint);
   ~Engine();
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
@@ -144,6 +150,11 @@ class Engine {
   /// Forces of the current state, fx, fy, fz concatenated: the integrator's (a bit-for-bit restart
   /// needs them) or the physical ones (output).
   std::vector<double> forces(StateKind kind = StateKind::Integrator) const;
+  /// Everything the engine needs to continue bit for bit (Engine(config, checkpoint)): the
+  /// integrator's state and forces, dt, the collision counter, the Coulomb parameters' design
+  /// and the multiple-time-step state. The run's own fields (config_toml, seed, frame counters)
+  /// are left for the caller (md/run/Simulation).
+  Checkpoint checkpoint() const;
   /// What else a bit-for-bit restart needs (the Coulomb force of the last evaluation).
   EngineExtra extraState() const;
   /// Restores a checkpointed state with its forces, collision counter and extraState() (same N).

@@ -14,8 +14,10 @@
 /// count.
 #include <thrust/device_vector.h>
 #include <thrust/for_each.h>
+#include <thrust/host_vector.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/reduce.h>
+#include <thrust/scatter.h>
 
 #if !defined(__CUDACC__)
 #include <omp.h>
@@ -95,6 +97,20 @@ T reduceBlocks(const thrust::device_vector<T>& blocks, T init, Op op) {
   for (std::size_t k = 0; k < blocks.size(); ++k) init = op(init, b[k]);
   return init;
 #endif
+}
+
+/// Combines per-slot values (storage order) in particle-id order, sequentially on the host: the
+/// same bits whatever the storage order (it changes with re-sorting and restarts), the thread
+/// count or the backend. For observables (sampled every so many steps), not for per-step work:
+/// it copies the values to the host.
+template <class T, class Op>
+T reduceById(const thrust::device_vector<T>& per_slot, const thrust::device_vector<int>& id,
+             T init, Op op) {
+  thrust::device_vector<T> by_id(per_slot.size());
+  thrust::scatter(per_slot.begin(), per_slot.end(), id.begin(), by_id.begin());
+  const thrust::host_vector<T> h = by_id;
+  for (std::size_t k = 0; k < h.size(); ++k) init = op(init, h[k]);
+  return init;
 }
 
 template <class Body, class Reduction>

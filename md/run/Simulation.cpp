@@ -1,0 +1,320 @@
+#include "md/run/Simulation.h"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "common/Csv.h"
+#include "common/Version.h"
+#include "md/config/ConfigParser.h"
+#include "md/io/Checkpoint.h"
+#include "md/io/H5mdWriter.h"
+#include "md/io/InitialState.h"
+
+namespace granagg::md {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// The frame to write: the physical state, with its per-particle forces when output.write_forces.
+Frame outputFrame(const Engine& engine, const MdConfig& cfg) {
+  Frame f = engine.frame(StateKind::Physical);
+  if (cfg.output.write_forces) {
+    const std::vector<double> all = engine.forces(StateKind::Physical);
+    const std::size_t N = engine.size();
+    f.fx.assign(all.begin(), all.begin() + N);
+    f.fy.assign(all.begin() + N, all.begin() + 2 * N);
+    f.fz.assign(all.begin() + 2 * N, all.end());
+  }
+  return f;
+}
+
+/// The observables as /granagg/observables stores them (design.md section 3).
+std::vector<std::pair<std::string, double>> observableRow(const Observables& o) {
+  return {{"temperature", o.temperature},
+          {"kinetic_energy", o.kinetic_energy},
+          {"elastic_energy", o.elastic_energy},
+          {"momentum_x", o.momentum[0]},
+          {"momentum_y", o.momentum[1]},
+          {"momentum_z", o.momentum[2]},
+          {"contacts_per_particle", o.contacts_per_particle},
+          {"collisions", static_cast<double>(o.collisions)},
+          {"mean_overlap", o.mean_overlap},
+          {"total_charge", o.total_charge},
+          {"mean_abs_charge", o.mean_abs_charge},
+          {"max_abs_charge", o.max_abs_charge},
+          {"coulomb_energy", o.coulomb_energy},
+          {"max_overlap", o.max_overlap}};
+}
+
+/// /parameters of a new trajectory: every configuration key, then what the run chose.
+std::vector<std::pair<std::string, std::string>> parameters(const MdConfig& cfg,
+                                                            const Engine& engine,
+                                                            const std::string& command_line,
+                                                            const std::string& dt_reason) {
+  auto params = flatten(cfg);
+  params.emplace_back("version", common::versionString());
+  params.emplace_back("command", command_line);
+  params.emplace_back("backend", Engine::backendDescription());
+  params.emplace_back("dt", common::formatReal(engine.dt()));
+  params.emplace_back("dt_reason", dt_reason);
+  if (const CoulombSetup* cs = engine.coulombSetup()) {  // chosen for coulomb.accuracy
+    params.emplace_back("coulomb_alpha", common::formatReal(cs->alpha));
+    params.emplace_back("coulomb_r_cut_used", common::formatReal(cs->r_cut));
+    params.emplace_back("coulomb_mesh_used", std::to_string(cs->mesh));
+    params.emplace_back("coulomb_order_used", std::to_string(cs->order));
+    params.emplace_back("coulomb_k_max", std::to_string(cs->k_max));
+    params.emplace_back("coulomb_estimated_error", common::formatReal(cs->estimated_error));
+    params.emplace_back("coulomb_sum_q2_design", common::formatReal(cs->sum_q2_design));
+    params.emplace_back("coulomb_r_fast_used", common::formatReal(cs->r_fast));
+    params.emplace_back("coulomb_every_used", std::to_string(cs->every));
+    params.emplace_back("coulomb_every_max_used", std::to_string(cs->every_max));
+  }
+  return params;
+}
+
+/// The initial state of a new run: random, or from system.initial with its charges set.
+Frame initialState(const MdConfig& cfg) {
+  if (cfg.system.initial == "random") return Engine::randomInitialState(cfg);
+  Frame init = readInitialState(cfg.system.initial, boxLength(cfg.system));
+  if (static_cast<int>(init.size()) != cfg.system.N)
+    throw std::invalid_argument("system.initial '" + cfg.system.initial + "' holds " +
+                                std::to_string(init.size()) + " particles but system.N = " +
+                                std::to_string(cfg.system.N));
+  Engine::assignInitialCharges(cfg, init);
+  return init;
+}
+
+/// profile.csv: one row, seconds per phase of the loop (`other` = the loop's time in no phase:
+/// observables, output, checkpoints). Column names are the phase names in snake case.
+void writeProfile(const Engine& engine, const fs::path& path, const std::string& command_line,
+                  std::int64_t steps, double loop_seconds) {
+  std::vector<std::string> columns = {"steps", "N", "loop_s"};
+  std::vector<double> row = {static_cast<double>(steps), static_cast<double>(engine.size()),
+                             loop_seconds};
+  double sum = 0.0;
+  for (const auto& [name, s] : engine.phaseSeconds()) {
+    std::string col;  // "PPPM k-space" -> "pppm_k_space"
+    for (char c : name)
+      col += std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::tolower(c))
+                                                         : '_';
+    while (col.find("__") != std::string::npos) col.erase(col.find("__"), 1);
+    if (!col.empty() && col.back() == '_') col.pop_back();
+    columns.push_back(col + "_s");
+    row.push_back(s);
+    sum += s;
+  }
+  columns.push_back("other_s");
+  row.push_back(loop_seconds - sum);
+  common::Provenance prov(command_line);
+  prov.add("version", common::versionString());
+  prov.add("backend", Engine::backendDescription());
+  common::CsvWriter w(path.string(), prov, columns, /*overwrite=*/true);
+  w.row(row);
+  w.close();
+}
+
+}  // namespace
+
+struct Simulation::Impl {
+  MdConfig cfg;
+  fs::path out;
+  RunOptions options;
+  bool resumed = false;
+  std::string dt_reason;
+  std::int64_t last = 0;
+  std::unique_ptr<Engine> engine;
+  std::unique_ptr<H5mdWriter> writer;
+  std::vector<std::int64_t> frames;  // frameSteps()
+  std::size_t next_frame = 0;        // index into frames of the next frame to write
+  std::vector<std::shared_ptr<Reporter>> reporters;
+  std::int64_t last_checkpoint_step = -1;  // -1: none written by this process or found
+  Observables observables;                 // at the end of the last chunk
+
+  fs::path trajectory() const { return out / "traj.h5"; }
+  fs::path checkpointFile() const { return out / "checkpoint.h5"; }
+
+  /// engine, dt, last step and frame schedule (both start() and resume())
+  void setUp(std::unique_ptr<Engine> e) {
+    engine = std::move(e);
+    engine->enableProfile(options.profile);
+    Engine::chooseTimeStep(cfg, &dt_reason);
+    last = static_cast<std::int64_t>(std::llround(cfg.run.t_end / engine->dt()));
+    frames = Simulation::frameSteps(cfg, engine->dt(), last);
+    next_frame = static_cast<std::size_t>(
+        std::upper_bound(frames.begin(), frames.end(), engine->step()) - frames.begin());
+  }
+
+  void checkpoint() {
+    writer->flush();
+    Checkpoint ck = engine->checkpoint();
+    ck.extra.config_toml = toToml(cfg);
+    ck.extra.seed = cfg.system.seed;
+    ck.extra.frames_written = writer->frames();
+    ck.extra.next_frame_index = next_frame;
+    md::writeCheckpoint(checkpointFile().string(), ck.state, ck.extra);
+    last_checkpoint_step = engine->step();
+  }
+};
+
+Simulation::Simulation(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+Simulation::Simulation(Simulation&&) noexcept = default;
+Simulation& Simulation::operator=(Simulation&&) noexcept = default;
+Simulation::~Simulation() = default;
+
+Simulation Simulation::start(const MdConfig& config, const fs::path& out,
+                             const RunOptions& options) {
+  auto d = std::make_unique<Impl>();
+  d->cfg = config;
+  d->out = out;
+  d->options = options;
+  validateConfig(d->cfg);
+  if (fs::exists(out) && !fs::is_empty(out) && !options.overwrite)
+    throw std::invalid_argument("output folder '" + out.string() +
+                                "' exists and is not empty; choose another --out or pass --force "
+                                "to overwrite it");
+  // everything that can fail on the input fails before the folder is touched
+  d->setUp(std::make_unique<Engine>(d->cfg, initialState(d->cfg)));
+  fs::create_directories(out);
+  // an overwritten run's checkpoint and profile are not this run's
+  fs::remove(d->checkpointFile());
+  fs::remove(out / "profile.csv");
+  const Engine& e = *d->engine;
+  d->writer = std::make_unique<H5mdWriter>(
+      d->trajectory().string(), e.size(), parameters(d->cfg, e, options.command_line, d->dt_reason),
+      toToml(d->cfg), options.overwrite, d->cfg.output.write_velocities,
+      d->cfg.output.write_forces);
+  d->writer->writeObservables(0, 0.0, observableRow(e.observables()));
+  d->writer->writeFrame(outputFrame(e, d->cfg));
+  d->next_frame = 1;  // frames[0] = 0: written
+  return Simulation(std::move(d));
+}
+
+Simulation Simulation::resume(const fs::path& out, const std::vector<std::string>& overrides,
+                              const RunOptions& options) {
+  for (const auto& s : overrides)
+    if (s.rfind("run.t_end=", 0) != 0)
+      throw std::invalid_argument(
+          "--restart accepts only --set run.t_end=... (to run further); got --set " + s);
+  auto d = std::make_unique<Impl>();
+  d->out = out;
+  d->options = options;
+  d->resumed = true;
+  const fs::path cpath = d->checkpointFile();
+  if (!fs::exists(cpath))
+    throw std::invalid_argument("--restart: no checkpoint at " + cpath.string());
+  const Checkpoint ck = readCheckpoint(cpath.string());
+  d->cfg = parseConfigString(ck.extra.config_toml, cpath.string() + ":/config_toml", overrides);
+  validateConfig(d->cfg);
+  d->setUp(std::make_unique<Engine>(d->cfg, ck));
+  d->last_checkpoint_step = d->engine->step();
+  d->writer = std::make_unique<H5mdWriter>(H5mdWriter::reopen(
+      d->trajectory().string(), d->engine->size(), d->engine->step(),
+      d->cfg.output.write_velocities, d->cfg.output.write_forces));
+  return Simulation(std::move(d));
+}
+
+void Simulation::addReporter(std::shared_ptr<Reporter> reporter) {
+  m_impl->reporters.push_back(std::move(reporter));
+}
+
+RunSummary Simulation::run() {
+  Impl& d = *m_impl;
+  Engine& engine = *d.engine;
+  const MdConfig& cfg = d.cfg;
+  const std::int64_t obs_every = cfg.output.observable_interval;
+  const std::int64_t ck_every = cfg.output.checkpoint_interval;
+  const std::int64_t first_step = engine.step(), first_builds = engine.neighborBuilds(),
+                     first_slow = engine.slowEvaluations();
+  auto last_checkpoint_time = Clock::now();
+  const auto loop_start = Clock::now();
+  struct Finish {  // reporters hear of the end however run() ends
+    Simulation& sim;
+    ~Finish() {
+      for (auto& r : sim.m_impl->reporters) r->finish(sim);
+    }
+  } finish{*this};
+  try {
+    while (engine.step() < d.last) {
+      std::int64_t target = std::min(d.last, (engine.step() / obs_every + 1) * obs_every);
+      if (d.next_frame < d.frames.size()) target = std::min(target, d.frames[d.next_frame]);
+      if (ck_every > 0) target = std::min(target, (engine.step() / ck_every + 1) * ck_every);
+      for (const auto& r : d.reporters)
+        if (const std::int64_t s = r->nextStep(*this); s > engine.step())
+          target = std::min(target, s);
+      engine.run(target - engine.step());
+      d.observables = engine.observables();
+      const Observables& o = d.observables;
+      if (engine.step() % obs_every == 0 || engine.step() == d.last)
+        d.writer->writeObservables(o.step, o.time, observableRow(o));
+      if (d.next_frame < d.frames.size() && engine.step() == d.frames[d.next_frame]) {
+        d.writer->writeFrame(outputFrame(engine, cfg));
+        ++d.next_frame;
+      }
+      const bool by_steps = ck_every > 0 && engine.step() % ck_every == 0;
+      const bool by_wall =
+          cfg.output.checkpoint_wall_seconds > 0 &&
+          std::chrono::duration<double>(Clock::now() - last_checkpoint_time).count() >
+              cfg.output.checkpoint_wall_seconds;
+      if (by_steps || by_wall) {
+        d.checkpoint();
+        last_checkpoint_time = Clock::now();
+      }
+      for (const auto& r : d.reporters) r->report(*this);
+    }
+  } catch (const RunAborted& e) {
+    d.writer->close();
+    const fs::path cpath = d.checkpointFile();
+    throw RunAborted(std::string(e.what()) + ". Trajectory up to the last frame in " +
+                     d.trajectory().string() +
+                     (d.last_checkpoint_step >= 0 ? "; last good checkpoint (step " +
+                                              std::to_string(d.last_checkpoint_step) +
+                                              ") kept in " + cpath.string()
+                                        : "; no checkpoint was written before the failure"));
+  }
+  RunSummary s;
+  s.loop_seconds = std::chrono::duration<double>(Clock::now() - loop_start).count();
+  s.steps = engine.step() - first_step;
+  s.neighbor_builds = engine.neighborBuilds() - first_builds;
+  s.slow_evaluations = engine.slowEvaluations() - first_slow;
+  d.checkpoint();
+  d.writer->close();
+  if (d.options.profile)
+    writeProfile(engine, d.out / "profile.csv", d.options.command_line, s.steps, s.loop_seconds);
+  return s;
+}
+
+void Simulation::writeCheckpoint() { m_impl->checkpoint(); }
+
+const Engine& Simulation::engine() const { return *m_impl->engine; }
+const MdConfig& Simulation::config() const { return m_impl->cfg; }
+const fs::path& Simulation::folder() const { return m_impl->out; }
+fs::path Simulation::trajectoryPath() const { return m_impl->trajectory(); }
+fs::path Simulation::checkpointPath() const { return m_impl->checkpointFile(); }
+const std::string& Simulation::dtReason() const { return m_impl->dt_reason; }
+std::int64_t Simulation::lastStep() const { return m_impl->last; }
+bool Simulation::resumed() const { return m_impl->resumed; }
+std::size_t Simulation::framesWritten() const { return m_impl->writer->frames(); }
+const Observables& Simulation::lastObservables() const { return m_impl->observables; }
+
+std::vector<std::int64_t> Simulation::frameSteps(const MdConfig& c, double dt, std::int64_t last) {
+  std::set<std::int64_t> s{0, last};
+  if (c.output.frames_per_decade > 0) {
+    const double t0 = std::max(0.01, dt);
+    const double k = std::pow(10.0, 1.0 / c.output.frames_per_decade);
+    for (double t = t0; t < c.run.t_end * (1 + 1e-12); t *= k)
+      s.insert(std::min<std::int64_t>(last, std::llround(t / dt)));
+  }
+  if (c.output.frame_interval > 0.0)
+    for (double t = c.output.frame_interval; t < c.run.t_end * (1 + 1e-12);
+         t += c.output.frame_interval)
+      s.insert(std::min<std::int64_t>(last, std::llround(t / dt)));
+  return {s.begin(), s.end()};
+}
+
+}  // namespace granagg::md

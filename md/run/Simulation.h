@@ -1,0 +1,126 @@
+#pragma once
+/// \file Simulation.h
+/// A restartable MD run: an Engine plus its output folder (design.md section 6), the frame and
+/// observable schedule and the checkpoints. `granagg md` is option wiring around this class; so is
+/// any other driver (a test, a study). Modelled on OpenMM's Simulation: the run owns the engine and
+/// its outputs, and reporters look at it between chunks of steps.
+///
+/// Output folder:
+///     traj.h5        H5MD trajectory: frames (log- and/or linearly spaced), observables every
+///                    output.observable_interval steps and at the end, /parameters (provenance)
+///     checkpoint.h5  the state to continue from bit for bit (md/io/Checkpoint.h), written every
+///                    output.checkpoint_interval steps and/or output.checkpoint_wall_seconds, and
+///                    at the end of run()
+///     profile.csv    with RunOptions::profile: wall seconds per phase of the loop
+///
+/// Determinism: a run resumed from any of its checkpoints writes the same frames, observables and
+/// final state, to the bit, as the uninterrupted run (same build; any thread count).
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "md/config/MdConfig.h"
+#include "md/engine/Engine.h"
+
+namespace granagg::md {
+
+class Simulation;
+
+/// Looks at a run between chunks of steps (progress lines, user callbacks). A reporter never
+/// changes the run: the frames, observables and checkpoints are the Simulation's own.
+class Reporter {
+ public:
+  virtual ~Reporter() = default;
+  /// The step at which this reporter next wants to be called; the run then stops there. The
+  /// default has no wish: report() is still called after every chunk (at most
+  /// output.observable_interval steps).
+  virtual std::int64_t nextStep(const Simulation&) const {
+    return std::numeric_limits<std::int64_t>::max();
+  }
+  /// Called after each chunk of steps, with the engine at the chunk's end.
+  virtual void report(const Simulation& sim) = 0;
+  /// Called once when run() ends (normally or not).
+  virtual void finish(const Simulation&) {}
+};
+
+/// How a run is started or resumed.
+struct RunOptions {
+  std::string command_line;  ///< provenance: stored in /parameters of a new trajectory
+  bool overwrite = false;    ///< start(): replace the files of a non-empty output folder
+  bool profile = false;      ///< time the loop by phase and write profile.csv (no result changes)
+};
+
+/// What run() did, for the log.
+struct RunSummary {
+  std::int64_t steps = 0;            ///< steps taken by this run() (not since t = 0)
+  double loop_seconds = 0.0;         ///< wall time of the loop, output included
+  std::int64_t neighbor_builds = 0;  ///< contact-list builds in this run()
+  std::int64_t slow_evaluations = 0; ///< evaluations of the slow Coulomb part in this run()
+};
+
+class Simulation {
+ public:
+  /// A new run of `config` (validated here) into the folder `out`, from its initial state
+  /// (system.initial: random, or a CSV / H5MD file, with charges from charging.initial). Creates
+  /// `out`; throws std::invalid_argument, before writing anything, for a bad configuration or
+  /// initial state and for a non-empty `out` without RunOptions::overwrite. Writes the trajectory's
+  /// header and the frame and observables at t = 0.
+  static Simulation start(const MdConfig& config, const std::filesystem::path& out,
+                          const RunOptions& options);
+  /// Continues the run in `out` from its checkpoint.h5, with the configuration stored there.
+  /// `overrides` ("key=value", as --set) may only set run.t_end, to run further. Throws
+  /// std::invalid_argument for another key, a bad value or a missing checkpoint, and
+  /// std::runtime_error for an unreadable one.
+  static Simulation resume(const std::filesystem::path& out,
+                           const std::vector<std::string>& overrides, const RunOptions& options);
+
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+  ~Simulation();
+
+  /// Adds a reporter (called in the order added).
+  void addReporter(std::shared_ptr<Reporter> reporter);
+
+  /// Runs to run.t_end: advances the engine in chunks, writes observables, frames and
+  /// checkpoints on their schedule and a final checkpoint, and closes the trajectory. Throws
+  /// RunAborted when the engine stops (NaN, deep overlap); the message then says where the
+  /// trajectory ends and which checkpoint is the last good state.
+  RunSummary run();
+
+  /// Writes checkpoint.h5 now (atomically; the trajectory is flushed first).
+  void writeCheckpoint();
+
+  const Engine& engine() const;
+  const MdConfig& config() const;
+  const std::filesystem::path& folder() const;
+  std::filesystem::path trajectoryPath() const;
+  std::filesystem::path checkpointPath() const;
+  /// Why dt is what it is ("auto: elastic Hertz contact time ..." or "fixed").
+  const std::string& dtReason() const;
+  /// The step at which the run ends (run.t_end / dt, rounded).
+  std::int64_t lastStep() const;
+  /// True if this Simulation continues a checkpoint.
+  bool resumed() const;
+  /// Frames in the trajectory so far.
+  std::size_t framesWritten() const;
+  /// The observables at the end of the last chunk of run() (what reporters should read: the
+  /// engine's observables() may evaluate the Coulomb energy afresh); zeros before the first.
+  const Observables& lastObservables() const;
+
+  /// Steps at which frames are written for `config` and `dt` up to `last`: t = 0, log-spaced
+  /// (output.frames_per_decade from t = 0.01, or from dt if larger), linear
+  /// (output.frame_interval) and `last`.
+  static std::vector<std::int64_t> frameSteps(const MdConfig& config, double dt,
+                                              std::int64_t last);
+
+ private:
+  struct Impl;
+  explicit Simulation(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace granagg::md
