@@ -1,4 +1,5 @@
 /// `granagg analyze`: trajectory analysis of one run or an ensemble (analysis/, docs/analysis.md).
+#include <unistd.h>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -7,7 +8,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #ifdef _OPENMP
@@ -61,8 +61,10 @@ class Progress {
     const auto now = std::chrono::steady_clock::now();
     if (frame > 1 && std::chrono::duration<double>(now - m_last).count() < 0.5) return;
     m_last = now;
-    if (hint) std::fprintf(stderr, "\ranalyze: run %zu/%zu, frame %zu/%zu   ", run + 1, runs, frame, hint);
-    else std::fprintf(stderr, "\ranalyze: run %zu/%zu, frame %zu   ", run + 1, runs, frame);
+    if (hint)
+      std::fprintf(stderr, "\ranalyze: run %zu/%zu, frame %zu/%zu   ", run + 1, runs, frame, hint);
+    else
+      std::fprintf(stderr, "\ranalyze: run %zu/%zu, frame %zu   ", run + 1, runs, frame);
     std::fflush(stderr);
   }
   void done() {
@@ -79,25 +81,34 @@ an::AnalysisOptions toOptions(const AnalyzeArgs& a) {
   o.grid.spacing = a.grid_spacing;
   o.grid.min_fill = a.grid_min_fill;
   o.grid.min_count = a.grid_min_count;
-  if (a.grid_assign == "ngp") o.grid.assignment = an::GridAssignment::Nearest;
-  else if (a.grid_assign == "cic") o.grid.assignment = an::GridAssignment::CloudInCell;
-  else throw std::invalid_argument("--grid-assign must be ngp or cic (got '" + a.grid_assign + "').");
+  if (a.grid_assign == "ngp")
+    o.grid.assignment = an::GridAssignment::Nearest;
+  else if (a.grid_assign == "cic")
+    o.grid.assignment = an::GridAssignment::CloudInCell;
+  else
+    throw std::invalid_argument("--grid-assign must be ngp or cic (got '" + a.grid_assign + "').");
   o.grid_clusters = !a.no_grid;
   o.particle_clusters = !a.no_particle;
-  if (a.no_grid && a.no_particle) throw std::invalid_argument("--no-grid and --no-particle together leave no cluster definition.");
-  if (a.write_grid && a.no_grid) throw std::invalid_argument("--write-grid needs grid clusters (drop --no-grid).");
+  if (a.no_grid && a.no_particle)
+    throw std::invalid_argument(
+        "--no-grid and --no-particle together leave no cluster definition.");
+  if (a.write_grid && a.no_grid)
+    throw std::invalid_argument("--write-grid needs grid clusters (drop --no-grid).");
   o.particle.tolerance = a.tolerance;
   o.slope_ratio = a.slope_ratio;
   if (!a.fit_window.empty()) {
-    if (a.fit_window.size() != 2) throw std::invalid_argument("--fit-window takes two times T_MIN T_MAX.");
+    if (a.fit_window.size() != 2)
+      throw std::invalid_argument("--fit-window takes two times T_MIN T_MAX.");
     o.fit_t_min = a.fit_window[0];
     o.fit_t_max = a.fit_window[1];
     if (!(o.fit_t_max > o.fit_t_min) || !(o.fit_t_min >= 0))
-      throw std::invalid_argument("--fit-window must be two times 0 <= T_MIN < T_MAX (got " + common::formatReal(o.fit_t_min) +
-                                  " " + common::formatReal(o.fit_t_max) + ").");
+      throw std::invalid_argument("--fit-window must be two times 0 <= T_MIN < T_MAX (got " +
+                                  common::formatReal(o.fit_t_min) + " " +
+                                  common::formatReal(o.fit_t_max) + ").");
   }
   if (!a.charge_fit_window.empty()) {
-    if (a.charge_fit_window.size() != 2) throw std::invalid_argument("--charge-fit-window takes two times T_MIN T_MAX.");
+    if (a.charge_fit_window.size() != 2)
+      throw std::invalid_argument("--charge-fit-window takes two times T_MIN T_MAX.");
     o.charge_fit_t_min = a.charge_fit_window[0];
     o.charge_fit_t_max = a.charge_fit_window[1];
   }
@@ -122,18 +133,20 @@ an::AnalysisOptions toOptions(const AnalyzeArgs& a) {
   return o;
 }
 
-common::Provenance provenanceOf(const AnalyzeArgs& a, const an::AnalysisOptions& o, const CliContext& ctx,
-                                const std::vector<an::RunResult>& runs) {
+common::Provenance provenanceOf(const AnalyzeArgs& a, const an::AnalysisOptions& o,
+                                const CliContext& ctx, const std::vector<an::RunResult>& runs) {
   common::Provenance p(ctx.command_line);
   for (std::size_t k = 0; k < runs.size(); ++k) {
-    p.add("run." + std::to_string(k), runs[k].source + " (" + runs[k].format + ", " + std::to_string(runs[k].frames) +
-                                          " frames, N = " + std::to_string(runs[k].particles) +
-                                          (runs[k].grid_cells > 0
-                                               ? ", grid " + std::to_string(runs[k].grid_cells) + "^3 cells of h = " +
-                                                     common::formatReal(runs[k].grid_cell_size) + ", occupied at >= " +
-                                                     common::formatReal(runs[k].grid_min_count) + " centres"
-                                               : std::string()) +
-                                          (runs[k].partial ? ", PARTIAL" : "") + ")");
+    p.add(
+        "run." + std::to_string(k),
+        runs[k].source + " (" + runs[k].format + ", " + std::to_string(runs[k].frames) +
+            " frames, N = " + std::to_string(runs[k].particles) +
+            (runs[k].grid_cells > 0
+                 ? ", grid " + std::to_string(runs[k].grid_cells) +
+                       "^3 cells of h = " + common::formatReal(runs[k].grid_cell_size) +
+                       ", occupied at >= " + common::formatReal(runs[k].grid_min_count) + " centres"
+                 : std::string()) +
+            (runs[k].partial ? ", PARTIAL" : "") + ")");
   }
   p.add("grid_spacing", o.grid.spacing);
   p.add("grid_min_fill", o.grid.min_fill);
@@ -144,7 +157,8 @@ common::Provenance provenanceOf(const AnalyzeArgs& a, const an::AnalysisOptions&
   p.add("fit_window", o.fit_t_min > 0 || o.fit_t_max > 0
                           ? common::formatReal(o.fit_t_min) + " " + common::formatReal(o.fit_t_max)
                           : std::string("last decade [t_last/10, t_last]"));
-  p.add("charge_fit_window", common::formatReal(o.charge_fit_t_min) + " " + common::formatReal(o.charge_fit_t_max));
+  p.add("charge_fit_window",
+        common::formatReal(o.charge_fit_t_min) + " " + common::formatReal(o.charge_fit_t_max));
   p.add("mle_min_tail", static_cast<long long>(o.mle_min_tail));
   p.add("speed_max", o.speed_max);
   p.add("speed_bins", o.speed_bins);
@@ -161,18 +175,21 @@ common::Provenance provenanceOf(const AnalyzeArgs& a, const an::AnalysisOptions&
 }
 
 void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
-  if (a.runs.empty()) throw std::invalid_argument("give at least one RUN (traj.h5, a run folder or a LAMMPS dump).");
+  if (a.runs.empty())
+    throw std::invalid_argument("give at least one RUN (traj.h5, a run folder or a LAMMPS dump).");
   if (a.threads < 0) throw std::invalid_argument("--threads must be >= 1.");
 #ifdef _OPENMP
   if (a.threads > 0) omp_set_num_threads(a.threads);
 #endif
   const an::AnalysisOptions o = toOptions(a);
   for (const auto& r : a.runs)
-    if (!fs::exists(r)) throw std::invalid_argument("no such trajectory or run folder: '" + r + "'");
+    if (!fs::exists(r))
+      throw std::invalid_argument("no such trajectory or run folder: '" + r + "'");
   const fs::path out(a.out);
   if (fs::exists(out) && (!fs::is_directory(out) || (!fs::is_empty(out) && !a.force)))
-    throw std::invalid_argument("output folder '" + out.string() +
-                                "' exists and is not empty; choose another --out or pass --force to overwrite it");
+    throw std::invalid_argument(
+        "output folder '" + out.string() +
+        "' exists and is not empty; choose another --out or pass --force to overwrite it");
   fs::create_directories(out / "per_run");
 
   // analysis.h5 is opened first so that --write-grid streams one frame at a time into it; a
@@ -184,8 +201,13 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
   try {
     for (std::size_t k = 0; k < a.runs.size(); ++k) {
       an::RunCallbacks cb;
-      cb.progress = [&](std::size_t frame, std::size_t hint) { progress.update(k, a.runs.size(), frame, hint); };
-      if (a.write_grid) cb.grid = [&](const an::Frame& f, const an::GridClusters& g) { file->writeGridFrame(k, f, g); };
+      cb.progress = [&](std::size_t frame, std::size_t hint) {
+        progress.update(k, a.runs.size(), frame, hint);
+      };
+      if (a.write_grid)
+        cb.grid = [&](const an::Frame& f, const an::GridClusters& g) {
+          file->writeGridFrame(k, f, g);
+        };
       results.push_back(an::analyzeRun(a.runs[k], o, cb));
     }
   } catch (...) {
@@ -206,21 +228,23 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
       if (r.hasTable(t.name)) all.push_back(&r.table(t.name));
     an::writeCsv(an::stackRuns(all), (out / "per_run" / (t.name + ".csv")).string(), prov, a.force);
   }
-  for (const an::Table& t : ensemble) an::writeCsv(t, (out / (t.name + ".csv")).string(), prov, a.force);
+  for (const an::Table& t : ensemble)
+    an::writeCsv(t, (out / (t.name + ".csv")).string(), prov, a.force);
 
   for (std::size_t k = 0; k < results.size(); ++k) {
     const auto& r = results[k];
     const std::string g = "runs/" + std::to_string(k);
     for (const auto& t : r.tables) file->writeTable(g, t);
-    std::map<std::string, std::string> attrs{{"source", r.source},
-                                             {"format", r.format},
-                                             {"frames", std::to_string(r.frames)},
-                                             {"particles", std::to_string(r.particles)},
-                                             {"partial", r.partial ? r.partial_reason : "no"},
-                                             {"kappa", common::formatReal(r.kappa) + " (" + r.kappa_source + ")"},
-                                             {"grid_cells_per_side", std::to_string(r.grid_cells)},
-                                             {"grid_cell_size", common::formatReal(r.grid_cell_size)},
-                                             {"grid_min_count", common::formatReal(r.grid_min_count)}};
+    std::map<std::string, std::string> attrs{
+        {"source", r.source},
+        {"format", r.format},
+        {"frames", std::to_string(r.frames)},
+        {"particles", std::to_string(r.particles)},
+        {"partial", r.partial ? r.partial_reason : "no"},
+        {"kappa", common::formatReal(r.kappa) + " (" + r.kappa_source + ")"},
+        {"grid_cells_per_side", std::to_string(r.grid_cells)},
+        {"grid_cell_size", common::formatReal(r.grid_cell_size)},
+        {"grid_min_count", common::formatReal(r.grid_min_count)}};
     std::string notes;
     for (const auto& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
     attrs["notes"] = notes;
@@ -236,28 +260,33 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
   if (a.quiet) return;
   for (std::size_t k = 0; k < results.size(); ++k) {
     const auto& r = results[k];
-    std::printf("analyze: run %zu: %s (%s): %zu frames, N = %zu%s\n", k, r.source.c_str(), r.format.c_str(), r.frames,
-                r.particles, r.partial ? " [PARTIAL]" : "");
+    std::printf("analyze: run %zu: %s (%s): %zu frames, N = %zu%s\n", k, r.source.c_str(),
+                r.format.c_str(), r.frames, r.particles, r.partial ? " [PARTIAL]" : "");
     if (r.grid_cells > 0)
-      std::printf("analyze:   grid: %d^3 cells of h = %.4g d, occupied at >= %g centres per cell\n", r.grid_cells,
-                  r.grid_cell_size, r.grid_min_count);
+      std::printf("analyze:   grid: %d^3 cells of h = %.4g d, occupied at >= %g centres per cell\n",
+                  r.grid_cells, r.grid_cell_size, r.grid_min_count);
     for (const auto& n : r.notes) std::printf("analyze:   note: %s\n", n.c_str());
   }
   for (const auto& t : ensemble)
     if (t.name == "fits" && !t.rows.empty()) {
       const auto& row = t.rows.front();
       auto c = [&](const char* name) { return row[t.column(name)]; };
-      std::printf("analyze: z (grid) = %.4g [%.4g, %.4g], z (particle) = %.4g [%.4g, %.4g] over t in [%.4g, %.4g] (%s)\n",
-                  c("z_grid"), c("z_grid_low"), c("z_grid_high"), c("z_particle"), c("z_particle_low"),
-                  c("z_particle_high"), c("fit_t_min"), c("fit_t_max"),
-                  results.size() > 1 ? "95% bootstrap over runs" : "95% Student t");
+      std::printf(
+          "analyze: z (grid) = %.4g [%.4g, %.4g], z (particle) = %.4g [%.4g, %.4g] over t in "
+          "[%.4g, %.4g] (%s)\n",
+          c("z_grid"), c("z_grid_low"), c("z_grid_high"), c("z_particle"), c("z_particle_low"),
+          c("z_particle_high"), c("fit_t_min"), c("fit_t_max"),
+          results.size() > 1 ? "95% bootstrap over runs" : "95% Student t");
       if (std::isfinite(c("charging_rate_exponent")))
-        std::printf("analyze: d<|q|>/dt ~ t^%.4g [%.4g, %.4g]; expected -5/6 - 5 kappa/3 = %.4g (kappa = %g, %s)\n",
-                    c("charging_rate_exponent"), c("charging_rate_low"), c("charging_rate_high"),
-                    c("charging_rate_expected"), c("kappa"), results.front().kappa_source.c_str());
+        std::printf(
+            "analyze: d<|q|>/dt ~ t^%.4g [%.4g, %.4g]; expected -5/6 - 5 kappa/3 = %.4g (kappa = "
+            "%g, %s)\n",
+            c("charging_rate_exponent"), c("charging_rate_low"), c("charging_rate_high"),
+            c("charging_rate_expected"), c("kappa"), results.front().kappa_source.c_str());
       if (std::isfinite(c("onset_time_grid")))
-        std::printf("analyze: onset (S_grid reaches %g x its median %.4g over t <= %g) at t_c = %.4g\n",
-                    c("onset_factor"), c("onset_S_base_grid"), c("onset_t_base"), c("onset_time_grid"));
+        std::printf(
+            "analyze: onset (S_grid reaches %g x its median %.4g over t <= %g) at t_c = %.4g\n",
+            c("onset_factor"), c("onset_S_base_grid"), c("onset_t_base"), c("onset_time_grid"));
     }
   std::printf("analyze: wrote %s (CSV tables, per_run/, analysis.h5)\n", out.string().c_str());
 }
@@ -266,39 +295,70 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
 
 void registerAnalyzeCommand(CLI::App& app, const CliContext& ctx) {
   auto a = std::make_shared<AnalyzeArgs>();
-  CLI::App* c = app.add_subcommand(
-      "analyze",
-      "Analyse trajectories (H5MD files, run folders holding traj.h5, or LAMMPS text dumps): grid and particle\n"
-      "clusters, N_s(s), S(t), Fisher and growth exponents, MSD, speed distribution, a2, T_g, charges, N_stick.\n"
-      "Several RUNs make an ensemble (mean and standard error). Tables and defaults: docs/analysis.md.");
+  CLI::App* c = app.add_subcommand("analyze",
+                                   "Analyse trajectories (H5MD files, run folders holding traj.h5, "
+                                   "or LAMMPS text dumps): grid and particle\n"
+                                   "clusters, N_s(s), S(t), Fisher and growth exponents, MSD, "
+                                   "speed distribution, a2, T_g, charges, N_stick.\n"
+                                   "Several RUNs make an ensemble (mean and standard error). "
+                                   "Tables and defaults: docs/analysis.md.");
   c->add_option("runs", a->runs, "Trajectories: traj.h5, run folders, or LAMMPS dumps")->required();
-  c->add_option("-o,--out", a->out, "Output folder (default analysis-out); must not exist or be empty unless --force");
+  c->add_option("-o,--out", a->out,
+                "Output folder (default analysis-out); must not exist or be empty unless --force");
   c->add_flag("--force", a->force, "Overwrite files in an existing output folder");
-  c->add_option("--grid-spacing", a->grid_spacing, "Grid clusters: target cell edge in d; cells per side floor(L/spacing) (default 2)");
-  c->add_option("--grid-min-fill", a->grid_min_fill, "Grid clusters: occupied when the local filling fraction >= this (default 0.25)");
-  c->add_option("--grid-min-count", a->grid_min_count, "Grid clusters: occupied when count >= this (overrides --grid-min-fill; default 0 = off)");
-  c->add_option("--grid-assign", a->grid_assign, "Grid clusters: ngp (count centres per cell, default) or cic (cloud-in-cell smoothing)");
+  c->add_option(
+      "--grid-spacing", a->grid_spacing,
+      "Grid clusters: target cell edge in d; cells per side floor(L/spacing) (default 2)");
+  c->add_option("--grid-min-fill", a->grid_min_fill,
+                "Grid clusters: occupied when the local filling fraction >= this (default 0.25)");
+  c->add_option(
+      "--grid-min-count", a->grid_min_count,
+      "Grid clusters: occupied when count >= this (overrides --grid-min-fill; default 0 = off)");
+  c->add_option(
+      "--grid-assign", a->grid_assign,
+      "Grid clusters: ngp (count centres per cell, default) or cic (cloud-in-cell smoothing)");
   c->add_flag("--no-grid", a->no_grid, "Skip grid clusters");
-  c->add_option("--tolerance", a->tolerance, "Particle clusters: bonded when |r_ij| <= 1 + tolerance (default 0.05)");
+  c->add_option("--tolerance", a->tolerance,
+                "Particle clusters: bonded when |r_ij| <= 1 + tolerance (default 0.05)");
   c->add_flag("--no-particle", a->no_particle, "Skip particle clusters and N_stick");
-  c->add_option("--slope-ratio", a->slope_ratio, "p of the local slope z(t) = ln[S(t)/S(t/p)]/ln p (default 2)");
-  c->add_option("--fit-window", a->fit_window, "T_MIN T_MAX of the growth-exponent fit (default: the last decade)")->expected(2);
-  c->add_option("--charge-fit-window", a->charge_fit_window, "T_MIN T_MAX of the charging-rate fit (default 1 100)")->expected(2);
-  c->add_option("--mle-min-tail", a->mle_min_tail, "Fisher MLE: smallest tail (clusters >= xmin) considered (default 10)");
+  c->add_option("--slope-ratio", a->slope_ratio,
+                "p of the local slope z(t) = ln[S(t)/S(t/p)]/ln p (default 2)");
+  c->add_option("--fit-window", a->fit_window,
+                "T_MIN T_MAX of the growth-exponent fit (default: the last decade)")
+      ->expected(2);
+  c->add_option("--charge-fit-window", a->charge_fit_window,
+                "T_MIN T_MAX of the charging-rate fit (default 1 100)")
+      ->expected(2);
+  c->add_option("--mle-min-tail", a->mle_min_tail,
+                "Fisher MLE: smallest tail (clusters >= xmin) considered (default 10)");
   c->add_option("--speed-max", a->speed_max, "Speed histogram range [0, max) in v~ (default 4)");
   c->add_option("--speed-bins", a->speed_bins, "Speed histogram bins (default 80)");
-  c->add_option("--msd-origins", a->msd_origins, "t0 (from the first frame), all (FFT, evenly spaced frames), auto (default: all when possible)");
-  c->add_option("--msd-max-memory", a->msd_max_memory_mib, "Memory budget of the all-origins MSD in MiB (default 1024)");
-  c->add_option("--kappa", a->kappa, "Charging exponent kappa for the expected rate law (default: the file's charging.kappa, else 0.83)");
-  c->add_option("--track", a->track, "N_stick: number of tracked particles (smallest ids; default 10)");
-  c->add_flag("--allow-partial", a->allow_partial, "Analyse the frames before a truncated or malformed frame instead of failing");
-  c->add_option("--lammps-dt", a->lammps_dt, "LAMMPS dumps without ITEM: TIME: time = timestep * dt (default 0: time = timestep)");
-  c->add_option("--bootstrap", a->bootstrap, "Bootstrap replicates over runs for the ensemble growth exponent (default 2000)");
+  c->add_option("--msd-origins", a->msd_origins,
+                "t0 (from the first frame), all (FFT, evenly spaced frames), auto (default: all "
+                "when possible)");
+  c->add_option("--msd-max-memory", a->msd_max_memory_mib,
+                "Memory budget of the all-origins MSD in MiB (default 1024)");
+  c->add_option("--kappa", a->kappa,
+                "Charging exponent kappa for the expected rate law (default: the file's "
+                "charging.kappa, else 0.83)");
+  c->add_option("--track", a->track,
+                "N_stick: number of tracked particles (smallest ids; default 10)");
+  c->add_flag("--allow-partial", a->allow_partial,
+              "Analyse the frames before a truncated or malformed frame instead of failing");
+  c->add_option(
+      "--lammps-dt", a->lammps_dt,
+      "LAMMPS dumps without ITEM: TIME: time = timestep * dt (default 0: time = timestep)");
+  c->add_option("--bootstrap", a->bootstrap,
+                "Bootstrap replicates over runs for the ensemble growth exponent (default 2000)");
   c->add_option("--seed", a->seed, "Seed of the bootstrap (default 20091)");
-  c->add_option("--onset-factor", a->onset_factor, "Onset time t_c: S reaches this multiple of its early median (default 2)");
-  c->add_option("--onset-baseline", a->onset_baseline, "Onset time t_c: the early median is over 0 < t <= this (default 10)");
-  c->add_option("--fisher-bin-ratio", a->fisher_bin_ratio, "The paper's Fisher estimator: log bins [r^k, r^(k+1)) (default 2)");
-  c->add_flag("--write-grid", a->write_grid, "Store every frame's occupancy grid and cluster labels in analysis.h5");
+  c->add_option("--onset-factor", a->onset_factor,
+                "Onset time t_c: S reaches this multiple of its early median (default 2)");
+  c->add_option("--onset-baseline", a->onset_baseline,
+                "Onset time t_c: the early median is over 0 < t <= this (default 10)");
+  c->add_option("--fisher-bin-ratio", a->fisher_bin_ratio,
+                "The paper's Fisher estimator: log bins [r^k, r^(k+1)) (default 2)");
+  c->add_flag("--write-grid", a->write_grid,
+              "Store every frame's occupancy grid and cluster labels in analysis.h5");
   c->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)");
   c->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
   c->callback([a, ctx]() { runAnalyze(*a, ctx); });

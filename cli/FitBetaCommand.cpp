@@ -47,10 +47,13 @@ struct Columns {
   std::string source;
   std::vector<std::string> names;
   std::vector<std::vector<double>> values;
-  bool has(const std::string& n) const { return std::find(names.begin(), names.end(), n) != names.end(); }
+  bool has(const std::string& n) const {
+    return std::find(names.begin(), names.end(), n) != names.end();
+  }
   const std::vector<double>& get(const std::string& n) const {
     const auto it = std::find(names.begin(), names.end(), n);
-    if (it == names.end()) throw std::invalid_argument(source + " has no column '" + n + "' (columns: " + list() + ").");
+    if (it == names.end())
+      throw std::invalid_argument(source + " has no column '" + n + "' (columns: " + list() + ").");
     return values[static_cast<std::size_t>(it - names.begin())];
   }
   std::string list() const {
@@ -82,7 +85,8 @@ Columns fromH5Group(hid_t file, const std::string& group, const std::string& pat
     h5::Handle d(H5Dopen2(g.get(), name.c_str(), H5P_DEFAULT));
     if (!d) h5::fail("'" + path + "': cannot open " + group + "/" + name);
     c.names.push_back(name);
-    c.values.push_back(h5::readAll<double>(d.get(), H5T_NATIVE_DOUBLE, "'" + path + "' " + group + "/" + name));
+    c.values.push_back(
+        h5::readAll<double>(d.get(), H5T_NATIVE_DOUBLE, "'" + path + "' " + group + "/" + name));
   }
   return c;
 }
@@ -111,26 +115,30 @@ std::string defaultColumn(const Columns& c, const std::string& input) {
   for (const auto& n : c.names)
     if (n != "t" && n != "run") others.push_back(n);
   if (others.size() == 1) return others.front();
-  if (others.empty()) throw std::invalid_argument("INPUT '" + input + "' has no S column besides t.");
+  if (others.empty())
+    throw std::invalid_argument("INPUT '" + input + "' has no S column besides t.");
   throw std::invalid_argument("INPUT '" + input + "' has several columns besides t (" + c.list() +
                               "); choose the S column with --column.");
 }
 
-/// Columns selected by --column NAME: NAME itself, else every column whose name starts with NAME (runs).
-std::vector<std::string> selectColumns(const Columns& c, const std::string& name, const std::string& input) {
+/// Columns selected by --column NAME: NAME itself, else every column whose name starts with NAME
+/// (runs).
+std::vector<std::string> selectColumns(const Columns& c, const std::string& name,
+                                       const std::string& input) {
   if (c.has(name)) return {name};
   std::vector<std::string> out;
   for (const auto& n : c.names)
     if (n != "t" && n.rfind(name, 0) == 0) out.push_back(n);
   if (out.empty())
-    throw std::invalid_argument("INPUT '" + input + "' has no column '" + name + "' nor columns starting with it (columns: " +
-                                c.list() + ").");
+    throw std::invalid_argument("INPUT '" + input + "' has no column '" + name +
+                                "' nor columns starting with it (columns: " + c.list() + ").");
   return out;
 }
 
 void requireT(const Columns& c, const std::string& input) {
   if (!c.has("t"))
-    throw std::invalid_argument("INPUT '" + input + "' has no column 't' (columns: " + c.list() + ").");
+    throw std::invalid_argument("INPUT '" + input + "' has no column 't' (columns: " + c.list() +
+                                ").");
 }
 
 /// Splits a long-format table (leading `run` column, as per_run/S_t.csv) into one Columns per run.
@@ -153,8 +161,9 @@ std::vector<Columns> splitRuns(const Columns& c) {
 
 /// Puts the per-run series of `column` on the times `t` (matched to 9 digits); keeps the times that
 /// every run holds. Returns false (with a note) when a run lacks the column.
-bool alignRuns(const std::vector<Columns>& perRun, const std::string& column, std::vector<double>& t,
-               std::vector<std::vector<double>>& runs, std::vector<std::string>& notes) {
+bool alignRuns(const std::vector<Columns>& perRun, const std::string& column,
+               std::vector<double>& t, std::vector<std::vector<double>>& runs,
+               std::vector<std::string>& notes) {
   std::vector<std::map<double, double>> maps;
   for (const Columns& r : perRun) {
     if (!r.has("t") || !r.has(column)) {
@@ -177,23 +186,26 @@ bool alignRuns(const std::vector<Columns>& perRun, const std::string& column, st
     for (std::size_t r = 0; r < maps.size(); ++r) runs[r].push_back(maps[r].at(key9(x)));
   }
   if (kept.size() < t.size())
-    notes.push_back(std::to_string(t.size() - kept.size()) + " times not held by every run were left out");
+    notes.push_back(std::to_string(t.size() - kept.size()) +
+                    " times not held by every run were left out");
   t = kept;
   return true;
 }
 
 /// The ensemble mean S column (c_mean) and its per-run column c, read from an ensemble table and
 /// the per-run tables (analyze folder or analysis.h5).
-Loaded loadEnsemble(const Columns& ens, const std::vector<Columns>& perRun, const std::string& input,
-                    const std::string& columnArg, const std::string& source) {
+Loaded loadEnsemble(const Columns& ens, const std::vector<Columns>& perRun,
+                    const std::string& input, const std::string& columnArg,
+                    const std::string& source) {
   requireT(ens, input);
   Loaded L;
   L.source = source;
   const std::string col = columnArg.empty() ? defaultColumn(ens, input) : columnArg;
   const auto cols = selectColumns(ens, col, input);
   if (cols.size() > 1)
-    throw std::invalid_argument("INPUT '" + input + "': --column '" + col + "' matches several columns (" +
-                                std::to_string(cols.size()) + "); name one of them.");
+    throw std::invalid_argument("INPUT '" + input + "': --column '" + col +
+                                "' matches several columns (" + std::to_string(cols.size()) +
+                                "); name one of them.");
   L.column = cols.front();
   L.t = ens.get("t");
   const std::string suffix = "_mean";
@@ -206,8 +218,8 @@ Loaded loadEnsemble(const Columns& ens, const std::vector<Columns>& perRun, cons
     if (alignRuns(perRun, base, t, runs, L.notes)) {
       L.t = t;
       L.runs = runs;
-      L.notes.push_back("S = mean of " + std::to_string(runs.size()) + " runs' " + base + " (the ensemble " + L.column +
-                        "); intervals over runs");
+      L.notes.push_back("S = mean of " + std::to_string(runs.size()) + " runs' " + base +
+                        " (the ensemble " + L.column + "); intervals over runs");
       return L;
     }
   }
@@ -221,8 +233,9 @@ Loaded loadH5(const std::string& path, const std::string& columnArg) {
   h5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
   if (!f) throw std::invalid_argument("INPUT '" + path + "' cannot be opened as HDF5.");
   if (h5::objectType(f.get(), "/ensemble/S_t") != H5I_GROUP)
-    throw std::invalid_argument("INPUT '" + path +
-                                "' has no /ensemble/S_t group (expected an analysis.h5 written by granagg analyze).");
+    throw std::invalid_argument(
+        "INPUT '" + path +
+        "' has no /ensemble/S_t group (expected an analysis.h5 written by granagg analyze).");
   const Columns ens = fromH5Group(f.get(), "/ensemble/S_t", path);
   std::vector<Columns> perRun;
   if (h5::objectType(f.get(), "/runs") == H5I_GROUP) {
@@ -247,9 +260,11 @@ Loaded loadCsv(const std::string& path, const std::string& columnArg) {
     L.source = "'" + path + "'";
     L.column = columnArg.empty() ? defaultColumn(c, path) : columnArg;
     if (!c.has(L.column))
-      throw std::invalid_argument("INPUT '" + path + "' has no column '" + L.column + "' (columns: " + c.list() + ").");
+      throw std::invalid_argument("INPUT '" + path + "' has no column '" + L.column +
+                                  "' (columns: " + c.list() + ").");
     L.t = per.front().get("t");
-    if (!alignRuns(per, L.column, L.t, L.runs, L.notes)) throw std::invalid_argument("INPUT '" + path + "': runs differ.");
+    if (!alignRuns(per, L.column, L.t, L.runs, L.notes))
+      throw std::invalid_argument("INPUT '" + path + "': runs differ.");
     L.notes.push_back(std::to_string(per.size()) + " runs from the 'run' column");
     return L;
   }
@@ -260,17 +275,20 @@ Loaded loadCsv(const std::string& path, const std::string& columnArg) {
   L.column = cols.size() == 1 ? cols.front() : col + "*";
   L.t = c.get("t");
   for (const auto& n : cols) L.runs.push_back(c.get(n));
-  if (cols.size() > 1) L.notes.push_back(std::to_string(cols.size()) + " run columns matching '" + col + "*'");
+  if (cols.size() > 1)
+    L.notes.push_back(std::to_string(cols.size()) + " run columns matching '" + col + "*'");
   return L;
 }
 
 Loaded load(const std::string& input, const std::string& columnArg) {
-  if (input.empty()) throw std::invalid_argument("INPUT is required (an analyze folder, a CSV or an analysis.h5).");
+  if (input.empty())
+    throw std::invalid_argument("INPUT is required (an analyze folder, a CSV or an analysis.h5).");
   const fs::path p(input);
   if (fs::is_directory(p)) {
     const fs::path st = p / "S_t.csv";
     if (!fs::exists(st))
-      throw std::invalid_argument("INPUT folder '" + input + "' has no S_t.csv (expected a `granagg analyze` output folder).");
+      throw std::invalid_argument("INPUT folder '" + input +
+                                  "' has no S_t.csv (expected a `granagg analyze` output folder).");
     const Columns ens = fromCsv(st.string());
     std::vector<Columns> perRun;
     const fs::path pr = p / "per_run" / "S_t.csv";
@@ -286,17 +304,18 @@ Loaded load(const std::string& input, const std::string& columnArg) {
   return loadCsv(input, columnArg);
 }
 
-/// Drops the rows with t = 0 (fits are in log t) and the rows where S is NaN in the series or in any
-/// run (`granagg analyze` writes NaN where a frame has no cluster); rejects negative or non-finite t.
-/// Infinite or non-positive S stays, for validateGrowthData to reject.
+/// Drops the rows with t = 0 (fits are in log t) and the rows where S is NaN in the series or in
+/// any run (`granagg analyze` writes NaN where a frame has no cluster); rejects negative or
+/// non-finite t. Infinite or non-positive S stays, for validateGrowthData to reject.
 void dropUnusableRows(Loaded& L) {
   std::size_t zero = 0, missing = 0;
   std::vector<double> t;
   std::vector<std::vector<double>> runs(L.runs.size());
   for (std::size_t i = 0; i < L.t.size(); ++i) {
     if (!std::isfinite(L.t[i]) || L.t[i] < 0.0)
-      throw std::invalid_argument("INPUT " + L.source + ": t must be non-negative and finite (t = " +
-                                  common::formatReal(L.t[i]) + " at row " + std::to_string(i + 1) + ").");
+      throw std::invalid_argument(
+          "INPUT " + L.source + ": t must be non-negative and finite (t = " +
+          common::formatReal(L.t[i]) + " at row " + std::to_string(i + 1) + ").");
     if (L.t[i] == 0.0) {
       ++zero;
       continue;
@@ -310,10 +329,12 @@ void dropUnusableRows(Loaded& L) {
     t.push_back(L.t[i]);
     for (std::size_t r = 0; r < runs.size(); ++r) runs[r].push_back(L.runs[r][i]);
   }
-  if (zero) L.notes.push_back(std::to_string(zero) + " row(s) at t = 0 left out (fits are in log t)");
+  if (zero)
+    L.notes.push_back(std::to_string(zero) + " row(s) at t = 0 left out (fits are in log t)");
   if (missing)
     L.notes.push_back(std::to_string(missing) + " row(s) with S = NaN (no cluster" +
-                      (L.runs.size() > 1 ? std::string(" in some run") : std::string()) + ") left out");
+                      (L.runs.size() > 1 ? std::string(" in some run") : std::string()) +
+                      ") left out");
   L.t = t;
   L.runs = runs;
 }
@@ -322,7 +343,9 @@ void dropUnusableRows(Loaded& L) {
 
 class Json {
  public:
-  void num(const std::string& k, double v) { add(k, std::isfinite(v) ? common::formatReal(v) : "null"); }
+  void num(const std::string& k, double v) {
+    add(k, std::isfinite(v) ? common::formatReal(v) : "null");
+  }
   void integer(const std::string& k, long long v) { add(k, std::to_string(v)); }
   void boolean(const std::string& k, bool v) { add(k, v ? "true" : "false"); }
   void str(const std::string& k, const std::string& v) { add(k, quote(v)); }
@@ -350,7 +373,9 @@ class Json {
     }
     return o + "\"";
   }
-  void add(const std::string& k, const std::string& v) { m_body += (m_body.empty() ? "  " : ",\n  ") + quote(k) + ": " + v; }
+  void add(const std::string& k, const std::string& v) {
+    m_body += (m_body.empty() ? "  " : ",\n  ") + quote(k) + ": " + v;
+  }
   std::string m_body;
 };
 
@@ -363,7 +388,8 @@ std::string interval(double v, double lo, double hi) {
 
 void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   mf::validateBetaRange(a.beta_min, a.beta_max);
-  if (!a.window.empty() && a.window.size() != 2) throw std::invalid_argument("--window needs two times T0 T1.");
+  if (!a.window.empty() && a.window.size() != 2)
+    throw std::invalid_argument("--window needs two times T0 T1.");
   Loaded L = load(a.input, a.column);
   dropUnusableRows(L);
   mf::GrowthData data;
@@ -375,11 +401,13 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   }
   const int minPoints = 5;
   if (data.t.size() < static_cast<std::size_t>(minPoints))
-    throw std::invalid_argument("INPUT " + L.source + ": too few points (" + std::to_string(data.t.size()) +
-                                " samples with t > 0, at least " + std::to_string(minPoints) + " needed).");
+    throw std::invalid_argument("INPUT " + L.source + ": too few points (" +
+                                std::to_string(data.t.size()) + " samples with t > 0, at least " +
+                                std::to_string(minPoints) + " needed).");
 
   const fs::path outDir(a.out);
-  const std::string csvPath = (outDir / "fit_beta.csv").string(), curvePath = (outDir / "fit_curve.csv").string(),
+  const std::string csvPath = (outDir / "fit_beta.csv").string(),
+                    curvePath = (outDir / "fit_curve.csv").string(),
                     jsonPath = (outDir / "fit_beta.json").string();
   common::refuseToOverwrite(csvPath, a.force);
   common::refuseToOverwrite(jsonPath, a.force);
@@ -388,14 +416,16 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   // 1. z over the window.
   mf::WindowOptions wo;
   wo.min_points = minPoints;
-  const mf::SlopeWindow window = a.window.empty() ? mf::automaticWindow(data, wo)
-                                                  : mf::explicitWindow(data, a.window[0], a.window[1], minPoints);
+  const mf::SlopeWindow window =
+      a.window.empty() ? mf::automaticWindow(data, wo)
+                       : mf::explicitWindow(data, a.window[0], a.window[1], minPoints);
   mf::BootstrapOptions bo;
   const mf::ZFit zf = mf::fitGrowthExponent(data, window, bo);
 
   // 2. beta from z at the window's S range, and the mean field's z there for beta = 2 and 3.
   mf::MeanFieldCurves curves;
-  const mf::BetaFromZ bz = mf::betaFromZ(curves, zf.z, zf.z_low, zf.z_high, zf.S0, zf.S1, a.beta_min, a.beta_max);
+  const mf::BetaFromZ bz =
+      mf::betaFromZ(curves, zf.z, zf.z_low, zf.z_high, zf.S0, zf.S1, a.beta_min, a.beta_max);
   double zmf2 = std::nan(""), zmf3 = std::nan("");
   if (bz.S1 > bz.S0 * 1.0001) {
     zmf2 = curves.exponentBetween(bz.S0, bz.S1, 2.0);
@@ -419,66 +449,134 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   mf::BetaFromZ bzs;
   bzs.beta = bzs.beta_low = bzs.beta_high = nan;
   if (!a.no_curve_fit && std::isfinite(cf.S_c) && cf.S_c > 0.0)
-    bzs = mf::betaFromZ(curves, zf.z, zf.z_low, zf.z_high, zf.S0 / cf.S_c, zf.S1 / cf.S_c, a.beta_min, a.beta_max);
+    bzs = mf::betaFromZ(curves, zf.z, zf.z_low, zf.z_high, zf.S0 / cf.S_c, zf.S1 / cf.S_c,
+                        a.beta_min, a.beta_max);
 
   // 5. beta from z by the asymptotic law z = 3 beta / (beta + 3): needs no S scale.
   const mf::BetaFromZ ba = mf::betaAsymptotic(zf.z, zf.z_low, zf.z_high);
 
   // Outputs.
   fs::create_directories(outDir);
-  if (a.no_curve_fit && a.force) fs::remove(curvePath);  // a stale curve from an earlier run would mislead
+  if (a.no_curve_fit && a.force)
+    fs::remove(curvePath);  // a stale curve from an earlier run would mislead
   common::Provenance prov(ctx.command_line);
   prov.add("input", L.source);
   prov.add("column", L.column);
   prov.add("runs", static_cast<long long>(L.runs.size()));
   prov.add("samples", static_cast<long long>(data.t.size()));
   prov.add("window_rule", window.rule);
-  prov.add("z_interval", zf.interval_method + (zf.replicates ? " (" + std::to_string(zf.replicates) + " replicates)" : ""));
+  prov.add("z_interval",
+           zf.interval_method +
+               (zf.replicates ? " (" + std::to_string(zf.replicates) + " replicates)" : ""));
   prov.add("confidence", bo.confidence);
   prov.add("bootstrap_seed", static_cast<long long>(bo.seed));
   prov.add("beta_min", a.beta_min);
   prov.add("beta_max", a.beta_max);
-  prov.add("mean_field", std::string("sectional solver, beta kernel, n_1(0) = 1, K0 = 1, grid ratio ") +
-                             common::formatReal(curves.options().ratio) + ", rtol " +
-                             common::formatReal(curves.options().rtol));
-  prov.add("beta_from_z", std::string("beta at which the mean-field least-squares exponent over the S range [S0, S1] "
-                                      "of the window (fitted power law at t0, t1) equals z"));
+  prov.add("mean_field",
+           std::string("sectional solver, beta kernel, n_1(0) = 1, K0 = 1, grid ratio ") +
+               common::formatReal(curves.options().ratio) + ", rtol " +
+               common::formatReal(curves.options().rtol));
+  prov.add(
+      "beta_from_z",
+      std::string("beta at which the mean-field least-squares exponent over the S range [S0, S1] "
+                  "of the window (fitted power law at t0, t1) equals z"));
   if (!bz.note.empty()) prov.add("beta_from_z_note", bz.note);
-  prov.add("beta_from_z_scaled", std::string("the same at the S range [S0, S1] / S_c (S_c from the curve fit)"));
+  prov.add("beta_from_z_scaled",
+           std::string("the same at the S range [S0, S1] / S_c (S_c from the curve fit)"));
   if (!bzs.note.empty()) prov.add("beta_from_z_scaled_note", bzs.note);
-  prov.add("beta_asymptotic", std::string("3 z / (3 - z), the inverse of the large-S limit z = 3 beta / (beta + 3) "
-                                          "(no S scale needed; valid where z was measured in the scaling regime)"));
+  prov.add("beta_asymptotic",
+           std::string("3 z / (3 - z), the inverse of the large-S limit z = 3 beta / (beta + 3) "
+                       "(no S scale needed; valid where z was measured in the scaling regime)"));
   if (!ba.note.empty()) prov.add("beta_asymptotic_note", ba.note);
   if (!a.no_curve_fit) prov.add("curve_interval", cf.interval_method);
   if (!cf.note.empty()) prov.add("curve_fit_note", cf.note);
-  for (std::size_t i = 0; i < L.notes.size(); ++i) prov.add("note." + std::to_string(i), L.notes[i]);
+  for (std::size_t i = 0; i < L.notes.size(); ++i)
+    prov.add("note." + std::to_string(i), L.notes[i]);
   common::Provenance sp = prov;
-  sp.add("columns", std::string("z, z_low, z_high: exponent of S ~ t^z over [t0, t1] (n_points samples) with its 95 % "
-                                  "interval; beta_from_z*: inversion of the full-Smoluchowski z(beta) at the window's S "
-                                  "range [S0, S1]; beta_fit, S_c, tau_c (+ _low/_high): fit of ln S(t) to "
-                                "ln[S_c S_MF(t/tau_c; beta)]; chi2_dof: residual variance of ln S; S0, S1: fitted S at "
-                                "t0, t1; n_runs: runs in the input; beta_from_z_scaled*: as beta_from_z at [S0, S1] / S_c; "
-                                "beta_asymptotic*: 3 z / (3 - z) (the large-S law inverted) at z, z_low, z_high; "
-                                "beta_fit_determined: 0 when beta_fit lies at a bound of the search range; NaN = not available"));
+  sp.add(
+      "columns",
+      std::string(
+          "z, z_low, z_high: exponent of S ~ t^z over [t0, t1] (n_points samples) with its 95 % "
+          "interval; beta_from_z*: inversion of the full-Smoluchowski z(beta) at the window's S "
+          "range [S0, S1]; beta_fit, S_c, tau_c (+ _low/_high): fit of ln S(t) to "
+          "ln[S_c S_MF(t/tau_c; beta)]; chi2_dof: residual variance of ln S; S0, S1: fitted S at "
+          "t0, t1; n_runs: runs in the input; beta_from_z_scaled*: as beta_from_z at [S0, S1] / "
+          "S_c; "
+          "beta_asymptotic*: 3 z / (3 - z) (the large-S law inverted) at z, z_low, z_high; "
+          "beta_fit_determined: 0 when beta_fit lies at a bound of the search range; NaN = not "
+          "available"));
   {
     common::CsvWriter w(csvPath, sp,
-                        {"z", "z_low", "z_high", "t0", "t1", "n_points", "beta_from_z", "beta_from_z_low",
-                         "beta_from_z_high", "beta_fit", "beta_fit_low", "beta_fit_high", "S_c", "S_c_low", "S_c_high",
-                         "tau_c", "tau_c_low", "tau_c_high", "chi2_dof", "S0", "S1", "n_runs", "beta_from_z_scaled",
-                         "beta_from_z_scaled_low", "beta_from_z_scaled_high", "beta_asymptotic", "beta_asymptotic_low",
-                         "beta_asymptotic_high", "beta_fit_determined"},
+                        {"z",
+                         "z_low",
+                         "z_high",
+                         "t0",
+                         "t1",
+                         "n_points",
+                         "beta_from_z",
+                         "beta_from_z_low",
+                         "beta_from_z_high",
+                         "beta_fit",
+                         "beta_fit_low",
+                         "beta_fit_high",
+                         "S_c",
+                         "S_c_low",
+                         "S_c_high",
+                         "tau_c",
+                         "tau_c_low",
+                         "tau_c_high",
+                         "chi2_dof",
+                         "S0",
+                         "S1",
+                         "n_runs",
+                         "beta_from_z_scaled",
+                         "beta_from_z_scaled_low",
+                         "beta_from_z_scaled_high",
+                         "beta_asymptotic",
+                         "beta_asymptotic_low",
+                         "beta_asymptotic_high",
+                         "beta_fit_determined"},
                         a.force);
-    w.row({zf.z, zf.z_low, zf.z_high, zf.t0, zf.t1, static_cast<double>(zf.points), bz.beta, bz.beta_low, bz.beta_high,
-           cf.beta, cf.beta_low, cf.beta_high, cf.S_c, cf.S_c_low, cf.S_c_high, cf.tau_c, cf.tau_c_low, cf.tau_c_high,
-           cf.chi2_dof, zf.S0, zf.S1, static_cast<double>(L.runs.size()), bzs.beta, bzs.beta_low, bzs.beta_high,
-           ba.beta, ba.beta_low, ba.beta_high, a.no_curve_fit ? nan : (cf.at_bound ? 0.0 : 1.0)});
+    w.row({zf.z,
+           zf.z_low,
+           zf.z_high,
+           zf.t0,
+           zf.t1,
+           static_cast<double>(zf.points),
+           bz.beta,
+           bz.beta_low,
+           bz.beta_high,
+           cf.beta,
+           cf.beta_low,
+           cf.beta_high,
+           cf.S_c,
+           cf.S_c_low,
+           cf.S_c_high,
+           cf.tau_c,
+           cf.tau_c_low,
+           cf.tau_c_high,
+           cf.chi2_dof,
+           zf.S0,
+           zf.S1,
+           static_cast<double>(L.runs.size()),
+           bzs.beta,
+           bzs.beta_low,
+           bzs.beta_high,
+           ba.beta,
+           ba.beta_low,
+           ba.beta_high,
+           a.no_curve_fit ? nan : (cf.at_bound ? 0.0 : 1.0)});
     w.close();
   }
   if (!a.no_curve_fit) {
     common::Provenance cp = prov;
-    cp.add("columns", std::string("t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit); "
-                                  "S_mf_beta2, S_mf_beta3: the mean field for beta = 2 and 3 with the same S_c, tau_c"));
-    common::CsvWriter w(curvePath, cp, {"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"}, a.force);
+    cp.add(
+        "columns",
+        std::string(
+            "t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit); "
+            "S_mf_beta2, S_mf_beta3: the mean field for beta = 2 and 3 with the same S_c, tau_c"));
+    common::CsvWriter w(curvePath, cp, {"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"},
+                        a.force);
     for (std::size_t i = 0; i < data.t.size(); ++i) {
       const double tm = data.t[i] / cf.tau_c;
       w.row({data.t[i], data.S[i], cf.S_fitted[i], cf.S_c * std::exp(curves.logS(tm, 2.0)),
@@ -552,57 +650,77 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   }
 
   if (a.quiet) return;
-  std::printf("fit-beta: %s column %s: %zu samples, %zu run%s\n", L.source.c_str(), L.column.c_str(), data.t.size(),
-              L.runs.size(), L.runs.size() == 1 ? "" : "s");
+  std::printf("fit-beta: %s column %s: %zu samples, %zu run%s\n", L.source.c_str(),
+              L.column.c_str(), data.t.size(), L.runs.size(), L.runs.size() == 1 ? "" : "s");
   for (const auto& n : L.notes) std::printf("fit-beta:   note: %s\n", n.c_str());
-  std::printf("fit-beta: window [%.4g, %.4g], %d samples (%s)\n", zf.t0, zf.t1, zf.points, window.rule.c_str());
+  std::printf("fit-beta: window [%.4g, %.4g], %d samples (%s)\n", zf.t0, zf.t1, zf.points,
+              window.rule.c_str());
   std::printf("fit-beta: z = %s (95 %%, %s)   paper: %.2f +- %.2f neutral, %.2f +- %.3f charged\n",
-              interval(zf.z, zf.z_low, zf.z_high).c_str(), zf.interval_method.c_str(), PAPER_Z_NEUTRAL,
-              PAPER_Z_NEUTRAL_ERR, PAPER_Z_CHARGED, PAPER_Z_CHARGED_ERR);
-  std::printf("fit-beta: beta from z = %s (full Smoluchowski z(beta) over S = %.4g..%.4g, where it gives z = %.4f at "
-              "beta = 2, %.4f at beta = 3)   paper: mean field z = %.2f at beta = 2, %.2f at beta = 3\n",
-              interval(bz.beta, bz.beta_low, bz.beta_high).c_str(), bz.S0, bz.S1, zmf2, zmf3, PAPER_Z_MF_BETA2,
-              PAPER_Z_MF_BETA3);
+              interval(zf.z, zf.z_low, zf.z_high).c_str(), zf.interval_method.c_str(),
+              PAPER_Z_NEUTRAL, PAPER_Z_NEUTRAL_ERR, PAPER_Z_CHARGED, PAPER_Z_CHARGED_ERR);
+  std::printf(
+      "fit-beta: beta from z = %s (full Smoluchowski z(beta) over S = %.4g..%.4g, where it gives z "
+      "= %.4f at "
+      "beta = 2, %.4f at beta = 3)   paper: mean field z = %.2f at beta = 2, %.2f at beta = 3\n",
+      interval(bz.beta, bz.beta_low, bz.beta_high).c_str(), bz.S0, bz.S1, zmf2, zmf3,
+      PAPER_Z_MF_BETA2, PAPER_Z_MF_BETA3);
   if (!bz.note.empty()) std::printf("fit-beta:   note: %s\n", bz.note.c_str());
-  std::printf("fit-beta: beta from the asymptotic law z = 3 beta/(beta + 3) = %s (no S scale; valid where the local "
-              "slope is flat)\n", interval(ba.beta, ba.beta_low, ba.beta_high).c_str());
+  std::printf(
+      "fit-beta: beta from the asymptotic law z = 3 beta/(beta + 3) = %s (no S scale; valid where "
+      "the local "
+      "slope is flat)\n",
+      interval(ba.beta, ba.beta_low, ba.beta_high).c_str());
   if (!ba.note.empty()) std::printf("fit-beta:   note: %s\n", ba.note.c_str());
   if (!a.no_curve_fit) {
-    std::printf("fit-beta: beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s\n", bzs.S0, bzs.S1,
-                interval(bzs.beta, bzs.beta_low, bzs.beta_high).c_str());
+    std::printf("fit-beta: beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s\n",
+                bzs.S0, bzs.S1, interval(bzs.beta, bzs.beta_low, bzs.beta_high).c_str());
     if (!bzs.note.empty()) std::printf("fit-beta:   note: %s\n", bzs.note.c_str());
     if (cf.at_bound)
-      std::printf("fit-beta: beta from the curve fit: not determined (at the bound %.3g of the search range)\n", cf.beta);
-    std::printf("fit-beta: beta from the curve fit = %s, S_c = %s, tau_c = %s, chi2/dof = %.3g (%s)\n",
-                interval(cf.beta, cf.beta_low, cf.beta_high).c_str(), interval(cf.S_c, cf.S_c_low, cf.S_c_high).c_str(),
-                interval(cf.tau_c, cf.tau_c_low, cf.tau_c_high).c_str(), cf.chi2_dof, cf.interval_method.c_str());
+      std::printf(
+          "fit-beta: beta from the curve fit: not determined (at the bound %.3g of the search "
+          "range)\n",
+          cf.beta);
+    std::printf(
+        "fit-beta: beta from the curve fit = %s, S_c = %s, tau_c = %s, chi2/dof = %.3g (%s)\n",
+        interval(cf.beta, cf.beta_low, cf.beta_high).c_str(),
+        interval(cf.S_c, cf.S_c_low, cf.S_c_high).c_str(),
+        interval(cf.tau_c, cf.tau_c_low, cf.tau_c_high).c_str(), cf.chi2_dof,
+        cf.interval_method.c_str());
     if (!cf.note.empty()) std::printf("fit-beta:   note: %s\n", cf.note.c_str());
   }
-  std::printf("fit-beta: wrote %s, %s%s\n", csvPath.c_str(), a.no_curve_fit ? "" : (curvePath + ", ").c_str(),
-              jsonPath.c_str());
+  std::printf("fit-beta: wrote %s, %s%s\n", csvPath.c_str(),
+              a.no_curve_fit ? "" : (curvePath + ", ").c_str(), jsonPath.c_str());
 }
 
 }  // namespace
 
 void registerFitBetaCommand(CLI::App& app, const CliContext& ctx) {
   auto args = std::make_shared<FitBetaArgs>();
-  CLI::App* c = app.add_subcommand(
-      "fit-beta",
-      "Fit the growth exponent z of a mean cluster size S(t) ~ t^z with a 95 % interval, the kernel exponent beta\n"
-      "whose full Smoluchowski solution grows with the same z over the same S range, and a full-curve fit of\n"
-      "S(t) against S_c S_MF(t/tau_c; beta). Writes fit_beta.csv, fit_curve.csv and fit_beta.json (docs/fit-beta.md).");
+  CLI::App* c = app.add_subcommand("fit-beta",
+                                   "Fit the growth exponent z of a mean cluster size S(t) ~ t^z "
+                                   "with a 95 % interval, the kernel exponent beta\n"
+                                   "whose full Smoluchowski solution grows with the same z over "
+                                   "the same S range, and a full-curve fit of\n"
+                                   "S(t) against S_c S_MF(t/tau_c; beta). Writes fit_beta.csv, "
+                                   "fit_curve.csv and fit_beta.json (docs/fit-beta.md).");
   c->add_option("INPUT", args->input,
-                "A `granagg analyze` output folder (S_t.csv, per_run/S_t.csv), an analysis.h5, or a CSV with a t column "
+                "A `granagg analyze` output folder (S_t.csv, per_run/S_t.csv), an analysis.h5, or "
+                "a CSV with a t column "
                 "and S column(s)")
       ->required();
   c->add_option("--column", args->column,
-                "S column (default: S_grid_mean, else S, else the only column besides t); a prefix (e.g. S_run) takes "
+                "S column (default: S_grid_mean, else S, else the only column besides t); a prefix "
+                "(e.g. S_run) takes "
                 "every matching column as one run");
-  c->add_option("--window", args->window, "Fit window T0 T1 for z (default: automatic, the late plateau of the local slope)")
+  c->add_option("--window", args->window,
+                "Fit window T0 T1 for z (default: automatic, the late plateau of the local slope)")
       ->expected(2);
-  c->add_option("--beta-min", args->beta_min, "Smallest beta considered (>= 1)")->capture_default_str();
-  c->add_option("--beta-max", args->beta_max, "Largest beta considered (<= 20)")->capture_default_str();
-  c->add_flag("--no-curve-fit", args->no_curve_fit, "Skip the full-curve fit (z and beta from z only)");
+  c->add_option("--beta-min", args->beta_min, "Smallest beta considered (>= 1)")
+      ->capture_default_str();
+  c->add_option("--beta-max", args->beta_max, "Largest beta considered (<= 20)")
+      ->capture_default_str();
+  c->add_flag("--no-curve-fit", args->no_curve_fit,
+              "Skip the full-curve fit (z and beta from z only)");
   c->add_option("-o,--out", args->out, "Output folder")->capture_default_str();
   c->add_flag("--force", args->force, "Overwrite existing output files");
   c->add_flag("-q,--quiet", args->quiet, "No summary on the terminal");

@@ -22,7 +22,8 @@ using common::formatReal;
 namespace {
 
 const char* const UNITS =
-    "Reduced units: diameter d = 1, mass m = 1, initial temperature T0 = 1; speeds in sqrt(T0/m), times in "
+    "Reduced units: diameter d = 1, mass m = 1, initial temperature T0 = 1; speeds in sqrt(T0/m), "
+    "times in "
     "sqrt(m d^2/T0).";
 
 void require(bool ok, const std::string& sentence) {
@@ -34,18 +35,23 @@ struct ContactArgs {
   double D = 27.7;
   bool unclamped = false;
   mf::ContactParams params() const {
-    require(E > 0.0 && std::isfinite(E), "--E must be positive and finite (got " + formatReal(E) + ").");
-    require(D >= 0.0 && std::isfinite(D), "--D must be non-negative and finite (got " + formatReal(D) + ").");
+    require(E > 0.0 && std::isfinite(E),
+            "--E must be positive and finite (got " + formatReal(E) + ").");
+    require(D >= 0.0 && std::isfinite(D),
+            "--D must be non-negative and finite (got " + formatReal(D) + ").");
     return mf::ContactParams{E, D, !unclamped};
   }
 };
 
 void addContactOptions(CLI::App* cmd, ContactArgs& c) {
-  cmd->add_option("--E", c.E, "Elastic constant E of F = E xi^{3/2} + D xi^{1/2} xi' (> 0, reduced units)")
+  cmd->add_option("--E", c.E,
+                  "Elastic constant E of F = E xi^{3/2} + D xi^{1/2} xi' (> 0, reduced units)")
       ->capture_default_str();
-  cmd->add_option("--D", c.D, "Dissipative constant D (>= 0, reduced units)")->capture_default_str();
+  cmd->add_option("--D", c.D, "Dissipative constant D (>= 0, reduced units)")
+      ->capture_default_str();
   cmd->add_flag("--unclamped", c.unclamped,
-                "Keep the attractive force at the end of a contact (default: clamp F at 0, a contact never pulls)");
+                "Keep the attractive force at the end of a contact (default: clamp F at 0, a "
+                "contact never pulls)");
 }
 
 struct OutArgs {
@@ -64,10 +70,13 @@ void checkPhi(double phi) {
 
 /// t = 0 followed by `points` log-spaced times from t_min to t_end.
 std::vector<double> outputTimes(double t_min, double t_end, int points) {
-  require(t_min > 0.0 && std::isfinite(t_min), "--t-min must be positive and finite (got " + formatReal(t_min) + ").");
+  require(t_min > 0.0 && std::isfinite(t_min),
+          "--t-min must be positive and finite (got " + formatReal(t_min) + ").");
   require(t_end > t_min && std::isfinite(t_end),
-          "--t-end must be finite and larger than --t-min = " + formatReal(t_min) + " (got " + formatReal(t_end) + ").");
-  require(points >= 2 && points <= 100000, "--points must lie in [2, 100000] (got " + std::to_string(points) + ").");
+          "--t-end must be finite and larger than --t-min = " + formatReal(t_min) + " (got " +
+              formatReal(t_end) + ").");
+  require(points >= 2 && points <= 100000,
+          "--points must lie in [2, 100000] (got " + std::to_string(points) + ").");
   std::vector<double> t{0.0};
   const double l0 = std::log10(t_min), l1 = std::log10(t_end);
   for (int k = 0; k < points; ++k) t.push_back(std::pow(10.0, l0 + (l1 - l0) * k / (points - 1.0)));
@@ -94,7 +103,9 @@ struct RestitutionArgs {
 void runRestitution(const RestitutionArgs& a, const CliContext& ctx) {
   const mf::ContactParams p = a.contact.params();
   require(!a.v.empty(), "--v needs at least one impact speed.");
-  for (double v : a.v) require(v > 0.0 && std::isfinite(v), "--v must be positive and finite (got " + formatReal(v) + ").");
+  for (double v : a.v)
+    require(v > 0.0 && std::isfinite(v),
+            "--v must be positive and finite (got " + formatReal(v) + ").");
   common::refuseToOverwrite(a.out.out == "-" ? std::string() : a.out.out, a.out.force);
   const mf::Restitution R(p);
 
@@ -104,19 +115,23 @@ void runRestitution(const RestitutionArgs& a, const CliContext& ctx) {
   common::Provenance prov(ctx.command_line);
   addContactProvenance(prov, p);
   prov.add("tolerance", R.options().tolerance);
-  prov.add("columns",
-           std::string("v: impact speed; e = -xi'(end)/v; contact_time: xi > 0 duration; release_time: clamped force "
-                       "reaches 0 (= contact_time unclamped); max_overlap in d; b = D m_eff^-0.4 E^-0.6 v^0.2 (e depends "
-                       "on b only); e_series = 1 - C1 b + C2 b^2 where b < ") +
-               formatReal(SERIES_B_MAX) + ", else nan; elastic_contact_time = 3.218065 (m_eff^2/(E^2 v))^0.2");
+  prov.add("columns", std::string("v: impact speed; e = -xi'(end)/v; contact_time: xi > 0 "
+                                  "duration; release_time: clamped force "
+                                  "reaches 0 (= contact_time unclamped); max_overlap in d; b = D "
+                                  "m_eff^-0.4 E^-0.6 v^0.2 (e depends "
+                                  "on b only); e_series = 1 - C1 b + C2 b^2 where b < ") +
+                          formatReal(SERIES_B_MAX) +
+                          ", else nan; elastic_contact_time = 3.218065 (m_eff^2/(E^2 v))^0.2");
   common::CsvWriter w(a.out.out, prov,
-                      {"v", "e", "contact_time", "release_time", "max_overlap", "b", "e_series", "elastic_contact_time"},
+                      {"v", "e", "contact_time", "release_time", "max_overlap", "b", "e_series",
+                       "elastic_contact_time"},
                       a.out.force);
   for (double v : a.v) {
     const mf::CollisionResult r = R.collide(v);
-    const double series = r.scaling_parameter < SERIES_B_MAX ? R.seriesRestitution(v) : std::nan("");
-    w.row({v, r.restitution, r.contact_time, r.release_time, r.max_overlap, r.scaling_parameter, series,
-           R.elasticContactTime(v)});
+    const double series =
+        r.scaling_parameter < SERIES_B_MAX ? R.seriesRestitution(v) : std::nan("");
+    w.row({v, r.restitution, r.contact_time, r.release_time, r.max_overlap, r.scaling_parameter,
+           series, R.elasticContactTime(v)});
   }
   w.close();
 }
@@ -133,9 +148,11 @@ struct HaffArgs {
 };
 
 void runHaff(const HaffArgs& a, const CliContext& ctx) {
-  require(a.eps >= 0.0 && a.eps <= 1.0, "--eps must lie in [0, 1] (got " + formatReal(a.eps) + ").");
+  require(a.eps >= 0.0 && a.eps <= 1.0,
+          "--eps must lie in [0, 1] (got " + formatReal(a.eps) + ").");
   checkPhi(a.phi);
-  require(a.T0 > 0.0 && std::isfinite(a.T0), "--T0 must be positive and finite (got " + formatReal(a.T0) + ").");
+  require(a.T0 > 0.0 && std::isfinite(a.T0),
+          "--T0 must be positive and finite (got " + formatReal(a.T0) + ").");
   const auto times = outputTimes(a.t_min, a.t_end, a.points);
   common::refuseToOverwrite(a.out.out == "-" ? std::string() : a.out.out, a.out.force);
   const double inv_tau0 = mf::haffInverseTau0(a.eps, a.phi, a.T0);
@@ -146,7 +163,8 @@ void runHaff(const HaffArgs& a, const CliContext& ctx) {
   prov.add("T0", a.T0);
   prov.add("omega0", mf::enskogCollisionFrequency(a.phi, a.T0));
   prov.add("tau0", inv_tau0 > 0.0 ? 1.0 / inv_tau0 : std::numeric_limits<double>::infinity());
-  prov.add("law", std::string("T = T0 / (1 + t/tau0)^2, 1/tau0 = (1 - eps^2) omega0 / 6 (Haff 1983)"));
+  prov.add("law",
+           std::string("T = T0 / (1 + t/tau0)^2, 1/tau0 = (1 - eps^2) omega0 / 6 (Haff 1983)"));
   prov.add("units", std::string(UNITS));
   prov.add("columns", std::string("t: time; T: granular temperature; slope = d ln T / d ln t"));
   common::CsvWriter w(a.out.out, prov, {"t", "T", "slope"}, a.out.force);
@@ -169,7 +187,8 @@ struct CoolingArgs {
 
 void runCooling(const CoolingArgs& a, const CliContext& ctx) {
   const mf::ContactParams p = a.contact.params();
-  require(p.D > 0.0, "--D must be positive for viscoelastic cooling (got 0: the gas does not cool).");
+  require(p.D > 0.0,
+          "--D must be positive for viscoelastic cooling (got 0: the gas does not cool).");
   checkPhi(a.phi);
   const auto times = outputTimes(a.t_min, a.t_end, a.points);
   common::refuseToOverwrite(a.out.out == "-" ? std::string() : a.out.out, a.out.force);
@@ -187,20 +206,27 @@ void runCooling(const CoolingArgs& a, const CliContext& ctx) {
   prov.add("phi", a.phi);
   prov.add("T0", o.T0);
   prov.add("omega0", mf::enskogCollisionFrequency(a.phi, o.T0));
-  prov.add("ode", std::string("dT/dt = -(omega(T)/12) <g^2 (1 - e(g)^2)>, P(g) = g/(2T) exp(-g^2/(4T)), Maxwellian"));
+  prov.add(
+      "ode",
+      std::string(
+          "dT/dt = -(omega(T)/12) <g^2 (1 - e(g)^2)>, P(g) = g/(2T) exp(-g^2/(4T)), Maxwellian"));
   prov.add("rtol", o.rtol);
   prov.add("eps_same_initial_rate", eps_eff);
   prov.add("tau0_small_damping", tau);
-  prov.add("columns",
-           std::string("t; T: viscoelastic cooling ODE; slope = d ln T/d ln t; loss = <g^2(1-e^2)>/<g^2>; T_haff: Haff's "
-                       "law with eps_same_initial_rate; T_asymptote = T0 (t/tau0)^(-5/3), the exact late-time limit; "
-                       "T_small_damping = T0 (1 + t/tau0)^(-5/3), first order in the damping (not valid when loss is not "
-                       "small)"));
-  common::CsvWriter w(a.out.out, prov, {"t", "T", "slope", "loss", "T_haff", "T_asymptote", "T_small_damping"},
+  prov.add("columns", std::string("t; T: viscoelastic cooling ODE; slope = d ln T/d ln t; loss = "
+                                  "<g^2(1-e^2)>/<g^2>; T_haff: Haff's "
+                                  "law with eps_same_initial_rate; T_asymptote = T0 "
+                                  "(t/tau0)^(-5/3), the exact late-time limit; "
+                                  "T_small_damping = T0 (1 + t/tau0)^(-5/3), first order in the "
+                                  "damping (not valid when loss is not "
+                                  "small)"));
+  common::CsvWriter w(a.out.out, prov,
+                      {"t", "T", "slope", "loss", "T_haff", "T_asymptote", "T_small_damping"},
                       a.out.force);
   for (const auto& s : r) {
     w.row({s.t, s.T, s.slope, s.loss, mf::haffTemperature(s.t, eps_eff, a.phi, o.T0),
-           s.t > 0.0 ? o.T0 * std::pow(s.t / tau, -5.0 / 3.0) : std::numeric_limits<double>::infinity(),
+           s.t > 0.0 ? o.T0 * std::pow(s.t / tau, -5.0 / 3.0)
+                     : std::numeric_limits<double>::infinity(),
            mf::viscoelasticCoolingTemperature(s.t, p, a.phi, o.T0)});
   }
   w.close();
@@ -215,16 +241,20 @@ struct EnskogArgs {
 
 void runEnskog(const EnskogArgs& a, const CliContext& ctx) {
   checkPhi(a.phi);
-  require(a.T >= 0.0 && std::isfinite(a.T), "--T must be non-negative and finite (got " + formatReal(a.T) + ").");
+  require(a.T >= 0.0 && std::isfinite(a.T),
+          "--T must be non-negative and finite (got " + formatReal(a.T) + ").");
   common::refuseToOverwrite(a.out.out == "-" ? std::string() : a.out.out, a.out.force);
   common::Provenance prov(ctx.command_line);
   prov.add("phi", a.phi);
   prov.add("T", a.T);
   prov.add("units", std::string(UNITS));
-  prov.add("columns", std::string("n = 6 phi/pi (d^-3); g2 = (1 - phi/2)/(1 - phi)^3 (Carnahan-Starling); "
-                                  "omega = 4 sqrt(pi) n g2 sqrt(T/m): Enskog collision frequency per particle"));
+  prov.add(
+      "columns",
+      std::string("n = 6 phi/pi (d^-3); g2 = (1 - phi/2)/(1 - phi)^3 (Carnahan-Starling); "
+                  "omega = 4 sqrt(pi) n g2 sqrt(T/m): Enskog collision frequency per particle"));
   common::CsvWriter w(a.out.out, prov, {"phi", "T", "n", "g2", "omega"}, a.out.force);
-  w.row({a.phi, a.T, mf::numberDensity(a.phi), mf::carnahanStarlingG2(a.phi), mf::enskogCollisionFrequency(a.phi, a.T)});
+  w.row({a.phi, a.T, mf::numberDensity(a.phi), mf::carnahanStarlingG2(a.phi),
+         mf::enskogCollisionFrequency(a.phi, a.T)});
   w.close();
 }
 
@@ -236,15 +266,19 @@ struct ChargingArgs {
 };
 
 void runCharging(const ChargingArgs& c, const CliContext& ctx) {
-  require(c.kappa >= 0.0 && std::isfinite(c.kappa), "--kappa must be non-negative and finite (got " + formatReal(c.kappa) + ").");
-  require(c.a > 0.0 && std::isfinite(c.a), "--cooling-exponent must be positive and finite (got " + formatReal(c.a) + ").");
+  require(c.kappa >= 0.0 && std::isfinite(c.kappa),
+          "--kappa must be non-negative and finite (got " + formatReal(c.kappa) + ").");
+  require(c.a > 0.0 && std::isfinite(c.a),
+          "--cooling-exponent must be positive and finite (got " + formatReal(c.a) + ").");
   common::refuseToOverwrite(c.out.out == "-" ? std::string() : c.out.out, c.out.force);
   common::Provenance prov(ctx.command_line);
   prov.add("kappa", c.kappa);
   prov.add("cooling_exponent", c.a);
-  prov.add("law", std::string("d<|q|>/dt ~ T^(1/2) T^kappa with T ~ t^-a: exponent = -a (1/2 + kappa) "
-                              "(design.md section 2; -13/6 at kappa = 0.8, a = 5/3)"));
-  common::CsvWriter w(c.out.out, prov, {"kappa", "cooling_exponent", "charging_rate_exponent"}, c.out.force);
+  prov.add("law",
+           std::string("d<|q|>/dt ~ T^(1/2) T^kappa with T ~ t^-a: exponent = -a (1/2 + kappa) "
+                       "(design.md section 2; -13/6 at kappa = 0.8, a = 5/3)"));
+  common::CsvWriter w(c.out.out, prov, {"kappa", "cooling_exponent", "charging_rate_exponent"},
+                      c.out.force);
   w.row({c.kappa, c.a, mf::chargingRateExponent(c.kappa, c.a)});
   w.close();
 }
@@ -253,18 +287,20 @@ void runCharging(const ChargingArgs& c, const CliContext& ctx) {
 
 void registerKineticCommand(CLI::App& app, const CliContext& ctx) {
   CLI::App* kin = app.add_subcommand(
-      "kinetic",
-      std::string("Kinetic-theory references: viscoelastic restitution e(v), Haff's law, viscoelastic cooling, Enskog "
-                  "collision frequency, charging-rate exponent. ") +
-          UNITS);
+      "kinetic", std::string("Kinetic-theory references: viscoelastic restitution e(v), Haff's "
+                             "law, viscoelastic cooling, Enskog "
+                             "collision frequency, charging-rate exponent. ") +
+                     UNITS);
   kin->require_subcommand(1);
 
   auto ra = std::make_shared<RestitutionArgs>();
   CLI::App* rest = kin->add_subcommand(
       "restitution",
-      "Restitution coefficient e(v) and contact time of two viscoelastic spheres (m_eff = 1/2) by integrating "
+      "Restitution coefficient e(v) and contact time of two viscoelastic spheres (m_eff = 1/2) by "
+      "integrating "
       "m_eff xi'' = -(E xi^{3/2} + D xi^{1/2} xi') from xi = 0, xi' = v until xi = 0 again.");
-  rest->add_option("--v", ra->v, "Impact speeds (normal relative speed, sqrt(T0/m), > 0), comma separated")
+  rest->add_option("--v", ra->v,
+                   "Impact speeds (normal relative speed, sqrt(T0/m), > 0), comma separated")
       ->delimiter(',')
       ->capture_default_str();
   addContactOptions(rest, ra->contact);
@@ -272,46 +308,57 @@ void registerKineticCommand(CLI::App& app, const CliContext& ctx) {
   rest->callback([ra, ctx]() { runRestitution(*ra, ctx); });
 
   auto ha = std::make_shared<HaffArgs>();
-  CLI::App* haff = kin->add_subcommand(
-      "haff", "Haff's law T(t) = T0/(1 + t/tau0)^2, 1/tau0 = (1 - eps^2) omega0/6, for constant restitution eps.");
-  haff->add_option("--eps", ha->eps, "Constant restitution coefficient, in [0, 1]")->capture_default_str();
+  CLI::App* haff = kin->add_subcommand("haff",
+                                       "Haff's law T(t) = T0/(1 + t/tau0)^2, 1/tau0 = (1 - eps^2) "
+                                       "omega0/6, for constant restitution eps.");
+  haff->add_option("--eps", ha->eps, "Constant restitution coefficient, in [0, 1]")
+      ->capture_default_str();
   haff->add_option("--phi", ha->phi, "Filling fraction, in (0, 0.74)")->capture_default_str();
   haff->add_option("--T0", ha->T0, "Initial temperature (units T0, > 0)")->capture_default_str();
-  haff->add_option("--t-min", ha->t_min, "First log-spaced output time after t = 0 (> 0)")->capture_default_str();
+  haff->add_option("--t-min", ha->t_min, "First log-spaced output time after t = 0 (> 0)")
+      ->capture_default_str();
   haff->add_option("--t-end", ha->t_end, "Last output time (> t-min)")->capture_default_str();
-  haff->add_option("--points", ha->points, "Number of log-spaced output times (>= 2)")->capture_default_str();
+  haff->add_option("--points", ha->points, "Number of log-spaced output times (>= 2)")
+      ->capture_default_str();
   addOutOptions(haff, ha->out);
   haff->callback([ha, ctx]() { runHaff(*ha, ctx); });
 
   auto ca = std::make_shared<CoolingArgs>();
   CLI::App* cool = kin->add_subcommand(
       "cooling",
-      "Homogeneous cooling with the viscoelastic e(g): dT/dt = -(omega(T)/12) <g^2 (1 - e(g)^2)> over a Maxwellian "
+      "Homogeneous cooling with the viscoelastic e(g): dT/dt = -(omega(T)/12) <g^2 (1 - e(g)^2)> "
+      "over a Maxwellian "
       "(T0 = 1), beside Haff's law with the same initial rate and the t^{-5/3} asymptote.");
   addContactOptions(cool, ca->contact);
   cool->add_option("--phi", ca->phi, "Filling fraction, in (0, 0.74)")->capture_default_str();
-  cool->add_option("--t-min", ca->t_min, "First log-spaced output time after t = 0 (> 0)")->capture_default_str();
-  cool->add_option("--t-end", ca->t_end, "Last output time (> t-min); the t^{-5/3} regime needs t >> 1e6")
+  cool->add_option("--t-min", ca->t_min, "First log-spaced output time after t = 0 (> 0)")
       ->capture_default_str();
-  cool->add_option("--points", ca->points, "Number of log-spaced output times (>= 2)")->capture_default_str();
+  cool->add_option("--t-end", ca->t_end,
+                   "Last output time (> t-min); the t^{-5/3} regime needs t >> 1e6")
+      ->capture_default_str();
+  cool->add_option("--points", ca->points, "Number of log-spaced output times (>= 2)")
+      ->capture_default_str();
   addOutOptions(cool, ca->out);
   cool->callback([ca, ctx]() { runCooling(*ca, ctx); });
 
   auto ea = std::make_shared<EnskogArgs>();
-  CLI::App* ensk = kin->add_subcommand(
-      "enskog", "Number density n, Carnahan-Starling g2 and Enskog collision frequency omega = 4 sqrt(pi) n g2 sqrt(T/m).");
+  CLI::App* ensk = kin->add_subcommand("enskog",
+                                       "Number density n, Carnahan-Starling g2 and Enskog "
+                                       "collision frequency omega = 4 sqrt(pi) n g2 sqrt(T/m).");
   ensk->add_option("--phi", ea->phi, "Filling fraction, in (0, 0.74)")->capture_default_str();
   ensk->add_option("--T", ea->T, "Granular temperature (units T0, >= 0)")->capture_default_str();
   addOutOptions(ensk, ea->out);
   ensk->callback([ea, ctx]() { runEnskog(*ea, ctx); });
 
   auto cha = std::make_shared<ChargingArgs>();
-  CLI::App* chg = kin->add_subcommand(
-      "charging",
-      "Time exponent of the charging rate d<|q|>/dt ~ T^{1/2} T^kappa ~ t^{-a(1/2 + kappa)} for T ~ t^{-a}.");
-  chg->add_option("--kappa", cha->kappa, "Charging exponent kappa (>= 0; 0.83 for silica, Poppe et al. 2000)")
+  CLI::App* chg = kin->add_subcommand("charging",
+                                      "Time exponent of the charging rate d<|q|>/dt ~ T^{1/2} "
+                                      "T^kappa ~ t^{-a(1/2 + kappa)} for T ~ t^{-a}.");
+  chg->add_option("--kappa", cha->kappa,
+                  "Charging exponent kappa (>= 0; 0.83 for silica, Poppe et al. 2000)")
       ->capture_default_str();
-  chg->add_option("--cooling-exponent", cha->a, "a in T ~ t^{-a} (> 0; 5/3 viscoelastic, 2 Haff)")->capture_default_str();
+  chg->add_option("--cooling-exponent", cha->a, "a in T ~ t^{-a} (> 0; 5/3 viscoelastic, 2 Haff)")
+      ->capture_default_str();
   addOutOptions(chg, cha->out);
   chg->callback([cha, ctx]() { runCharging(*cha, ctx); });
 }

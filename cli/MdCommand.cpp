@@ -41,8 +41,11 @@ struct MdArgs {
 class ProgressReporter : public md::Reporter {
  public:
   explicit ProgressReporter(const md::Simulation& sim)
-      : m_on(::isatty(2)), m_t_end(sim.config().run.t_end), m_first_step(sim.engine().step()),
-        m_start(Clock::now()), m_last(m_start) {}
+      : m_on(::isatty(2)),
+        m_t_end(sim.config().run.t_end),
+        m_first_step(sim.engine().step()),
+        m_start(Clock::now()),
+        m_last(m_start) {}
   void report(const md::Simulation& sim) override {
     if (!m_on) return;
     const auto now = Clock::now();
@@ -53,8 +56,8 @@ class ProgressReporter : public md::Reporter {
     const double rate = (e.step() - m_first_step) / std::max(el, 1e-9);
     const double frac = e.time() / m_t_end;
     const double eta = frac > 0 ? el * (1 - frac) / frac : 0.0;
-    std::fprintf(stderr, "\rmd: t = %.4g / %.4g  T_g = %.4g  %.3g steps/s  ETA %.0f s   ",
-                 e.time(), m_t_end, sim.lastObservables().temperature, rate, eta);
+    std::fprintf(stderr, "\rmd: t = %.4g / %.4g  T_g = %.4g  %.3g steps/s  ETA %.0f s   ", e.time(),
+                 m_t_end, sim.lastObservables().temperature, rate, eta);
     std::fflush(stderr);
     m_printed = true;
   }
@@ -101,10 +104,11 @@ void printStart(const md::Simulation& sim) {
     const std::string mesh = cs->method == "pppm" ? "mesh " + std::to_string(cs->mesh) +
                                                         "^3, order " + std::to_string(cs->order)
                                                   : "k_max " + std::to_string(cs->k_max);
-    std::printf("md: Coulomb K = %g, %s: alpha = %.6g, r_cut = %.6g, %s; estimated relative "
-                "force error %.2g (for sum q^2 = %.4g)\n",
-                cfg.coulomb.K, cs->method.c_str(), cs->alpha, cs->r_cut, mesh.c_str(),
-                cs->estimated_error, cs->sum_q2_design);
+    std::printf(
+        "md: Coulomb K = %g, %s: alpha = %.6g, r_cut = %.6g, %s; estimated relative "
+        "force error %.2g (for sum q^2 = %.4g)\n",
+        cfg.coulomb.K, cs->method.c_str(), cs->alpha, cs->r_cut, mesh.c_str(), cs->estimated_error,
+        cs->sum_q2_design);
     if (cs->r_fast > 0.0)
       std::printf(
           "md: multiple time stepping: slow Coulomb part every %d steps%s; pair force within "
@@ -124,24 +128,27 @@ void printStart(const md::Simulation& sim) {
 void printSummary(const md::Simulation& sim, const md::RunSummary& s) {
   const md::Engine& e = sim.engine();
   const md::Observables o = e.observables();
-  std::printf("md: %lld steps in %.4g s (%.3g particle-steps/s incl. output); neighbour list "
-              "rebuilt %lld times (every %.3g steps)\n",
-              static_cast<long long>(s.steps), s.loop_seconds,
-              s.loop_seconds > 0 ? static_cast<double>(s.steps) * e.size() / s.loop_seconds : 0.0,
-              static_cast<long long>(s.neighbor_builds),
-              s.neighbor_builds > 0 ? static_cast<double>(s.steps) / s.neighbor_builds : 0.0);
-  std::printf("md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max "
-              "overlap %.3g\n",
-              o.time, o.temperature, static_cast<long long>(o.collisions),
-              o.contacts_per_particle, o.max_overlap);
+  std::printf(
+      "md: %lld steps in %.4g s (%.3g particle-steps/s incl. output); neighbour list "
+      "rebuilt %lld times (every %.3g steps)\n",
+      static_cast<long long>(s.steps), s.loop_seconds,
+      s.loop_seconds > 0 ? static_cast<double>(s.steps) * e.size() / s.loop_seconds : 0.0,
+      static_cast<long long>(s.neighbor_builds),
+      s.neighbor_builds > 0 ? static_cast<double>(s.steps) / s.neighbor_builds : 0.0);
+  std::printf(
+      "md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max "
+      "overlap %.3g\n",
+      o.time, o.temperature, static_cast<long long>(o.collisions), o.contacts_per_particle,
+      o.max_overlap);
   if (const md::CoulombSetup* cs = e.coulombSetup(); cs && cs->r_fast > 0.0)
-    std::printf("md: slow Coulomb part evaluated %lld times (every %.3g steps on average; "
-                "interval now %d steps)\n",
-                static_cast<long long>(s.slow_evaluations),
-                s.slow_evaluations > 0 ? static_cast<double>(s.steps) / s.slow_evaluations : 0.0,
-                e.slowInterval());
-  std::printf("md: wrote %s (%zu frames), %s\n", sim.trajectoryPath().c_str(),
-              sim.framesWritten(), sim.checkpointPath().c_str());
+    std::printf(
+        "md: slow Coulomb part evaluated %lld times (every %.3g steps on average; "
+        "interval now %d steps)\n",
+        static_cast<long long>(s.slow_evaluations),
+        s.slow_evaluations > 0 ? static_cast<double>(s.steps) / s.slow_evaluations : 0.0,
+        e.slowInterval());
+  std::printf("md: wrote %s (%zu frames), %s\n", sim.trajectoryPath().c_str(), sim.framesWritten(),
+              sim.checkpointPath().c_str());
 }
 
 void runMd(const MdArgs& a, const CliContext& ctx) {
@@ -154,8 +161,9 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   std::optional<md::Simulation> sim;
   if (!a.restart.empty()) {
     if (!a.config.empty() || !a.preset.empty() || a.seed >= 0)
-      throw std::invalid_argument("--restart continues a run with its own configuration: do not "
-                                  "combine it with --config, --preset or --seed.");
+      throw std::invalid_argument(
+          "--restart continues a run with its own configuration: do not "
+          "combine it with --config, --preset or --seed.");
     sim.emplace(md::Simulation::resume(a.restart, a.set, options));
   } else {
     if (a.config.empty() == a.preset.empty())
@@ -182,14 +190,18 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
 void registerMdCommand(CLI::App& app, const CliContext& ctx) {
   auto a = std::make_shared<MdArgs>();
   CLI::App* md = app.add_subcommand(
-      "md", "Run the MD engine (viscoelastic or spring-dashpot granular gas) and write an H5MD trajectory,\n"
-            "observables and a checkpoint into an output folder. Reduced units d = m = T0 = 1.");
+      "md",
+      "Run the MD engine (viscoelastic or spring-dashpot granular gas) and write an H5MD "
+      "trajectory,\n"
+      "observables and a checkpoint into an output folder. Reduced units d = m = T0 = 1.");
   md->add_option("-c,--config", a->config, "TOML configuration (keys: docs/config.md)");
   md->add_option("--preset", a->preset, "Preset from data/presets: quick, paper, haff");
   md->add_option("--set", a->set, "Override a key, e.g. --set system.N=5000 (repeatable)");
-  md->add_option("-o,--out", a->out, "Output folder (default md-out); must not exist or be empty unless --force");
+  md->add_option("-o,--out", a->out,
+                 "Output folder (default md-out); must not exist or be empty unless --force");
   md->add_option("--restart", a->restart,
-                 "Continue the run whose output folder (with checkpoint.h5) is given; --set run.t_end=T runs it further");
+                 "Continue the run whose output folder (with checkpoint.h5) is given; --set "
+                 "run.t_end=T runs it further");
   md->add_option("--seed", a->seed, "Random seed (overrides system.seed)");
   md->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)");
   md->add_flag("--force", a->force, "Overwrite an existing output folder");

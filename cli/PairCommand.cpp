@@ -100,7 +100,8 @@ PairConfig parsePairConfig(const std::string& path) {
   try {
     doc = toml::parse_file(path);
   } catch (const toml::parse_error& e) {
-    throw std::invalid_argument(where(e.source(), path) + ": invalid TOML: " + std::string(e.description()));
+    throw std::invalid_argument(where(e.source(), path) +
+                                ": invalid TOML: " + std::string(e.description()));
   }
   PairConfig c;
   c.source = fs::absolute(path).string();
@@ -135,20 +136,26 @@ PairConfig parsePairConfig(const std::string& path) {
   auto number = [&](const char* sec, const char* key, double& out) {
     const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
     if (!n) return;
-    if (auto v = n->value<double>()) out = *v;
-    else fail(*n, std::string(sec) + "." + key + " must be a number");
+    if (auto v = n->value<double>())
+      out = *v;
+    else
+      fail(*n, std::string(sec) + "." + key + " must be a number");
   };
   auto integer = [&](const char* sec, const char* key, long long& out) {
     const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
     if (!n) return;
-    if (auto v = n->as_integer()) out = v->get();
-    else fail(*n, std::string(sec) + "." + key + " must be an integer");
+    if (auto v = n->as_integer())
+      out = v->get();
+    else
+      fail(*n, std::string(sec) + "." + key + " must be an integer");
   };
   auto string = [&](const char* sec, const char* key, std::string& out) {
     const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
     if (!n) return;
-    if (auto v = n->as_string()) out = v->get();
-    else fail(*n, std::string(sec) + "." + key + " must be a string");
+    if (auto v = n->as_string())
+      out = v->get();
+    else
+      fail(*n, std::string(sec) + "." + key + " must be a string");
   };
   auto strings = [&](const char* sec, const char* key, std::vector<std::string>& out) {
     const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
@@ -157,8 +164,10 @@ PairConfig parsePairConfig(const std::string& path) {
     if (!a) fail(*n, std::string(sec) + "." + key + " must be an array of strings");
     out.clear();
     for (const auto& e : *a) {
-      if (auto v = e.as_string()) out.push_back(v->get());
-      else fail(e, std::string(sec) + "." + key + " must hold strings only");
+      if (auto v = e.as_string())
+        out.push_back(v->get());
+      else
+        fail(e, std::string(sec) + "." + key + " must hold strings only");
     }
   };
   auto numbers = [&](const char* sec, const char* key, std::vector<double>& out) {
@@ -168,13 +177,17 @@ PairConfig parsePairConfig(const std::string& path) {
     if (!a) fail(*n, std::string(sec) + "." + key + " must be an array of numbers");
     out.clear();
     for (const auto& e : *a) {
-      if (auto v = e.value<double>()) out.push_back(*v);
-      else fail(e, std::string(sec) + "." + key + " must hold numbers only");
+      if (auto v = e.value<double>())
+        out.push_back(*v);
+      else
+        fail(e, std::string(sec) + "." + key + " must hold numbers only");
     }
   };
   long long version = 1, runs = c.runs, zcount = c.zbeta_count;
   integer("input", "version", version);
-  if (version != 1) throw std::invalid_argument(path + ": [input] version = " + std::to_string(version) + " is not supported (only 1)");
+  if (version != 1)
+    throw std::invalid_argument(path + ": [input] version = " + std::to_string(version) +
+                                " is not supported (only 1)");
   string("pair", "name", c.name);
   numbers("pair", "K", c.K);
   integer("pair", "runs", runs);
@@ -196,7 +209,8 @@ PairConfig parsePairConfig(const std::string& path) {
   c.runs = static_cast<int>(std::clamp<long long>(runs, -1, 1000000));
   c.zbeta_count = static_cast<int>(std::clamp<long long>(zcount, -1, 100000));
   if (c.md_preset.empty() == c.md_config.empty())
-    throw std::invalid_argument(path + ": [md] needs exactly one of preset = \"name\" or config = \"file.toml\"");
+    throw std::invalid_argument(
+        path + ": [md] needs exactly one of preset = \"name\" or config = \"file.toml\"");
   if (!c.md_config.empty() && fs::path(c.md_config).is_relative())
     c.md_config = (fs::path(c.source).parent_path() / c.md_config).lexically_normal().string();
   return c;
@@ -227,16 +241,23 @@ std::string realToml(double x) {
 /// The resolved configuration as TOML (DIR/config/pair.toml): what resume and batch jobs read.
 std::string toToml(const PairConfig& c) {
   std::ostringstream o;
-  o << "# granagg pair configuration, resolved from " << c.source << " and the command line (docs/pair.md)\n"
-    << "[input]\nversion = 1\n\n[pair]\nname = " << tomlString(c.name) << "\nK = " << tomlArray(c.K, realToml)
-    << "\nruns = " << c.runs << "\nseed = " << c.seed << "\n\n[md]\n"
-    << (c.md_preset.empty() ? "config = " + tomlString(c.md_config) : "preset = " + tomlString(c.md_preset))
-    << "\nset = " << tomlArray(c.md_set, tomlString) << "\n\n[charged]\nQ = " << realToml(c.charged_Q)
-    << "\nset = " << tomlArray(c.charged_set, tomlString) << "\n\n[analysis]\nargs = " << tomlArray(c.analysis_args, tomlString)
-    << "\n\n[meanfield]\nbeta = " << tomlArray(c.betas, realToml) << "\nt_end = " << realToml(c.mf_t_end)
-    << "\ns_end = " << realToml(c.mf_s_end) << "\nzbeta_min = " << realToml(c.zbeta_min)
-    << "\nzbeta_max = " << realToml(c.zbeta_max) << "\nzbeta_count = " << c.zbeta_count << "\n\n[fit]\nwindow = "
-    << tomlArray(c.fit_window, realToml) << "\ncolumn = " << tomlString(c.fit_column) << "\n";
+  o << "# granagg pair configuration, resolved from " << c.source
+    << " and the command line (docs/pair.md)\n"
+    << "[input]\nversion = 1\n\n[pair]\nname = " << tomlString(c.name)
+    << "\nK = " << tomlArray(c.K, realToml) << "\nruns = " << c.runs << "\nseed = " << c.seed
+    << "\n\n[md]\n"
+    << (c.md_preset.empty() ? "config = " + tomlString(c.md_config)
+                            : "preset = " + tomlString(c.md_preset))
+    << "\nset = " << tomlArray(c.md_set, tomlString)
+    << "\n\n[charged]\nQ = " << realToml(c.charged_Q)
+    << "\nset = " << tomlArray(c.charged_set, tomlString)
+    << "\n\n[analysis]\nargs = " << tomlArray(c.analysis_args, tomlString)
+    << "\n\n[meanfield]\nbeta = " << tomlArray(c.betas, realToml)
+    << "\nt_end = " << realToml(c.mf_t_end) << "\ns_end = " << realToml(c.mf_s_end)
+    << "\nzbeta_min = " << realToml(c.zbeta_min) << "\nzbeta_max = " << realToml(c.zbeta_max)
+    << "\nzbeta_count = " << c.zbeta_count
+    << "\n\n[fit]\nwindow = " << tomlArray(c.fit_window, realToml)
+    << "\ncolumn = " << tomlString(c.fit_column) << "\n";
   return o.str();
 }
 
@@ -248,31 +269,46 @@ std::vector<double> parseKList(const std::string& s) {
     char* end = nullptr;
     const double k = std::strtod(item.c_str(), &end);
     if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(k) || k < 0)
-      throw std::invalid_argument("--K takes comma-separated Coulomb constants >= 0, e.g. --K 0,5 (got '" + s + "')");
+      throw std::invalid_argument(
+          "--K takes comma-separated Coulomb constants >= 0, e.g. --K 0,5 (got '" + s + "')");
     K.push_back(k);
   }
-  if (K.empty()) throw std::invalid_argument("--K takes comma-separated Coulomb constants >= 0, e.g. --K 0,5 (got '" + s + "')");
+  if (K.empty())
+    throw std::invalid_argument(
+        "--K takes comma-separated Coulomb constants >= 0, e.g. --K 0,5 (got '" + s + "')");
   return K;
 }
 
 void validate(const PairConfig& c) {
   const std::string src = c.source + ": ";
-  if (c.K.empty()) throw std::invalid_argument(src + "pair.K must list at least one Coulomb constant");
+  if (c.K.empty())
+    throw std::invalid_argument(src + "pair.K must list at least one Coulomb constant");
   std::set<std::string> seen;
   for (double k : c.K) {
-    if (!(k >= 0) || !std::isfinite(k)) throw std::invalid_argument("K = " + formatReal(k) + " is invalid: Coulomb constants must be >= 0 (--K, pair.K)");
-    if (!seen.insert(formatReal(k)).second) throw std::invalid_argument("K = " + formatReal(k) + " is listed twice (--K, pair.K)");
+    if (!(k >= 0) || !std::isfinite(k))
+      throw std::invalid_argument("K = " + formatReal(k) +
+                                  " is invalid: Coulomb constants must be >= 0 (--K, pair.K)");
+    if (!seen.insert(formatReal(k)).second)
+      throw std::invalid_argument("K = " + formatReal(k) + " is listed twice (--K, pair.K)");
   }
-  if (c.runs < 1) throw std::invalid_argument("--runs must be >= 1 (got " + std::to_string(c.runs) + ")");
+  if (c.runs < 1)
+    throw std::invalid_argument("--runs must be >= 1 (got " + std::to_string(c.runs) + ")");
   if (c.seed < 0) throw std::invalid_argument(src + "pair.seed must be >= 0");
-  if (!(c.charged_Q > 0) || !std::isfinite(c.charged_Q)) throw std::invalid_argument(src + "charged.Q must be > 0");
-  if (c.betas.empty()) throw std::invalid_argument(src + "meanfield.beta must list at least one beta");
+  if (!(c.charged_Q > 0) || !std::isfinite(c.charged_Q))
+    throw std::invalid_argument(src + "charged.Q must be > 0");
+  if (c.betas.empty())
+    throw std::invalid_argument(src + "meanfield.beta must list at least one beta");
   for (double b : c.betas)
-    if (!(b > 0)) throw std::invalid_argument(src + "meanfield.beta = " + formatReal(b) + " is invalid: must be > 0");
-  if (!(c.mf_t_end > 0) || !(c.mf_s_end > 1)) throw std::invalid_argument(src + "meanfield.t_end must be > 0 and s_end > 1");
+    if (!(b > 0))
+      throw std::invalid_argument(src + "meanfield.beta = " + formatReal(b) +
+                                  " is invalid: must be > 0");
+  if (!(c.mf_t_end > 0) || !(c.mf_s_end > 1))
+    throw std::invalid_argument(src + "meanfield.t_end must be > 0 and s_end > 1");
   if (!(c.zbeta_min > 0) || !(c.zbeta_max >= c.zbeta_min) || c.zbeta_count < 1)
-    throw std::invalid_argument(src + "meanfield.zbeta_min/zbeta_max/zbeta_count must satisfy 0 < min <= max, count >= 1");
-  if (!c.fit_window.empty() && (c.fit_window.size() != 2 || !(c.fit_window[1] > c.fit_window[0]) || !(c.fit_window[0] >= 0)))
+    throw std::invalid_argument(
+        src + "meanfield.zbeta_min/zbeta_max/zbeta_count must satisfy 0 < min <= max, count >= 1");
+  if (!c.fit_window.empty() &&
+      (c.fit_window.size() != 2 || !(c.fit_window[1] > c.fit_window[0]) || !(c.fit_window[0] >= 0)))
     throw std::invalid_argument(src + "fit.window must be [] or [T0, T1] with 0 <= T0 < T1");
 }
 
@@ -319,10 +355,18 @@ std::string jsonString(const std::string& s) {
   std::string o = "\"";
   for (char ch : s) {
     switch (ch) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\t': o += "\\t"; break;
+      case '"':
+        o += "\\\"";
+        break;
+      case '\\':
+        o += "\\\\";
+        break;
+      case '\n':
+        o += "\\n";
+        break;
+      case '\t':
+        o += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(ch) < 0x20) {
           char b[8];
@@ -347,7 +391,9 @@ double jsonValue(const std::string& text, const std::string& key, std::size_t in
     while (p < text.size() && std::isspace(static_cast<unsigned char>(text[p]))) ++p;
     if (p < text.size() && text[p] == ':') {
       ++p;
-      while (p < text.size() && (std::isspace(static_cast<unsigned char>(text[p])) || text[p] == '[')) ++p;
+      while (p < text.size() &&
+             (std::isspace(static_cast<unsigned char>(text[p])) || text[p] == '['))
+        ++p;
       for (std::size_t k = 0; k < index; ++k) {
         p = text.find(',', p);
         if (p == std::string::npos) return std::nan("");
@@ -400,7 +446,10 @@ std::string selfExe() {
 }
 
 std::string shellQuote(const std::string& a) {
-  if (!a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=/.,:@%") == std::string::npos)
+  if (!a.empty() &&
+      a.find_first_not_of(
+          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=/.,:@%") ==
+          std::string::npos)
     return a;
   std::string o = "'";
   for (char ch : a) o += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -451,7 +500,8 @@ std::string lastLine(const fs::path& log) {
   std::size_t end = t.find_last_not_of("\n\r ");
   if (end == std::string::npos) return "";
   std::size_t begin = t.find_last_of('\n', end);
-  std::string l = t.substr(begin == std::string::npos ? 0 : begin + 1, end - (begin == std::string::npos ? 0 : begin + 1) + 1);
+  std::string l = t.substr(begin == std::string::npos ? 0 : begin + 1,
+                           end - (begin == std::string::npos ? 0 : begin + 1) + 1);
   if (const auto cr = l.find_last_of('\r'); cr != std::string::npos) l = l.substr(cr + 1);
   return l;
 }
@@ -473,9 +523,15 @@ struct RunJob {
 class Pair {
  public:
   Pair(const PairArgs& a, PairConfig c, const CliContext& ctx, bool fit_available)
-      : m_a(a), m_c(std::move(c)), m_ctx(ctx), m_fit_available(fit_available), m_exe(selfExe()),
-        m_out(fs::absolute(a.out.empty() ? fs::path("pair-" + m_c.name) : fs::path(a.out)).lexically_normal()),
-        m_cores(availableCores()), m_start(clock::now()) {}
+      : m_a(a),
+        m_c(std::move(c)),
+        m_ctx(ctx),
+        m_fit_available(fit_available),
+        m_exe(selfExe()),
+        m_out(fs::absolute(a.out.empty() ? fs::path("pair-" + m_c.name) : fs::path(a.out))
+                  .lexically_normal()),
+        m_cores(availableCores()),
+        m_start(clock::now()) {}
 
   void run();
 
@@ -487,7 +543,8 @@ class Pair {
   std::string batchArgs() const;
   void emitSlurm();
   void runMd(std::vector<RunJob> jobs);
-  int runStep(const std::string& label, std::vector<std::string> argv, const std::string& logname, bool quiet_failure = false);
+  int runStep(const std::string& label, std::vector<std::string> argv, const std::string& logname,
+              bool quiet_failure = false);
   bool stageDone(const fs::path& marker, const std::string& spec) const;
   void analyse();
   void meanField();
@@ -504,14 +561,14 @@ class Pair {
   fs::path m_out;
   int m_cores;
   clock::time_point m_start;
-  std::map<std::string, md::MdConfig> m_md;        ///< per K name
-  std::map<std::string, std::string> m_md_hash;    ///< per K name: hash of the resolved MD TOML
-  std::map<std::string, std::string> m_md_text;    ///< path -> resolved MD TOML to write
-  std::vector<RunJob> m_runs;                      ///< every run of the study
-  std::set<std::string> m_changed_k;               ///< K names with a run (re)done now
+  std::map<std::string, md::MdConfig> m_md;      ///< per K name
+  std::map<std::string, std::string> m_md_hash;  ///< per K name: hash of the resolved MD TOML
+  std::map<std::string, std::string> m_md_text;  ///< path -> resolved MD TOML to write
+  std::vector<RunJob> m_runs;                    ///< every run of the study
+  std::set<std::string> m_changed_k;             ///< K names with a run (re)done now
   std::map<std::string, double> m_timing;
-  std::map<std::string, std::string> m_status;     ///< step -> done / skipped: ... / failed: ...
-  std::map<std::string, std::string> m_fit_note;   ///< K name -> why fit-beta gave no result
+  std::map<std::string, std::string> m_status;    ///< step -> done / skipped: ... / failed: ...
+  std::map<std::string, std::string> m_fit_note;  ///< K name -> why fit-beta gave no result
   int m_failures = 0;
 };
 
@@ -529,19 +586,23 @@ void Pair::prepareFolder() {
     throw std::invalid_argument("--out '" + m_out.string() + "' exists and is not a folder");
   const bool is_pair = fs::exists(m_out / "config" / "pair.toml");
   if (exists && !fs::is_empty(m_out) && !is_pair && !m_a.force)
-    throw std::invalid_argument("output folder '" + m_out.string() +
-                                "' exists, is not empty and holds no pair study; choose another --out or pass --force");
+    throw std::invalid_argument(
+        "output folder '" + m_out.string() +
+        "' exists, is not empty and holds no pair study; choose another --out or pass --force");
   if (is_pair && m_a.force && m_a.run_index < 0) {
     // --force: start over (keep nothing this command made before).
-    for (const char* sub : {"runs", "analysis", "meanfield", "fit", "figures", "logs", "config"}) fs::remove_all(m_out / sub);
-    for (const char* f : {"summary.json", "report.html", "commands.txt", "batch.slurm", "pair.log"}) fs::remove(m_out / f);
+    for (const char* sub : {"runs", "analysis", "meanfield", "fit", "figures", "logs", "config"})
+      fs::remove_all(m_out / sub);
+    for (const char* f : {"summary.json", "report.html", "commands.txt", "batch.slurm", "pair.log"})
+      fs::remove(m_out / f);
   }
   fs::create_directories(m_out / "config");
   fs::create_directories(m_out / "logs");
 }
 
 void Pair::resolveMd() {
-  const std::string base = m_c.md_preset.empty() ? m_c.md_config : findPreset("presets", m_c.md_preset, "[md] preset");
+  const std::string base =
+      m_c.md_preset.empty() ? m_c.md_config : findPreset("presets", m_c.md_preset, "[md] preset");
   for (std::size_t k = 0; k < m_c.K.size(); ++k) {
     const double K = m_c.K[k];
     std::vector<std::string> set = m_c.md_set;
@@ -558,8 +619,9 @@ void Pair::resolveMd() {
     const fs::path path = m_out / "config" / ("md_" + name + ".toml");
     m_md[name] = cfg;
     m_md_hash[name] = fnv1a(text);
-    const std::string header = "# granagg md configuration of the K = " + formatReal(K) + " runs of pair study '" + m_c.name +
-                               "' (resolved from " + base + "; every run sets its own --seed)\n";
+    const std::string header = "# granagg md configuration of the K = " + formatReal(K) +
+                               " runs of pair study '" + m_c.name + "' (resolved from " + base +
+                               "; every run sets its own --seed)\n";
     m_md_text[path.string()] = header + text;  // written once the folder is prepared
     const double dt = md::Engine::chooseTimeStep(cfg);
     const double steps = std::ceil(cfg.run.t_end / dt);
@@ -580,7 +642,8 @@ void Pair::resolveMd() {
 }
 
 std::string Pair::batchArgs() const {
-  return shellQuote(m_exe) + " pair --config " + shellQuote((m_out / "config" / "pair.toml").string()) + " --out " +
+  return shellQuote(m_exe) + " pair --config " +
+         shellQuote((m_out / "config" / "pair.toml").string()) + " --out " +
          shellQuote(m_out.string());
 }
 
@@ -589,14 +652,19 @@ void Pair::emitSlurm() {
   const fs::path path = m_out / "batch.slurm";
   std::ostringstream s;
   s << "#!/bin/bash\n"
-    << "# granagg pair study '" << m_c.name << "': " << m_runs.size() << " MD runs (" << m_c.K.size() << " values of K x "
-    << m_c.runs << " runs) as a Slurm job array, then the analysis, mean field, fit, figures and report as a\n"
-    << "# follow-up job that starts once every array task succeeded. Written by: " << m_ctx.command_line << "\n#\n"
+    << "# granagg pair study '" << m_c.name << "': " << m_runs.size() << " MD runs ("
+    << m_c.K.size() << " values of K x " << m_c.runs
+    << " runs) as a Slurm job array, then the analysis, mean field, fit, figures and report as a\n"
+    << "# follow-up job that starts once every array task succeeded. Written by: "
+    << m_ctx.command_line << "\n#\n"
     << "#   bash " << path.string() << "      submits both jobs (array + dependent follow-up)\n"
     << "#   sbatch " << path.string() << "    submits the array only\n#\n"
-    << "# Each task runs one MD run into " << (m_out / "runs").string() << "/K<K>/run<r>/ and marks it done; a task whose\n"
-    << "# run is already done returns at once, so resubmitting the array after a failure redoes only what is missing.\n"
-    << "# Adjust the #SBATCH lines (partition, account, time, GPUs: --gres=gpu:1 for a CUDA build) to your cluster.\n"
+    << "# Each task runs one MD run into " << (m_out / "runs").string()
+    << "/K<K>/run<r>/ and marks it done; a task whose\n"
+    << "# run is already done returns at once, so resubmitting the array after a failure redoes "
+       "only what is missing.\n"
+    << "# Adjust the #SBATCH lines (partition, account, time, GPUs: --gres=gpu:1 for a CUDA build) "
+       "to your cluster.\n"
     << "#SBATCH --job-name=granagg-" << m_c.name << "\n"
     << "#SBATCH --array=0-" << (m_runs.size() - 1) << "\n"
     << "#SBATCH --cpus-per-task=" << threads << "\n"
@@ -605,19 +673,22 @@ void Pair::emitSlurm() {
     << "set -euo pipefail\n"
     << "if [ -z \"${SLURM_JOB_ID:-}\" ]; then\n"
     << "  jid=$(sbatch --parsable \"$0\")\n"
-    << "  sbatch --dependency=afterok:${jid%%;*} --job-name=granagg-" << m_c.name << "-post --cpus-per-task=" << threads
-    << " --time=04:00:00 --output=" << (m_out / "logs").string() << "/slurm-post-%j.out --wrap=" << shellQuote(batchArgs())
-    << "\n"
+    << "  sbatch --dependency=afterok:${jid%%;*} --job-name=granagg-" << m_c.name
+    << "-post --cpus-per-task=" << threads
+    << " --time=04:00:00 --output=" << (m_out / "logs").string()
+    << "/slurm-post-%j.out --wrap=" << shellQuote(batchArgs()) << "\n"
     << "  echo \"submitted array job $jid and its follow-up\"\n"
     << "  exit 0\n"
     << "fi\n"
-    << "# task index = k * " << m_c.runs << " + r for K index k (K = " << tomlArray(m_c.K, realToml) << ") and run r\n"
-    << "exec " << batchArgs() << " --run-index \"$SLURM_ARRAY_TASK_ID\" --threads \"${SLURM_CPUS_PER_TASK:-" << threads
+    << "# task index = k * " << m_c.runs << " + r for K index k (K = " << tomlArray(m_c.K, realToml)
+    << ") and run r\n"
+    << "exec " << batchArgs()
+    << " --run-index \"$SLURM_ARRAY_TASK_ID\" --threads \"${SLURM_CPUS_PER_TASK:-" << threads
     << "}\" -q\n";
   writeText(path, s.str());
   fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
-  say("wrote " + path.string() + " (" + std::to_string(m_runs.size()) + " array tasks + a follow-up job); submit with: bash " +
-      path.string());
+  say("wrote " + path.string() + " (" + std::to_string(m_runs.size()) +
+      " array tasks + a follow-up job); submit with: bash " + path.string());
 }
 
 void Pair::runMd(std::vector<RunJob> all) {
@@ -630,14 +701,17 @@ void Pair::runMd(std::vector<RunJob> all) {
       const std::string m = readText(marker);
       if (m.find(jsonString(j.spec)) != std::string::npos) {
         ++done;
-        say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": finished already, skipped", false);
+        say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": finished already, skipped",
+            false);
         continue;
       }
       if (!m_a.force)
         throw std::invalid_argument("run folder '" + j.dir.string() +
-                                    "' holds a run made with another configuration; choose another --out or pass --force to redo it");
+                                    "' holds a run made with another configuration; choose another "
+                                    "--out or pass --force to redo it");
     }
-    j.restart = fs::exists(j.dir / "checkpoint.h5") && fs::exists(j.dir / "traj.h5") && fs::exists(j.dir / "run.json") &&
+    j.restart = fs::exists(j.dir / "checkpoint.h5") && fs::exists(j.dir / "traj.h5") &&
+                fs::exists(j.dir / "run.json") &&
                 readText(j.dir / "run.json").find(jsonString(j.spec)) != std::string::npos;
     todo.push_back(j);
   }
@@ -648,13 +722,15 @@ void Pair::runMd(std::vector<RunJob> all) {
   if (m_a.run_index < 0)
     say("md: " + std::to_string(todo.size()) + " of " + std::to_string(all.size()) + " runs to do" +
         (done ? " (" + std::to_string(done) + " finished already)" : ""));
-  std::stable_sort(todo.begin(), todo.end(), [](const RunJob& a, const RunJob& b) { return a.cost > b.cost; });
+  std::stable_sort(todo.begin(), todo.end(),
+                   [](const RunJob& a, const RunJob& b) { return a.cost > b.cost; });
 
   // Default: two OpenMP threads per run. The engine's one-thread path is currently several times
   // slower per core than its two-thread path (measured 2026-11-23: N = 500 neutral, 1.9e5 vs
   // 1.2e6 particle-steps/s), so one run per core loses on a 2-core machine.
   const int default_jobs = std::max(1, m_cores / 2);
-  const int jobs = std::max(1, std::min<int>(m_a.jobs > 0 ? m_a.jobs : default_jobs, static_cast<int>(todo.size())));
+  const int jobs = std::max(
+      1, std::min<int>(m_a.jobs > 0 ? m_a.jobs : default_jobs, static_cast<int>(todo.size())));
   const int threads = m_a.threads > 0 ? m_a.threads : std::max(1, m_cores / jobs);
   struct Running {
     RunJob job;
@@ -668,8 +744,10 @@ void Pair::runMd(std::vector<RunJob> all) {
   std::size_t finished = 0;
   auto progress = [&]() {
     if (!tty) return;
-    std::fprintf(stderr, "\rpair: md %zu/%zu runs done, %zu running (%d jobs x %d threads), %.0f s   ", finished, todo.size(),
-                 running.size(), jobs, threads, std::chrono::duration<double>(clock::now() - t0).count());
+    std::fprintf(stderr,
+                 "\rpair: md %zu/%zu runs done, %zu running (%d jobs x %d threads), %.0f s   ",
+                 finished, todo.size(), running.size(), jobs, threads,
+                 std::chrono::duration<double>(clock::now() - t0).count());
     std::fflush(stderr);
   };
   auto start = [&](RunJob j) {
@@ -679,18 +757,22 @@ void Pair::runMd(std::vector<RunJob> all) {
       argv.insert(argv.end(), {"--restart", j.dir.string()});
     } else {
       // A fresh start: clear what an interrupted attempt left behind.
-      for (const char* f : {"traj.h5", "traj.xdmf", "checkpoint.h5", "done.json"}) fs::remove(j.dir / f);
-      writeText(j.dir / "run.json", "{\n  \"spec\": " + jsonString(j.spec) + ",\n  \"K\": " + jsonNumber(j.K) +
-                                        ",\n  \"run\": " + std::to_string(j.r) + ",\n  \"seed\": " + std::to_string(j.seed) +
-                                        ",\n  \"config\": " + jsonString(j.config.string()) + ",\n  \"started\": " +
-                                        jsonString(nowUtc()) + "\n}\n");
-      argv.insert(argv.end(), {"--config", j.config.string(), "--seed", std::to_string(j.seed), "--out", j.dir.string(), "--force"});
+      for (const char* f : {"traj.h5", "traj.xdmf", "checkpoint.h5", "done.json"})
+        fs::remove(j.dir / f);
+      writeText(j.dir / "run.json", "{\n  \"spec\": " + jsonString(j.spec) + ",\n  \"K\": " +
+                                        jsonNumber(j.K) + ",\n  \"run\": " + std::to_string(j.r) +
+                                        ",\n  \"seed\": " + std::to_string(j.seed) +
+                                        ",\n  \"config\": " + jsonString(j.config.string()) +
+                                        ",\n  \"started\": " + jsonString(nowUtc()) + "\n}\n");
+      argv.insert(argv.end(), {"--config", j.config.string(), "--seed", std::to_string(j.seed),
+                               "--out", j.dir.string(), "--force"});
     }
     argv.insert(argv.end(), {"--threads", std::to_string(threads), "-q"});
     appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
     appendText(j.log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
-    say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": " + (j.restart ? "restarting from its checkpoint" : "started") +
-            " (seed " + std::to_string(j.seed) + ")",
+    say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": " +
+            (j.restart ? "restarting from its checkpoint" : "started") + " (seed " +
+            std::to_string(j.seed) + ")",
         !tty);
     const pid_t pid = spawn(argv, j.log);
     running[pid] = {j, clock::now()};
@@ -708,7 +790,8 @@ void Pair::runMd(std::vector<RunJob> all) {
       for (auto& [p, r] : running) ::kill(p, SIGTERM);
       for (auto& [p, r] : running) ::waitpid(p, nullptr, 0);
       if (tty) std::fprintf(stderr, "\n");
-      say("interrupted (signal " + std::to_string(g_interrupted) + "): finished runs are kept; run the same command again to resume");
+      say("interrupted (signal " + std::to_string(g_interrupted) +
+          "): finished runs are kept; run the same command again to resume");
       throw std::runtime_error("interrupted; run the same command again to resume");
     }
     if (pid == 0 || (pid < 0 && errno == EINTR)) {
@@ -725,27 +808,34 @@ void Pair::runMd(std::vector<RunJob> all) {
     const std::string name = kName(r.job.K) + " run " + std::to_string(r.job.r);
     if (ok) {
       writeText(r.job.dir / "done.json",
-                "{\n  \"spec\": " + jsonString(r.job.spec) + ",\n  \"K\": " + jsonNumber(r.job.K) + ",\n  \"run\": " +
-                    std::to_string(r.job.r) + ",\n  \"seed\": " + std::to_string(r.job.seed) + ",\n  \"config\": " +
-                    jsonString(r.job.config.string()) + ",\n  \"wall_seconds\": " + jsonNumber(wall) + ",\n  \"threads\": " +
-                    std::to_string(threads) + ",\n  \"restarted\": " + (r.job.restart ? "true" : "false") +
-                    ",\n  \"finished\": " + jsonString(nowUtc()) + ",\n  \"granagg\": " + jsonString(common::versionString()) +
-                    "\n}\n");
+                "{\n  \"spec\": " + jsonString(r.job.spec) + ",\n  \"K\": " + jsonNumber(r.job.K) +
+                    ",\n  \"run\": " + std::to_string(r.job.r) +
+                    ",\n  \"seed\": " + std::to_string(r.job.seed) +
+                    ",\n  \"config\": " + jsonString(r.job.config.string()) +
+                    ",\n  \"wall_seconds\": " + jsonNumber(wall) +
+                    ",\n  \"threads\": " + std::to_string(threads) +
+                    ",\n  \"restarted\": " + (r.job.restart ? "true" : "false") +
+                    ",\n  \"finished\": " + jsonString(nowUtc()) +
+                    ",\n  \"granagg\": " + jsonString(common::versionString()) + "\n}\n");
       ++finished;
       m_changed_k.insert(kName(r.job.K));
       if (tty) std::fprintf(stderr, "\r%100s\r", "");
-      say("md " + name + ": done in " + formatReal(std::round(wall * 10) / 10) + " s" + (r.job.restart ? " (restarted)" : ""));
+      say("md " + name + ": done in " + formatReal(std::round(wall * 10) / 10) + " s" +
+          (r.job.restart ? " (restarted)" : ""));
     } else if (r.job.restart) {
       // The checkpoint could not be continued (e.g. a trajectory cut by a kill): start afresh.
-      say("md " + name + ": restart failed (" + lastLine(r.job.log) + "); starting it afresh", !tty);
+      say("md " + name + ": restart failed (" + lastLine(r.job.log) + "); starting it afresh",
+          !tty);
       r.job.restart = false;
       pending.push_front(r.job);
     } else {
       ++finished;
-      const std::string why = WIFEXITED(st) ? "exit status " + std::to_string(WEXITSTATUS(st)) : "killed by signal " + std::to_string(WTERMSIG(st));
+      const std::string why = WIFEXITED(st) ? "exit status " + std::to_string(WEXITSTATUS(st))
+                                            : "killed by signal " + std::to_string(WTERMSIG(st));
       failed.push_back(name);
       if (tty) std::fprintf(stderr, "\r%100s\r", "");
-      say("md " + name + ": FAILED (" + why + "): " + lastLine(r.job.log) + " [log: " + r.job.log.string() + "]");
+      say("md " + name + ": FAILED (" + why + "): " + lastLine(r.job.log) +
+          " [log: " + r.job.log.string() + "]");
     }
   }
   if (tty) std::fprintf(stderr, "\r%100s\r", "");
@@ -753,13 +843,16 @@ void Pair::runMd(std::vector<RunJob> all) {
   if (!failed.empty()) {
     std::string list;
     for (const auto& f : failed) list += (list.empty() ? "" : ", ") + f;
-    throw std::runtime_error(std::to_string(failed.size()) + " MD run(s) failed (" + list + "; logs in " + (m_out / "logs").string() +
-                             "); finished runs are kept: run the same command again to retry the others");
+    throw std::runtime_error(
+        std::to_string(failed.size()) + " MD run(s) failed (" + list + "; logs in " +
+        (m_out / "logs").string() +
+        "); finished runs are kept: run the same command again to retry the others");
   }
 }
 
 /// Runs one post-processing command (blocking); returns its exit status (127: could not run).
-int Pair::runStep(const std::string& label, std::vector<std::string> argv, const std::string& logname, bool quiet_failure) {
+int Pair::runStep(const std::string& label, std::vector<std::string> argv,
+                  const std::string& logname, bool quiet_failure) {
   const fs::path log = m_out / "logs" / (logname + ".log");
   appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
   appendText(log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
@@ -774,12 +867,15 @@ int Pair::runStep(const std::string& label, std::vector<std::string> argv, const
     if (g_interrupted) {
       ::kill(pid, SIGTERM);
       ::waitpid(pid, nullptr, 0);
-      throw std::runtime_error("interrupted during " + label + "; run the same command again to resume");
+      throw std::runtime_error("interrupted during " + label +
+                               "; run the same command again to resume");
     }
   }
   if (!m_a.quiet && ::isatty(2)) std::fprintf(stderr, "\r%100s\r", "");
   const int rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  if (rc != 0 && !quiet_failure) say(label + ": FAILED (exit status " + std::to_string(rc) + "): " + lastLine(log) + " [log: " + log.string() + "]");
+  if (rc != 0 && !quiet_failure)
+    say(label + ": FAILED (exit status " + std::to_string(rc) + "): " + lastLine(log) +
+        " [log: " + log.string() + "]");
   return rc;
 }
 
@@ -826,7 +922,8 @@ void Pair::meanField() {
   const fs::path dir = m_out / "meanfield";
   fs::create_directories(dir);
   // Kinetic theory with the neutral runs' contact parameters (or the first K's).
-  const md::MdConfig& ref = m_md.count(kName(0.0)) ? m_md.at(kName(0.0)) : m_md.at(kName(m_c.K.front()));
+  const md::MdConfig& ref =
+      m_md.count(kName(0.0)) ? m_md.at(kName(0.0)) : m_md.at(kName(m_c.K.front()));
   double kappa = ref.charging.kappa;
   for (double K : m_c.K)
     if (K > 0) kappa = m_md.at(kName(K)).charging.kappa;
@@ -838,16 +935,22 @@ void Pair::meanField() {
   };
   std::vector<Step> steps;
   for (double b : m_c.betas)
-    steps.push_back({"mean field S(t), beta = " + formatReal(b), "S_beta" + formatReal(b) + ".csv",
-                     {"smol", "--beta", formatReal(b), "--method", "sectional", "--t-end", formatReal(m_c.mf_t_end), "--s-end",
-                      formatReal(m_c.mf_s_end)}});
-  steps.push_back({"mean field z(beta)", "zbeta.csv",
-                   {"smol", "zbeta", "--beta-min", formatReal(m_c.zbeta_min), "--beta-max", formatReal(m_c.zbeta_max), "--count",
-                    std::to_string(m_c.zbeta_count)}});
-  steps.push_back({"kinetic theory: cooling", "cooling.csv",
-                   {"kinetic", "cooling", "--phi", formatReal(ref.system.phi), "--E", formatReal(ref.contact.E), "--D",
-                    formatReal(ref.contact.D), "--t-end", formatReal(std::max(t_md, 1.0))}});
-  steps.push_back({"kinetic theory: charging rate", "charging.csv", {"kinetic", "charging", "--kappa", formatReal(kappa)}});
+    steps.push_back({"mean field S(t), beta = " + formatReal(b),
+                     "S_beta" + formatReal(b) + ".csv",
+                     {"smol", "--beta", formatReal(b), "--method", "sectional", "--t-end",
+                      formatReal(m_c.mf_t_end), "--s-end", formatReal(m_c.mf_s_end)}});
+  steps.push_back({"mean field z(beta)",
+                   "zbeta.csv",
+                   {"smol", "zbeta", "--beta-min", formatReal(m_c.zbeta_min), "--beta-max",
+                    formatReal(m_c.zbeta_max), "--count", std::to_string(m_c.zbeta_count)}});
+  steps.push_back(
+      {"kinetic theory: cooling",
+       "cooling.csv",
+       {"kinetic", "cooling", "--phi", formatReal(ref.system.phi), "--E", formatReal(ref.contact.E),
+        "--D", formatReal(ref.contact.D), "--t-end", formatReal(std::max(t_md, 1.0))}});
+  steps.push_back({"kinetic theory: charging rate",
+                   "charging.csv",
+                   {"kinetic", "charging", "--kappa", formatReal(kappa)}});
   int ok = 0;
   for (const Step& s : steps) {
     const fs::path out = dir / s.file, marker = dir / (s.file + ".done");
@@ -870,7 +973,8 @@ void Pair::meanField() {
       ++m_failures;
     }
   }
-  m_status["meanfield"] = ok == static_cast<int>(steps.size()) ? "done" : "failed (see logs/meanfield.log)";
+  m_status["meanfield"] =
+      ok == static_cast<int>(steps.size()) ? "done" : "failed (see logs/meanfield.log)";
   say("mean field: " + m_status["meanfield"] + " (" + dir.string() + ")");
   m_timing["meanfield"] += std::chrono::duration<double>(clock::now() - t0).count();
 }
@@ -885,13 +989,16 @@ void Pair::fitBeta() {
   int ok = 0;
   for (double K : m_c.K) {
     const std::string name = kName(K);
-    const fs::path in = m_out / "analysis" / name, dir = m_out / "fit" / name, marker = m_out / "fit" / (name + ".done");
+    const fs::path in = m_out / "analysis" / name, dir = m_out / "fit" / name,
+                   marker = m_out / "fit" / (name + ".done");
     if (!fs::exists(in / "S_t.csv")) continue;
     std::vector<std::string> argv{m_exe, "fit-beta", in.string()};
     if (!m_c.fit_column.empty()) argv.insert(argv.end(), {"--column", m_c.fit_column});
-    if (!m_c.fit_window.empty()) argv.insert(argv.end(), {"--window", formatReal(m_c.fit_window[0]), formatReal(m_c.fit_window[1])});
-    const std::string spec = joinCommand(std::vector<std::string>(argv.begin() + 1, argv.end())) + " " +
-                             readText(m_out / "analysis" / (name + ".done"));
+    if (!m_c.fit_window.empty())
+      argv.insert(argv.end(),
+                  {"--window", formatReal(m_c.fit_window[0]), formatReal(m_c.fit_window[1])});
+    const std::string spec = joinCommand(std::vector<std::string>(argv.begin() + 1, argv.end())) +
+                             " " + readText(m_out / "analysis" / (name + ".done"));
     if (!m_changed_k.count(name) && stageDone(marker, spec) && fs::exists(dir / "fit_beta.json")) {
       ++ok;
       say("fit " + name + ": up to date, skipped", false);
@@ -915,14 +1022,16 @@ void Pair::fitBeta() {
       say("fit " + name + ": not possible for these data (" + why + ")");
     } else {
       ++m_failures;
-      say("fit " + name + ": FAILED (exit status " + std::to_string(rc) + ", log: " + (m_out / "logs" / ("fit-" + name + ".log")).string() + ")");
+      say("fit " + name + ": FAILED (exit status " + std::to_string(rc) +
+          ", log: " + (m_out / "logs" / ("fit-" + name + ".log")).string() + ")");
     }
   }
   const std::size_t fitted = static_cast<std::size_t>(ok), nK = m_c.K.size();
-  m_status["fit"] = fitted == nK                          ? "done"
-                    : fitted + m_fit_note.size() < nK     ? "failed for some K (see logs/fit-*.log)"
-                    : fitted > 0                          ? "done where the data allow a fit"
-                                                          : "not possible for these data (see each ensemble's fit_beta note)";
+  m_status["fit"] = fitted == nK                      ? "done"
+                    : fitted + m_fit_note.size() < nK ? "failed for some K (see logs/fit-*.log)"
+                    : fitted > 0
+                        ? "done where the data allow a fit"
+                        : "not possible for these data (see each ensemble's fit_beta note)";
   m_timing["fit"] += std::chrono::duration<double>(clock::now() - t0).count();
 }
 
@@ -933,9 +1042,9 @@ struct KResult {
   double fz = NAN, fz_low = NAN, fz_high = NAN, bz = NAN, bz_low = NAN, bz_high = NAN;
   double bf = NAN, bf_low = NAN, bf_high = NAN, S_c = NAN, tau_c = NAN, w0 = NAN, w1 = NAN;
   double ba = NAN, ba_low = NAN, ba_high = NAN;  ///< beta from the asymptotic law 3 z / (3 - z)
-  bool bf_determined = true;                      ///< false when the curve fit ended at a bound
-  double onset = NAN, onset_err = NAN;            ///< onset time of S_grid (analyze's fits.csv)
-  granagg::analysis::GrowthRegime regime;         ///< of the ensemble-mean S_grid (S_t.csv)
+  bool bf_determined = true;                     ///< false when the curve fit ended at a bound
+  double onset = NAN, onset_err = NAN;           ///< onset time of S_grid (analyze's fits.csv)
+  granagg::analysis::GrowthRegime regime;        ///< of the ensemble-mean S_grid (S_t.csv)
   bool has_fit = false;
   std::string notes;  ///< fit-beta's notes on beta (clamped, no beta, at a bound)
 };
@@ -950,15 +1059,19 @@ std::string validationLine(double K) {
     try {
       const common::CsvTable t = common::readCsv(p.string());
       for (const auto& row : t.rows) {
-        if (std::abs(row[t.column("K")] - K) > 1e-12 || row[t.column("quantity_id")] != 1.0) continue;
+        if (std::abs(row[t.column("K")] - K) > 1e-12 || row[t.column("quantity_id")] != 1.0)
+          continue;
         char buf[600];
         std::snprintf(buf, sizeof buf,
-                      "validation study (docs/validation.md; N = %.0f, %.0f runs to t = %.0f): z = %.2f [%.2f, %.2f] over "
-                      "t = %.0f..%.0f, onset t_c = %.0f, growth x%.0f; local slope %.2f..%.2f over the last half "
+                      "validation study (docs/validation.md; N = %.0f, %.0f runs to t = %.0f): z = "
+                      "%.2f [%.2f, %.2f] over "
+                      "t = %.0f..%.0f, onset t_c = %.0f, growth x%.0f; local slope %.2f..%.2f over "
+                      "the last half "
                       "decade%s",
-                      row[t.column("N")], row[t.column("runs")], row[t.column("t_end")], row[t.column("value")],
-                      row[t.column("low")], row[t.column("high")], row[t.column("t0")], row[t.column("t1")],
-                      row[t.column("onset")], row[t.column("growth_factor")], row[t.column("zloc_min")],
+                      row[t.column("N")], row[t.column("runs")], row[t.column("t_end")],
+                      row[t.column("value")], row[t.column("low")], row[t.column("high")],
+                      row[t.column("t0")], row[t.column("t1")], row[t.column("onset")],
+                      row[t.column("growth_factor")], row[t.column("zloc_min")],
                       row[t.column("zloc_max")],
                       row[t.column("zloc_max")] - row[t.column("zloc_min")] >
                               granagg::analysis::FLAT_SLOPE_TOLERANCE * 0.5 *
@@ -1005,7 +1118,8 @@ KResult readK(const fs::path& out, double K) {
       for (const auto& row : t.rows) {
         tt.push_back(row[t.column("t")]);
         S.push_back(row[t.column("S_grid_mean")]);
-        z.push_back(row[t.column(t.hasColumn("z_local_grid_of_mean") ? "z_local_grid_of_mean" : "z_local_grid")]);
+        z.push_back(row[t.column(t.hasColumn("z_local_grid_of_mean") ? "z_local_grid_of_mean"
+                                                                     : "z_local_grid")]);
       }
       r.regime = granagg::analysis::classifyGrowth(tt, S, z);
     } catch (const std::exception&) {
@@ -1058,42 +1172,60 @@ double localSlopeAt(const fs::path& csv, double S_target) {
 }
 
 std::string interval(double v, double lo, double hi) {
-  return "{\"value\": " + jsonNumber(v) + ", \"low\": " + jsonNumber(lo) + ", \"high\": " + jsonNumber(hi) + "}";
+  return "{\"value\": " + jsonNumber(v) + ", \"low\": " + jsonNumber(lo) +
+         ", \"high\": " + jsonNumber(hi) + "}";
 }
 
 void Pair::writeSummary() {
   std::ostringstream s;
-  s << "{\n  \"granagg\": " << jsonString(common::versionString()) << ",\n  \"study\": " << jsonString(m_c.name)
-    << ",\n  \"config\": " << jsonString((m_out / "config" / "pair.toml").string()) << ",\n  \"source_config\": "
-    << jsonString(m_c.source) << ",\n  \"out\": " << jsonString(m_out.string()) << ",\n  \"command\": "
-    << jsonString(m_ctx.command_line) << ",\n  \"written\": " << jsonString(nowUtc()) << ",\n  \"cores\": " << m_cores
+  s << "{\n  \"granagg\": " << jsonString(common::versionString())
+    << ",\n  \"study\": " << jsonString(m_c.name)
+    << ",\n  \"config\": " << jsonString((m_out / "config" / "pair.toml").string())
+    << ",\n  \"source_config\": " << jsonString(m_c.source)
+    << ",\n  \"out\": " << jsonString(m_out.string())
+    << ",\n  \"command\": " << jsonString(m_ctx.command_line)
+    << ",\n  \"written\": " << jsonString(nowUtc()) << ",\n  \"cores\": " << m_cores
     << ",\n  \"backend\": " << jsonString(md::Engine::backendDescription()) << ",\n";
-  s << "  \"paper\": {\"reference\": \"Singh & Mazza, Phys. Rev. E (2018)\", \"z_neutral\": 1.21, \"z_neutral_pm\": 0.04, "
-       "\"z_charged\": 1.49, \"z_charged_pm\": 0.012, \"z_meanfield_beta2\": 1.19, \"z_meanfield_beta3\": 1.49},\n";
+  s << "  \"paper\": {\"reference\": \"Singh & Mazza, Phys. Rev. E (2018)\", \"z_neutral\": 1.21, "
+       "\"z_neutral_pm\": 0.04, "
+       "\"z_charged\": 1.49, \"z_charged_pm\": 0.012, \"z_meanfield_beta2\": 1.19, "
+       "\"z_meanfield_beta3\": 1.49},\n";
   s << "  \"ensembles\": [\n";
   for (std::size_t k = 0; k < m_c.K.size(); ++k) {
     const double K = m_c.K[k];
     const KResult r = readK(m_out, K);
     const md::MdConfig& cfg = m_md.at(kName(K));
-    s << "    {\"K\": " << jsonNumber(K) << ", \"name\": " << jsonString(kName(K)) << ", \"runs\": " << m_c.runs
-      << ", \"N\": " << cfg.system.N << ", \"phi\": " << jsonNumber(cfg.system.phi) << ", \"t_end\": "
-      << jsonNumber(cfg.run.t_end) << ", \"charging_Q\": " << jsonNumber(cfg.charging.Q) << ",\n"
-      << "     \"z_analyze\": " << interval(r.z, r.z_low, r.z_high) << ", \"z_analyze_window\": [" << jsonNumber(r.fit_t_min)
-      << ", " << jsonNumber(r.fit_t_max) << "], \"z_analyze_method\": \"grid clusters, least squares of ln S on ln t, 95% "
+    s << "    {\"K\": " << jsonNumber(K) << ", \"name\": " << jsonString(kName(K))
+      << ", \"runs\": " << m_c.runs << ", \"N\": " << cfg.system.N
+      << ", \"phi\": " << jsonNumber(cfg.system.phi) << ", \"t_end\": " << jsonNumber(cfg.run.t_end)
+      << ", \"charging_Q\": " << jsonNumber(cfg.charging.Q) << ",\n"
+      << "     \"z_analyze\": " << interval(r.z, r.z_low, r.z_high) << ", \"z_analyze_window\": ["
+      << jsonNumber(r.fit_t_min) << ", " << jsonNumber(r.fit_t_max)
+      << "], \"z_analyze_method\": \"grid clusters, least squares of ln S on ln t, 95% "
       << (m_c.runs > 1 ? "bootstrap over runs" : "Student t") << "\",\n"
-      << "     \"fit_beta\": " << (r.has_fit ? "\"done\"" : jsonString(m_fit_note.count(kName(K)) ? m_fit_note.at(kName(K)) : m_status.count("fit") ? m_status.at("fit") : "not run"))
-      << ", \"z\": " << interval(r.fz, r.fz_low, r.fz_high) << ", \"fit_window\": [" << jsonNumber(r.w0) << ", "
-      << jsonNumber(r.w1) << "],\n     \"beta_from_z\": " << interval(r.bz, r.bz_low, r.bz_high)
+      << "     \"fit_beta\": "
+      << (r.has_fit ? "\"done\""
+                    : jsonString(m_fit_note.count(kName(K)) ? m_fit_note.at(kName(K))
+                                 : m_status.count("fit")    ? m_status.at("fit")
+                                                            : "not run"))
+      << ", \"z\": " << interval(r.fz, r.fz_low, r.fz_high) << ", \"fit_window\": ["
+      << jsonNumber(r.w0) << ", " << jsonNumber(r.w1)
+      << "],\n     \"beta_from_z\": " << interval(r.bz, r.bz_low, r.bz_high)
       << ", \"beta_asymptotic\": " << interval(r.ba, r.ba_low, r.ba_high)
       << ", \"beta_asymptotic_applicable\": " << (r.regime.regime == "scaling" ? "true" : "false")
-      << ", \"beta_fit\": " << interval(r.bf, r.bf_low, r.bf_high) << ", \"beta_fit_determined\": "
-      << (r.bf_determined ? "true" : "false") << ", \"S_c\": " << jsonNumber(r.S_c)
-      << ", \"tau_c\": " << jsonNumber(r.tau_c) << ", \"fit_notes\": " << jsonString(r.notes) << ",\n"
-      << "     \"growth_factor\": " << jsonNumber(r.regime.growth_factor) << ", \"onset_time\": " << jsonNumber(r.onset)
-      << ", \"onset_time_se\": " << jsonNumber(r.onset_err) << ", \"regime\": " << jsonString(r.regime.regime)
-      << ", \"regime_reason\": " << jsonString(r.regime.reason) << ", \"validation\": "
-      << jsonString(validationLine(K)) << ",\n     \"paper_z\": "
-      << (K == 0 ? "1.21, \"paper_z_pm\": 0.04" : "1.49, \"paper_z_pm\": 0.012, \"paper_note\": \"the paper's charged value (K = 5)\"")
+      << ", \"beta_fit\": " << interval(r.bf, r.bf_low, r.bf_high)
+      << ", \"beta_fit_determined\": " << (r.bf_determined ? "true" : "false")
+      << ", \"S_c\": " << jsonNumber(r.S_c) << ", \"tau_c\": " << jsonNumber(r.tau_c)
+      << ", \"fit_notes\": " << jsonString(r.notes) << ",\n"
+      << "     \"growth_factor\": " << jsonNumber(r.regime.growth_factor)
+      << ", \"onset_time\": " << jsonNumber(r.onset)
+      << ", \"onset_time_se\": " << jsonNumber(r.onset_err)
+      << ", \"regime\": " << jsonString(r.regime.regime)
+      << ", \"regime_reason\": " << jsonString(r.regime.reason)
+      << ", \"validation\": " << jsonString(validationLine(K)) << ",\n     \"paper_z\": "
+      << (K == 0 ? "1.21, \"paper_z_pm\": 0.04"
+                 : "1.49, \"paper_z_pm\": 0.012, \"paper_note\": \"the paper's charged value (K = "
+                   "5)\"")
       << "}" << (k + 1 < m_c.K.size() ? "," : "") << "\n";
   }
   s << "  ],\n  \"meanfield\": [\n";
@@ -1113,10 +1245,14 @@ void Pair::writeSummary() {
       for (const auto& row : zb->rows)
         if (std::abs(row[zb->column("beta")] - b) < 1e-9) zinf = row[zb->column("z_asymptotic")];
     const fs::path csv = m_out / "meanfield" / ("S_beta" + formatReal(b) + ".csv");
-    s << "    {\"beta\": " << jsonNumber(b) << ", \"z_scaling\": " << jsonNumber(3 * b / (b + 3)) << ", \"z_asymptotic\": "
-      << jsonNumber(zinf) << ", \"z_local_S250\": " << jsonNumber(localSlopeAt(csv, 250)) << ", \"z_local_S1650\": "
-      << jsonNumber(localSlopeAt(csv, 1650)) << ", \"paper_z\": "
-      << (b == 2 ? "1.19" : b == 3 ? "1.49" : "null") << "}" << (k + 1 < m_c.betas.size() ? "," : "") << "\n";
+    s << "    {\"beta\": " << jsonNumber(b) << ", \"z_scaling\": " << jsonNumber(3 * b / (b + 3))
+      << ", \"z_asymptotic\": " << jsonNumber(zinf)
+      << ", \"z_local_S250\": " << jsonNumber(localSlopeAt(csv, 250))
+      << ", \"z_local_S1650\": " << jsonNumber(localSlopeAt(csv, 1650)) << ", \"paper_z\": "
+      << (b == 2   ? "1.19"
+          : b == 3 ? "1.49"
+                   : "null")
+      << "}" << (k + 1 < m_c.betas.size() ? "," : "") << "\n";
   }
   s << "  ],\n  \"steps\": {";
   bool first = true;
@@ -1130,7 +1266,8 @@ void Pair::writeSummary() {
     s << (first ? "" : ", ") << jsonString(k) << ": " << jsonNumber(std::round(v * 100) / 100);
     first = false;
   }
-  s << (first ? "" : ", ") << "\"total\": " << jsonNumber(std::round(seconds() * 100) / 100) << "},\n  \"commands\": [";
+  s << (first ? "" : ", ") << "\"total\": " << jsonNumber(std::round(seconds() * 100) / 100)
+    << "},\n  \"commands\": [";
   std::istringstream cmds(readText(m_out / "commands.txt"));
   std::string line;
   first = true;
@@ -1153,37 +1290,49 @@ void Pair::printSummary() {
   std::printf("pair: ---- summary (%s) ----\n", (m_out / "summary.json").c_str());
   for (double K : m_c.K) {
     const KResult r = readK(m_out, K);
-    std::printf("pair: K = %-5s z = %s [%s, %s] (analyze, grid, t in [%s, %s])", formatReal(K).c_str(), fmt(r.z).c_str(),
-                fmt(r.z_low).c_str(), fmt(r.z_high).c_str(), fmt(r.fit_t_min, 3).c_str(), fmt(r.fit_t_max, 3).c_str());
+    std::printf("pair: K = %-5s z = %s [%s, %s] (analyze, grid, t in [%s, %s])",
+                formatReal(K).c_str(), fmt(r.z).c_str(), fmt(r.z_low).c_str(),
+                fmt(r.z_high).c_str(), fmt(r.fit_t_min, 3).c_str(), fmt(r.fit_t_max, 3).c_str());
     std::printf("   paper: %s\n", K == 0 ? "1.21 +- 0.04" : "1.49 +- 0.012 (K = 5)");
-    std::printf("pair:           regime: %s (%s)\n", r.regime.regime.c_str(), r.regime.reason.c_str());
+    std::printf("pair:           regime: %s (%s)\n", r.regime.regime.c_str(),
+                r.regime.reason.c_str());
     const std::string v = validationLine(K);
     if (!v.empty()) std::printf("pair:           %s\n", v.c_str());
     if (r.has_fit)
-      std::printf("pair:           fit-beta: z = %s [%s, %s], beta from z at the data's S %s, asymptotic beta %s, "
-                  "full-curve beta = %s\n",
-                  fmt(r.fz).c_str(), fmt(r.fz_low).c_str(), fmt(r.fz_high).c_str(),
-                  (std::isfinite(r.bz) ? "= " + fmt(r.bz, 2) + " [" + fmt(r.bz_low, 2) + ", " + fmt(r.bz_high, 2) + "]"
-                                       : std::string("n/a (z outside the mean field's range there)"))
-                      .c_str(),
-                  (r.regime.regime == "scaling"
-                       ? "= " + fmt(r.ba, 2) + " [" + fmt(r.ba_low, 2) + ", " + fmt(r.ba_high, 2) + "]"
-                       : "not applicable (no scaling regime; 3z/(3-z) would give " + fmt(r.ba, 2) + ")")
-                      .c_str(),
-                  r.bf_determined ? (fmt(r.bf, 2) + " [" + fmt(r.bf_low, 2) + ", " + fmt(r.bf_high, 2) + "]").c_str()
-                                  : "not determined (at the bound of its range)");
+      std::printf(
+          "pair:           fit-beta: z = %s [%s, %s], beta from z at the data's S %s, asymptotic "
+          "beta %s, "
+          "full-curve beta = %s\n",
+          fmt(r.fz).c_str(), fmt(r.fz_low).c_str(), fmt(r.fz_high).c_str(),
+          (std::isfinite(r.bz)
+               ? "= " + fmt(r.bz, 2) + " [" + fmt(r.bz_low, 2) + ", " + fmt(r.bz_high, 2) + "]"
+               : std::string("n/a (z outside the mean field's range there)"))
+              .c_str(),
+          (r.regime.regime == "scaling"
+               ? "= " + fmt(r.ba, 2) + " [" + fmt(r.ba_low, 2) + ", " + fmt(r.ba_high, 2) + "]"
+               : "not applicable (no scaling regime; 3z/(3-z) would give " + fmt(r.ba, 2) + ")")
+              .c_str(),
+          r.bf_determined
+              ? (fmt(r.bf, 2) + " [" + fmt(r.bf_low, 2) + ", " + fmt(r.bf_high, 2) + "]").c_str()
+              : "not determined (at the bound of its range)");
     if (r.has_fit && !r.notes.empty())
-      std::printf("pair:           fit-beta note: %.200s%s\n", r.notes.c_str(), r.notes.size() > 200 ? "..." : "");
+      std::printf("pair:           fit-beta note: %.200s%s\n", r.notes.c_str(),
+                  r.notes.size() > 200 ? "..." : "");
     if (!r.has_fit)
-      std::printf("pair:           fit-beta: %s\n", m_fit_note.count(kName(K))  ? m_fit_note.at(kName(K)).c_str()
-                                                    : m_status.count("fit") ? m_status.at("fit").c_str() : "not run");
+      std::printf("pair:           fit-beta: %s\n",
+                  m_fit_note.count(kName(K)) ? m_fit_note.at(kName(K)).c_str()
+                  : m_status.count("fit")    ? m_status.at("fit").c_str()
+                                             : "not run");
   }
   for (double b : m_c.betas) {
     const fs::path csv = m_out / "meanfield" / ("S_beta" + formatReal(b) + ".csv");
     const double S_paper = b == 2 ? 250 : 1650;
-    std::printf("pair: mean field beta = %s: z(S ~ %g) = %s, asymptotic 3 beta/(beta+3) = %s%s\n", formatReal(b).c_str(), S_paper,
-                fmt(localSlopeAt(csv, S_paper)).c_str(), fmt(3 * b / (b + 3)).c_str(),
-                b == 2 ? "   paper: 1.19" : b == 3 ? "   paper: 1.49" : "");
+    std::printf("pair: mean field beta = %s: z(S ~ %g) = %s, asymptotic 3 beta/(beta+3) = %s%s\n",
+                formatReal(b).c_str(), S_paper, fmt(localSlopeAt(csv, S_paper)).c_str(),
+                fmt(3 * b / (b + 3)).c_str(),
+                b == 2   ? "   paper: 1.19"
+                : b == 3 ? "   paper: 1.49"
+                         : "");
   }
   std::printf("pair: wrote %s (summary.json%s) in %.0f s\n", m_out.c_str(),
               fs::exists(m_out / "report.html") ? ", report.html, figures/" : "", seconds());
@@ -1196,7 +1345,8 @@ void Pair::run() {
     if (!fs::exists(path) || readText(path) != text) writeText(path, text);
   const std::string resolved = toToml(m_c);
   const fs::path cfgpath = m_out / "config" / "pair.toml";
-  if (m_a.run_index < 0 && (!fs::exists(cfgpath) || readText(cfgpath) != resolved)) writeText(cfgpath, resolved);
+  if (m_a.run_index < 0 && (!fs::exists(cfgpath) || readText(cfgpath) != resolved))
+    writeText(cfgpath, resolved);
   if (m_a.run_index >= 0 && !fs::exists(cfgpath)) writeText(cfgpath, resolved);
 
   if (m_a.emit_batch == "slurm") {
@@ -1205,13 +1355,15 @@ void Pair::run() {
   }
   if (m_a.run_index >= 0) {  // one array task of a batch job
     if (m_a.run_index >= static_cast<int>(m_runs.size()))
-      throw std::invalid_argument("--run-index " + std::to_string(m_a.run_index) + " is out of range (the study has " +
-                                  std::to_string(m_runs.size()) + " runs: 0.." + std::to_string(m_runs.size() - 1) + ")");
+      throw std::invalid_argument(
+          "--run-index " + std::to_string(m_a.run_index) + " is out of range (the study has " +
+          std::to_string(m_runs.size()) + " runs: 0.." + std::to_string(m_runs.size() - 1) + ")");
     runMd({m_runs[static_cast<std::size_t>(m_a.run_index)]});
     return;
   }
-  say("study '" + m_c.name + "' -> " + m_out.string() + " (" + common::versionString() + "; K = " + tomlArray(m_c.K, realToml) +
-      ", " + std::to_string(m_c.runs) + " runs each, " + std::to_string(m_cores) + " cores)");
+  say("study '" + m_c.name + "' -> " + m_out.string() + " (" + common::versionString() +
+      "; K = " + tomlArray(m_c.K, realToml) + ", " + std::to_string(m_c.runs) + " runs each, " +
+      std::to_string(m_cores) + " cores)");
   runMd(m_runs);
   analyse();
   meanField();
@@ -1220,7 +1372,8 @@ void Pair::run() {
   writeSummary();
   if (!m_a.no_figures) {
     const auto t0 = clock::now();
-    const fs::path plot = scriptsDir() / "plot_figures.py", report = scriptsDir() / "make_report.py";
+    const fs::path plot = scriptsDir() / "plot_figures.py",
+                   report = scriptsDir() / "make_report.py";
     if (!fs::exists(plot)) {
       m_status["figures"] = "skipped: " + plot.string() + " not found (set GRANAGG_SCRIPTS)";
       say("figures: " + m_status["figures"]);
@@ -1252,17 +1405,22 @@ void Pair::run() {
   printSummary();
   std::fflush(stdout);
   if (m_failures > 0)
-    throw std::runtime_error(std::to_string(m_failures) + " post-processing step(s) failed (see " + (m_out / "pair.log").string() +
+    throw std::runtime_error(std::to_string(m_failures) + " post-processing step(s) failed (see " +
+                             (m_out / "pair.log").string() +
                              "); run the same command again to retry them");
 }
 
 void runPair(const PairArgs& a, const CliContext& ctx, const CLI::App* root, bool runs_given) {
-  if (a.preset.empty() == a.config.empty()) throw std::invalid_argument("give exactly one of --preset NAME or --config FILE");
-  if (a.jobs < 0) throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(a.jobs) + ")");
-  if (a.threads < 0) throw std::invalid_argument("--threads must be >= 1 (got " + std::to_string(a.threads) + ")");
+  if (a.preset.empty() == a.config.empty())
+    throw std::invalid_argument("give exactly one of --preset NAME or --config FILE");
+  if (a.jobs < 0)
+    throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(a.jobs) + ")");
+  if (a.threads < 0)
+    throw std::invalid_argument("--threads must be >= 1 (got " + std::to_string(a.threads) + ")");
   if (!a.emit_batch.empty() && a.emit_batch != "slurm")
     throw std::invalid_argument("--emit-batch supports only 'slurm' (got '" + a.emit_batch + "')");
-  PairConfig c = parsePairConfig(a.config.empty() ? findPreset("pair", a.preset, "--preset") : a.config);
+  PairConfig c =
+      parsePairConfig(a.config.empty() ? findPreset("pair", a.preset, "--preset") : a.config);
   if (!a.K.empty()) c.K = parseKList(a.K);
   if (runs_given) c.runs = a.runs;
   validate(c);
@@ -1281,29 +1439,35 @@ void runPair(const PairArgs& a, const CliContext& ctx, const CLI::App* root, boo
 
 void registerPairCommand(CLI::App& app, const CliContext& ctx) {
   auto a = std::make_shared<PairArgs>();
-  CLI::App* c = app.add_subcommand(
-      "pair",
-      "Paired MD / mean-field study (docs/pair.md): MD ensembles for each Coulomb constant K (independent seeds, up to\n"
-      "--jobs runs at a time), their analysis, the mean field (Smoluchowski S(t) for beta = 2, 3 and z(beta)), the\n"
-      "beta fit, the paper's figures and report.html, and summary.json. An interrupted study resumes: run the same\n"
-      "command again and finished runs are not redone.");
-  c->add_option("--preset", a->preset, "Pair preset from data/pair: tiny, quick, paper, validate-neutral, validate-charged, validate-box");
+  CLI::App* c = app.add_subcommand("pair",
+                                   "Paired MD / mean-field study (docs/pair.md): MD ensembles for "
+                                   "each Coulomb constant K (independent seeds, up to\n"
+                                   "--jobs runs at a time), their analysis, the mean field "
+                                   "(Smoluchowski S(t) for beta = 2, 3 and z(beta)), the\n"
+                                   "beta fit, the paper's figures and report.html, and "
+                                   "summary.json. An interrupted study resumes: run the same\n"
+                                   "command again and finished runs are not redone.");
+  c->add_option("--preset", a->preset,
+                "Pair preset from data/pair: tiny, quick, paper, validate-neutral, "
+                "validate-charged, validate-box");
   c->add_option("-c,--config", a->config, "Pair configuration TOML (keys: docs/pair.md)");
   c->add_option("--K", a->K, "Comma-separated Coulomb constants, e.g. 0,5 (overrides pair.K)");
   c->add_option("--runs", a->runs, "Runs per K (>= 1; overrides pair.runs)");
   c->add_option("--jobs", a->jobs, "MD runs at a time (default: max(1, cores / 2))");
-  c->add_option("--threads", a->threads, "OpenMP threads per MD run (default: max(1, cores / jobs))");
-  c->add_option("-o,--out", a->out, "Output folder (default pair-<preset>); an existing study there is resumed");
+  c->add_option("--threads", a->threads,
+                "OpenMP threads per MD run (default: max(1, cores / jobs))");
+  c->add_option("-o,--out", a->out,
+                "Output folder (default pair-<preset>); an existing study there is resumed");
   c->add_flag("--force", a->force, "Start over in an existing output folder (redo every run)");
-  c->add_option("--emit-batch", a->emit_batch, "Write DIR/batch.slurm (a Slurm job array + follow-up job) instead of running");
-  c->add_option("--run-index", a->run_index, "Run only the run with this index (k * runs + r); what batch array tasks call")
+  c->add_option("--emit-batch", a->emit_batch,
+                "Write DIR/batch.slurm (a Slurm job array + follow-up job) instead of running");
+  c->add_option("--run-index", a->run_index,
+                "Run only the run with this index (k * runs + r); what batch array tasks call")
       ->group("");
   c->add_flag("--no-figures", a->no_figures, "Skip the figures and the report");
   c->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
   const CLI::App* root = &app;
-  c->callback([a, ctx, root, c]() {
-    runPair(*a, ctx, root, c->count("--runs") > 0);
-  });
+  c->callback([a, ctx, root, c]() { runPair(*a, ctx, root, c->count("--runs") > 0); });
 }
 
 }  // namespace granagg::cli

@@ -58,17 +58,21 @@ void requireRange(bool ok, const std::string& what) {
 }
 
 std::vector<double> outputTimes(double t_min, double t_end, int per_decade) {
-  requireRange(t_min > 0.0 && std::isfinite(t_min), "--t-min must be positive (got " + common::formatReal(t_min) + ").");
+  requireRange(t_min > 0.0 && std::isfinite(t_min),
+               "--t-min must be positive (got " + common::formatReal(t_min) + ").");
   requireRange(t_end > t_min && std::isfinite(t_end),
-               "--t-end must be larger than --t-min = " + common::formatReal(t_min) + " (got " + common::formatReal(t_end) + ").");
+               "--t-end must be larger than --t-min = " + common::formatReal(t_min) + " (got " +
+                   common::formatReal(t_end) + ").");
   requireRange(per_decade >= 1 && per_decade <= 10000, "--per-decade must lie in [1, 10000].");
-  const int count = std::max(2, static_cast<int>(std::ceil(std::log10(t_end / t_min) * per_decade)) + 1);
+  const int count =
+      std::max(2, static_cast<int>(std::ceil(std::log10(t_end / t_min) * per_decade)) + 1);
   return mf::logSpacedTimes(t_min, t_end, count);
 }
 
 /// Runs the chosen method; all three return moments on the same output times.
-mf::SmolResult solve(const mf::Kernel& kernel, const std::string& method, const std::vector<double>& times,
-                     double s_end, int max_size, double ratio, double rtol, double atol, const std::string& integrator) {
+mf::SmolResult solve(const mf::Kernel& kernel, const std::string& method,
+                     const std::vector<double>& times, double s_end, int max_size, double ratio,
+                     double rtol, double atol, const std::string& integrator) {
   if (method == "discrete") {
     mf::DiscreteOptions o;
     o.times = times;
@@ -94,7 +98,8 @@ mf::SmolResult solve(const mf::Kernel& kernel, const std::string& method, const 
     o.s_end = s_end;
     return mf::solveMonodisperse(kernel, o);
   }
-  throw std::invalid_argument("--method must be one of sectional, discrete, mono (got '" + method + "').");
+  throw std::invalid_argument("--method must be one of sectional, discrete, mono (got '" + method +
+                              "').");
 }
 
 /// Times and S of the valid samples only (a truncated solution never enters a fit).
@@ -116,14 +121,16 @@ void runSmol(const SmolArgs& a, const CliContext& ctx) {
   requireRange(a.atol > 0.0, "--atol must be positive.");
   requireRange(a.p > 1.0, "--p must be > 1.");
   if (kernel.gels() && a.t_end >= 1.0 / a.K0)
-    throw std::invalid_argument("--t-end must be below the gel time 1/K0 = " + common::formatReal(1.0 / a.K0) +
-                                " for the multiplicative kernel.");
+    throw std::invalid_argument("--t-end must be below the gel time 1/K0 = " +
+                                common::formatReal(1.0 / a.K0) + " for the multiplicative kernel.");
   const auto times = outputTimes(a.t_min, a.t_end, a.per_decade);
   common::refuseToOverwrite(a.out == "-" ? std::string() : a.out, a.force);
 
   const auto wall0 = std::chrono::steady_clock::now();
-  const mf::SmolResult r = solve(kernel, a.method, times, a.s_end, a.max_size, a.ratio, a.rtol, a.atol, a.integrator);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const mf::SmolResult r =
+      solve(kernel, a.method, times, a.s_end, a.max_size, a.ratio, a.rtol, a.atol, a.integrator);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   std::vector<double> t, S;
   validSeries(r, t, S);
@@ -143,9 +150,13 @@ void runSmol(const SmolArgs& a, const CliContext& ctx) {
   prov.add("atol", a.atol);
   prov.add("initial_state", std::string("monodisperse n_1(0) = 1"));
   prov.add("local_slope_ratio_p", a.p);
-  prov.add("columns", std::string("t: time in 1/(K0 n_1(0)); M_p = sum k^p n_k; S = M2/M1; z_local = log[S(t)/S(t/p)]/log p; "
-                                  "mass_loss = (M1(0)-M1(t))/M1(0); valid = 0 where truncation lost mass"));
-  common::CsvWriter w(a.out, prov, {"t", "S", "M0", "M1", "M2", "z_local", "mass_loss", "valid", "max_size"}, a.force);
+  prov.add("columns",
+           std::string("t: time in 1/(K0 n_1(0)); M_p = sum k^p n_k; S = M2/M1; z_local = "
+                       "log[S(t)/S(t/p)]/log p; "
+                       "mass_loss = (M1(0)-M1(t))/M1(0); valid = 0 where truncation lost mass"));
+  common::CsvWriter w(a.out, prov,
+                      {"t", "S", "M0", "M1", "M2", "z_local", "mass_loss", "valid", "max_size"},
+                      a.force);
   std::size_t j = 0;
   for (const auto& s : r.samples) {
     double z = std::nan("");
@@ -157,13 +168,19 @@ void runSmol(const SmolArgs& a, const CliContext& ctx) {
 
   if (a.quiet) return;
   std::FILE* info = a.out == "-" ? stderr : stdout;
-  std::fprintf(info, "smol: kernel %s%s, method %s: %zu samples to t = %.4g, S = %.6g (%.2f s, %ld steps, %ld RHS)\n",
-               kernel.name().c_str(), kernel.type() == mf::KernelType::Beta ? (" beta=" + common::formatReal(a.beta)).c_str() : "",
-               a.method.c_str(), r.samples.size(), r.samples.empty() ? 0.0 : r.samples.back().t,
-               r.samples.empty() ? 0.0 : r.samples.back().S, wall, r.stats.steps, r.stats.rhs_evaluations);
-  if (!r.stopped_early.empty()) std::fprintf(info, "smol: stopped early: %s\n", r.stopped_early.c_str());
+  std::fprintf(
+      info,
+      "smol: kernel %s%s, method %s: %zu samples to t = %.4g, S = %.6g (%.2f s, %ld steps, %ld "
+      "RHS)\n",
+      kernel.name().c_str(),
+      kernel.type() == mf::KernelType::Beta ? (" beta=" + common::formatReal(a.beta)).c_str() : "",
+      a.method.c_str(), r.samples.size(), r.samples.empty() ? 0.0 : r.samples.back().t,
+      r.samples.empty() ? 0.0 : r.samples.back().S, wall, r.stats.steps, r.stats.rhs_evaluations);
+  if (!r.stopped_early.empty())
+    std::fprintf(info, "smol: stopped early: %s\n", r.stopped_early.c_str());
   if (kernel.homogeneity() < 1.0) {
-    std::fprintf(info, "smol: scaling prediction z = 1/(1 - lambda) = %.6f\n", kernel.scalingExponent());
+    std::fprintf(info, "smol: scaling prediction z = 1/(1 - lambda) = %.6f\n",
+                 kernel.scalingExponent());
     try {
       const auto az = mf::asymptoticExponent(t, S, a.p, a.z_tolerance);
       std::fprintf(info, "smol: asymptotic %s\n", az.describe().c_str());
@@ -175,7 +192,8 @@ void runSmol(const SmolArgs& a, const CliContext& ctx) {
 }
 
 void runZbeta(const ZbetaArgs& a, const CliContext& ctx) {
-  requireRange(a.beta_min > 0.0, "--beta-min must be positive (got " + common::formatReal(a.beta_min) + ").");
+  requireRange(a.beta_min > 0.0,
+               "--beta-min must be positive (got " + common::formatReal(a.beta_min) + ").");
   requireRange(a.beta_max >= a.beta_min, "--beta-max must be >= --beta-min.");
   requireRange(a.count >= 1 && a.count <= 1000, "--count must lie in [1, 1000].");
   requireRange(a.s_end >= 1e3, "--s-end must be at least 1e3 for an asymptotic exponent.");
@@ -187,17 +205,20 @@ void runZbeta(const ZbetaArgs& a, const CliContext& ctx) {
   prov.add("method", a.method);
   prov.add("s_end", a.s_end);
   if (a.method == "sectional") prov.add("ratio", a.ratio);
-  prov.add("columns", std::string("z_asymptotic: 1/t-extrapolated local slope of S(t) (GrowthExponent.h); "
-                                  "z_scaling = 3 beta/(beta+3); z_local_S250 and z_local_S2500: local slopes (p = 2) "
-                                  "where S first exceeds 250 and 2500 (the paper's 1.19 and 1.49 are such)"));
+  prov.add("columns",
+           std::string(
+               "z_asymptotic: 1/t-extrapolated local slope of S(t) (GrowthExponent.h); "
+               "z_scaling = 3 beta/(beta+3); z_local_S250 and z_local_S2500: local slopes (p = 2) "
+               "where S first exceeds 250 and 2500 (the paper's 1.19 and 1.49 are such)"));
   common::CsvWriter w(a.out, prov,
-                      {"beta", "z_asymptotic", "z_scaling", "difference", "converged", "S_final", "z_local_S250",
-                       "z_local_S2500"},
+                      {"beta", "z_asymptotic", "z_scaling", "difference", "converged", "S_final",
+                       "z_local_S250", "z_local_S2500"},
                       a.force);
   std::FILE* info = a.out == "-" ? stderr : stdout;
   // t_end from the scaling law S ~ t^z with a generous margin; s_end stops the solve.
   for (int i = 0; i < a.count; ++i) {
-    const double beta = a.count == 1 ? a.beta_min : a.beta_min + (a.beta_max - a.beta_min) * i / (a.count - 1);
+    const double beta =
+        a.count == 1 ? a.beta_min : a.beta_min + (a.beta_max - a.beta_min) * i / (a.count - 1);
     const mf::Kernel kernel = mf::Kernel::beta(beta);
     const double z_th = kernel.scalingExponent();
     const double t_end = 100.0 * std::pow(a.s_end, 1.0 / z_th);
@@ -215,9 +236,12 @@ void runZbeta(const ZbetaArgs& a, const CliContext& ctx) {
       }
       return std::nan("");
     };
-    w.row({beta, az.z, z_th, az.z - z_th, az.converged ? 1.0 : 0.0, S.back(), slopeAt(250.0), slopeAt(2500.0)});
-    std::fprintf(info, "zbeta: beta = %.4f  z = %.5f  3beta/(beta+3) = %.5f  diff = %+.1e  (S_final = %.3g%s)\n", beta,
-                 az.z, z_th, az.z - z_th, S.back(), az.converged ? "" : ", NOT converged");
+    w.row({beta, az.z, z_th, az.z - z_th, az.converged ? 1.0 : 0.0, S.back(), slopeAt(250.0),
+           slopeAt(2500.0)});
+    std::fprintf(
+        info,
+        "zbeta: beta = %.4f  z = %.5f  3beta/(beta+3) = %.5f  diff = %+.1e  (S_final = %.3g%s)\n",
+        beta, az.z, z_th, az.z - z_th, S.back(), az.converged ? "" : ", NOT converged");
   }
   w.close();
   if (a.out != "-") std::fprintf(info, "zbeta: wrote %s\n", a.out.c_str());
@@ -229,46 +253,63 @@ void registerSmolCommand(CLI::App& app, const CliContext& ctx) {
   auto args = std::make_shared<SmolArgs>();
   CLI::App* smol = app.add_subcommand(
       "smol",
-      "Solve the Smoluchowski coagulation equation from a monodisperse start (n_1(0) = 1) and report S(t) = M2/M1\n"
+      "Solve the Smoluchowski coagulation equation from a monodisperse start (n_1(0) = 1) and "
+      "report S(t) = M2/M1\n"
       "with its local slope and asymptotic growth exponent z. Time unit 1/(K0 n_1(0)).");
-  smol->add_option("--kernel", args->kernel, "Aggregation kernel: beta, constant, additive, multiplicative")
+  smol->add_option("--kernel", args->kernel,
+                   "Aggregation kernel: beta, constant, additive, multiplicative")
       ->capture_default_str();
-  smol->add_option("--beta", args->beta, "beta of the kernel (i^{1/3}+j^{1/3})^2 (1/i+1/j)^{1/beta}; > 0")
+  smol->add_option("--beta", args->beta,
+                   "beta of the kernel (i^{1/3}+j^{1/3})^2 (1/i+1/j)^{1/beta}; > 0")
       ->capture_default_str();
   smol->add_option("--K0", args->K0, "Kernel prefactor (> 0)")->capture_default_str();
-  smol->add_option("--method", args->method,
-                   "sectional (fixed-pivot, reaches S >> 1e8), discrete (CVODE + FFT, exact sizes 1..M), "
-                   "mono (monodisperse approximation, Odeint)")
+  smol->add_option(
+          "--method", args->method,
+          "sectional (fixed-pivot, reaches S >> 1e8), discrete (CVODE + FFT, exact sizes 1..M), "
+          "mono (monodisperse approximation, Odeint)")
       ->capture_default_str();
   smol->add_option("--t-min", args->t_min, "First output time (> 0)")->capture_default_str();
   smol->add_option("--t-end", args->t_end, "Last output time")->capture_default_str();
-  smol->add_option("--per-decade", args->per_decade, "Log-spaced output times per decade")->capture_default_str();
-  smol->add_option("--s-end", args->s_end, "Stop once S reaches this mean size (default: no limit)");
-  smol->add_option("--M", args->max_size, "discrete: largest size class (the active range grows with S up to M)")
+  smol->add_option("--per-decade", args->per_decade, "Log-spaced output times per decade")
       ->capture_default_str();
-  smol->add_option("--ratio", args->ratio, "sectional: geometric grid ratio (> 1); S errors scale as (ratio-1)^2")
+  smol->add_option("--s-end", args->s_end,
+                   "Stop once S reaches this mean size (default: no limit)");
+  smol->add_option("--M", args->max_size,
+                   "discrete: largest size class (the active range grows with S up to M)")
+      ->capture_default_str();
+  smol->add_option("--ratio", args->ratio,
+                   "sectional: geometric grid ratio (> 1); S errors scale as (ratio-1)^2")
       ->capture_default_str();
   smol->add_option("--rtol", args->rtol, "CVODE relative tolerance")->capture_default_str();
-  smol->add_option("--atol", args->atol, "CVODE absolute tolerance, relative to the initial mass M1(0)")
+  smol->add_option("--atol", args->atol,
+                   "CVODE absolute tolerance, relative to the initial mass M1(0)")
       ->capture_default_str();
-  smol->add_option("--integrator", args->integrator, "discrete: adams, bdf (matrix-free GMRES) or bdf-dense")
+  smol->add_option("--integrator", args->integrator,
+                   "discrete: adams, bdf (matrix-free GMRES) or bdf-dense")
       ->capture_default_str();
-  smol->add_option("--p", args->p, "Local-slope ratio p in z(t) = log[S(t)/S(t/p)]/log p")->capture_default_str();
-  smol->add_option("--z-tolerance", args->z_tolerance, "Convergence criterion of the asymptotic z")->capture_default_str();
-  smol->add_option("-o,--out", args->out, "Output CSV ('-' = standard output)")->capture_default_str();
+  smol->add_option("--p", args->p, "Local-slope ratio p in z(t) = log[S(t)/S(t/p)]/log p")
+      ->capture_default_str();
+  smol->add_option("--z-tolerance", args->z_tolerance, "Convergence criterion of the asymptotic z")
+      ->capture_default_str();
+  smol->add_option("-o,--out", args->out, "Output CSV ('-' = standard output)")
+      ->capture_default_str();
   smol->add_flag("--force", args->force, "Overwrite an existing output file");
   smol->add_flag("-q,--quiet", args->quiet, "No summary on the terminal");
 
   auto zargs = std::make_shared<ZbetaArgs>();
-  CLI::App* zbeta = smol->add_subcommand(
-      "zbeta", "Table of the asymptotic growth exponent z(beta) from the full Smoluchowski equation beside 3 beta/(beta+3).");
+  CLI::App* zbeta = smol->add_subcommand("zbeta",
+                                         "Table of the asymptotic growth exponent z(beta) from the "
+                                         "full Smoluchowski equation beside 3 beta/(beta+3).");
   zbeta->add_option("--beta-min", zargs->beta_min, "Smallest beta (> 0)")->capture_default_str();
   zbeta->add_option("--beta-max", zargs->beta_max, "Largest beta")->capture_default_str();
   zbeta->add_option("--count", zargs->count, "Number of beta values")->capture_default_str();
   zbeta->add_option("--method", zargs->method, "sectional or discrete")->capture_default_str();
-  zbeta->add_option("--s-end", zargs->s_end, "Mean size at which each solve stops")->capture_default_str();
-  zbeta->add_option("--ratio", zargs->ratio, "sectional: geometric grid ratio")->capture_default_str();
-  zbeta->add_option("-o,--out", zargs->out, "Output CSV ('-' = standard output)")->capture_default_str();
+  zbeta->add_option("--s-end", zargs->s_end, "Mean size at which each solve stops")
+      ->capture_default_str();
+  zbeta->add_option("--ratio", zargs->ratio, "sectional: geometric grid ratio")
+      ->capture_default_str();
+  zbeta->add_option("-o,--out", zargs->out, "Output CSV ('-' = standard output)")
+      ->capture_default_str();
   zbeta->add_flag("--force", zargs->force, "Overwrite an existing output file");
 
   zbeta->callback([zargs, ctx]() { runZbeta(*zargs, ctx); });

@@ -16,7 +16,8 @@ int main(int argc, char** argv) {
   cli::CliContext ctx{common::commandLine(argc, argv)};
 
   CLI::App app{
-      "granagg: aggregation in charged granular gases -- MD engine, trajectory analysis and mean-field\n"
+      "granagg: aggregation in charged granular gases -- MD engine, trajectory analysis and "
+      "mean-field\n"
       "(Smoluchowski, kinetic theory) solver. Reduced units: particle diameter d = 1, mass m = 1,\n"
       "initial granular temperature T0 = 1 (design.md section 2).",
       "granagg"};
@@ -40,7 +41,8 @@ int main(int argc, char** argv) {
       names += (names.empty() ? "" : ", ") + sub->get_name();
     }
     if (!known) {
-      std::fprintf(stderr, "granagg: error: unknown subcommand '%s' (available: %s; see --help)\n", argv[1], names.c_str());
+      std::fprintf(stderr, "granagg: error: unknown subcommand '%s' (available: %s; see --help)\n",
+                   argv[1], names.c_str());
       return 2;
     }
   }

@@ -1,10 +1,10 @@
 #include "common/Csv.h"
 
+#include <sys/stat.h>
 #include <charconv>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <sys/stat.h>
 
 #include "common/Strings.h"
 #include "common/Version.h"
@@ -39,8 +39,9 @@ std::string commandLine(int argc, const char* const* argv) {
 void refuseToOverwrite(const std::string& path, bool overwrite) {
   struct stat st;
   if (!overwrite && ::stat(path.c_str(), &st) == 0)
-    throw std::invalid_argument("output file '" + path +
-                                "' already exists; choose another --out or pass --force to overwrite it");
+    throw std::invalid_argument(
+        "output file '" + path +
+        "' already exists; choose another --out or pass --force to overwrite it");
 }
 
 CsvWriter::CsvWriter(const std::string& path, const Provenance& prov,
@@ -57,7 +58,8 @@ CsvWriter::CsvWriter(const std::string& path, const Provenance& prov,
   }
   std::fprintf(m_file, "# %s\n", versionString().c_str());
   if (!prov.command().empty()) std::fprintf(m_file, "# command = %s\n", prov.command().c_str());
-  for (const auto& [k, v] : prov.parameters()) std::fprintf(m_file, "# %s = %s\n", k.c_str(), v.c_str());
+  for (const auto& [k, v] : prov.parameters())
+    std::fprintf(m_file, "# %s = %s\n", k.c_str(), v.c_str());
   for (std::size_t c = 0; c < columns.size(); ++c)
     std::fprintf(m_file, "%s%s", c ? "," : "", columns[c].c_str());
   std::fputc('\n', m_file);
@@ -103,7 +105,8 @@ bool CsvTable::hasColumn(const std::string& name) const {
 std::size_t CsvTable::column(const std::string& name) const {
   for (std::size_t c = 0; c < columns.size(); ++c)
     if (columns[c] == name) return c;
-  throw std::invalid_argument(source + ": no column named '" + name + "' (columns: " + join(columns, ",") + ")");
+  throw std::invalid_argument(source + ": no column named '" + name +
+                              "' (columns: " + join(columns, ",") + ")");
 }
 
 CsvTable readCsv(const std::string& path) {
@@ -119,7 +122,8 @@ CsvTable readCsv(const std::string& path) {
     if (s.empty()) continue;
     if (s[0] == '#') {
       auto eq = s.find('=');
-      if (eq != std::string::npos) t.meta.emplace_back(trim(s.substr(1, eq - 1)), trim(s.substr(eq + 1)));
+      if (eq != std::string::npos)
+        t.meta.emplace_back(trim(s.substr(1, eq - 1)), trim(s.substr(eq + 1)));
       continue;
     }
     auto fields = split(s, ',');
@@ -136,7 +140,8 @@ CsvTable readCsv(const std::string& path) {
     for (auto& f : fields) {
       double v;
       if (!parseReal(trim(f), v))
-        throw std::invalid_argument(path + ":" + std::to_string(lineno) + ": '" + trim(f) + "' is not a number");
+        throw std::invalid_argument(path + ":" + std::to_string(lineno) + ": '" + trim(f) +
+                                    "' is not a number");
       row.push_back(v);
     }
     t.rows.push_back(std::move(row));

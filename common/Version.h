@@ -6,7 +6,8 @@
 namespace granagg::common {
 /// Semantic version of granagg (from the top-level CMakeLists.txt).
 const char* version();
-/// `git describe --always --dirty` of the source tree the binary was built from ("unknown" outside git).
+/// `git describe --always --dirty` of the source tree the binary was built from ("unknown" outside
+/// git).
 const char* gitCommit();
 /// "granagg <version> (<commit>)", the string written into provenance headers.
 inline std::string versionString() {

@@ -14,25 +14,32 @@ constexpr double SPHERE_VOLUME = 0.52359877559829887;  // pi/6: volume of a part
 
 GridClusters::GridClusters(const GridClustersParams& p) : m_params(p) {
   if (!(p.spacing > 0.0) || !std::isfinite(p.spacing))
-    throw std::invalid_argument("GridClusters requires a positive grid spacing, got " + common::formatReal(p.spacing) + ".");
-  if (p.min_count < 0) throw std::invalid_argument("GridClusters requires min_count >= 0, got " + std::to_string(p.min_count) + ".");
+    throw std::invalid_argument("GridClusters requires a positive grid spacing, got " +
+                                common::formatReal(p.spacing) + ".");
+  if (p.min_count < 0)
+    throw std::invalid_argument("GridClusters requires min_count >= 0, got " +
+                                std::to_string(p.min_count) + ".");
   if (p.min_count == 0 && !(p.min_fill > 0.0 && p.min_fill <= 1.0))
-    throw std::invalid_argument("GridClusters requires min_fill in (0, 1], got " + common::formatReal(p.min_fill) + ".");
+    throw std::invalid_argument("GridClusters requires min_fill in (0, 1], got " +
+                                common::formatReal(p.min_fill) + ".");
 }
 
 void GridClusters::compute(const Frame& f) { compute(f.position.data(), f.size(), f.box); }
 
 void GridClusters::compute(const double* pos, std::size_t np, double L) {
-  if (!(L > 0.0)) throw std::invalid_argument("GridClusters: box edge must be positive, got " + common::formatReal(L) + ".");
+  if (!(L > 0.0))
+    throw std::invalid_argument("GridClusters: box edge must be positive, got " +
+                                common::formatReal(L) + ".");
   if (L != m_box) {
     m_box = L;
     m_n = std::max(1, static_cast<int>(std::floor(L / m_params.spacing)));
     m_h = L / m_n;
     // The integer threshold is fixed once per box size: count * (pi/6) / h^3 >= min_fill.
     // The 1e-9 guards against a product like 3.9999999999 meant to be 4.
-    m_min_count = m_params.min_count > 0
-                      ? m_params.min_count
-                      : std::max(1.0, std::ceil(m_params.min_fill * m_h * m_h * m_h / SPHERE_VOLUME - 1e-9));
+    m_min_count =
+        m_params.min_count > 0
+            ? m_params.min_count
+            : std::max(1.0, std::ceil(m_params.min_fill * m_h * m_h * m_h / SPHERE_VOLUME - 1e-9));
   }
   const int n = m_n;
   const std::size_t cells = static_cast<std::size_t>(n) * n * n;
@@ -43,7 +50,8 @@ void GridClusters::compute(const double* pos, std::size_t np, double L) {
     return c >= n ? n - 1 : (c < 0 ? 0 : c);  // x in [0, L): rounding only
   };
   if (m_params.assignment == GridAssignment::Nearest) {
-    for (std::size_t i = 0; i < np; ++i) m_counts[index(cellOf(pos[3 * i]), cellOf(pos[3 * i + 1]), cellOf(pos[3 * i + 2]))] += 1.0;
+    for (std::size_t i = 0; i < np; ++i)
+      m_counts[index(cellOf(pos[3 * i]), cellOf(pos[3 * i + 1]), cellOf(pos[3 * i + 2]))] += 1.0;
   } else {
     // Cloud in cell: weight (1 - |dx|/h) per axis to the two nearest cell centres (periodic).
     for (std::size_t i = 0; i < np; ++i) {
@@ -58,8 +66,10 @@ void GridClusters::compute(const double* pos, std::size_t np, double L) {
       for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b)
           for (int c = 0; c < 2; ++c) {
-            const double w = (a ? w1[0] : 1 - w1[0]) * (b ? w1[1] : 1 - w1[1]) * (c ? w1[2] : 1 - w1[2]);
-            const int x = ((c0[0] + a) % n + n) % n, y = ((c0[1] + b) % n + n) % n, z = ((c0[2] + c) % n + n) % n;
+            const double w =
+                (a ? w1[0] : 1 - w1[0]) * (b ? w1[1] : 1 - w1[1]) * (c ? w1[2] : 1 - w1[2]);
+            const int x = ((c0[0] + a) % n + n) % n, y = ((c0[1] + b) % n + n) % n,
+                      z = ((c0[2] + c) % n + n) % n;
             m_counts[index(x, y, z)] += w;
           }
     }
@@ -76,9 +86,11 @@ void GridClusters::compute(const double* pos, std::size_t np, double L) {
       for (int z = 0; z < n; ++z) {
         const std::size_t c = index(x, y, z);
         if (!m_occupied[c]) continue;
-        const std::size_t nb[3] = {index((x + 1) % n, y, z), index(x, (y + 1) % n, z), index(x, y, (z + 1) % n)};
+        const std::size_t nb[3] = {index((x + 1) % n, y, z), index(x, (y + 1) % n, z),
+                                   index(x, y, (z + 1) % n)};
         for (std::size_t o : nb)
-          if (m_occupied[o]) m_uf.unite(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(o));
+          if (m_occupied[o])
+            m_uf.unite(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(o));
       }
   m_labels.assign(cells, -1);
   std::vector<std::int32_t> label_of_root(cells, -1);
@@ -102,8 +114,11 @@ const ClusterSizes& GridClusters::result() const {
 }
 
 double GridClusters::occupiedFraction() const {
-  if (!m_computed) throw std::logic_error("GridClusters::occupiedFraction() called before compute().");
-  return m_occupied.empty() ? 0.0 : static_cast<double>(m_result.mass) / static_cast<double>(m_occupied.size());
+  if (!m_computed)
+    throw std::logic_error("GridClusters::occupiedFraction() called before compute().");
+  return m_occupied.empty()
+             ? 0.0
+             : static_cast<double>(m_result.mass) / static_cast<double>(m_occupied.size());
 }
 
 void GridClusters::reset() {

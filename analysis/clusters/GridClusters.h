@@ -27,9 +27,9 @@ enum class GridAssignment {
 };
 
 struct GridClustersParams {
-  double spacing = 2.0;   ///< target cell edge, in d; cells per side = max(1, floor(L / spacing))
-  double min_fill = 0.25; ///< occupied when (count * pi/6) / h^3 >= min_fill
-  int min_count = 0;      ///< if > 0: occupied when count >= min_count (overrides min_fill)
+  double spacing = 2.0;    ///< target cell edge, in d; cells per side = max(1, floor(L / spacing))
+  double min_fill = 0.25;  ///< occupied when (count * pi/6) / h^3 >= min_fill
+  int min_count = 0;       ///< if > 0: occupied when count >= min_count (overrides min_fill)
   GridAssignment assignment = GridAssignment::Nearest;
 };
 

@@ -15,7 +15,8 @@ namespace granagg::analysis {
 
 ParticleClusters::ParticleClusters(const ParticleClustersParams& p) : m_params(p) {
   if (!(p.tolerance >= 0.0) || !std::isfinite(p.tolerance))
-    throw std::invalid_argument("ParticleClusters requires a tolerance >= 0, got " + common::formatReal(p.tolerance) + ".");
+    throw std::invalid_argument("ParticleClusters requires a tolerance >= 0, got " +
+                                common::formatReal(p.tolerance) + ".");
 }
 
 void ParticleClusters::compute(const Frame& f) { compute(f.position.data(), f.size(), f.box); }
@@ -41,7 +42,8 @@ void ParticleClusters::compute(const double* pos, std::size_t np, double L) {
   // Cells may be larger than rc: at the dilute phi = 0.076 cells of edge rc hold 0.1 particles and
   // the loop over empty cells dominates; about 2 particles per cell is the faster balance
   // (N = 1e5, one thread: 129 ms per frame with cells of edge rc, 36 ms with ~2 per cell).
-  const int nc = std::min(nc_max, std::max(3, static_cast<int>(std::cbrt(static_cast<double>(np) / 2.0))));
+  const int nc =
+      std::min(nc_max, std::max(3, static_cast<int>(std::cbrt(static_cast<double>(np) / 2.0))));
   if (nc_max < 3) {
     // Small box: a cell list with fewer than 3 cells per side would visit a neighbour cell twice.
     for (std::size_t i = 0; i < np; ++i)
@@ -58,15 +60,17 @@ void ParticleClusters::compute(const double* pos, std::size_t np, double L) {
     const std::size_t ncells = static_cast<std::size_t>(nc) * nc * nc;
     std::vector<std::uint32_t> cell_of(np), start(ncells + 1, 0), order(np);
     for (std::size_t i = 0; i < np; ++i) {
-      const std::size_t c = (static_cast<std::size_t>(cellCoord(pos[3 * i])) * nc + cellCoord(pos[3 * i + 1])) * nc +
-                            cellCoord(pos[3 * i + 2]);
+      const std::size_t c =
+          (static_cast<std::size_t>(cellCoord(pos[3 * i])) * nc + cellCoord(pos[3 * i + 1])) * nc +
+          cellCoord(pos[3 * i + 2]);
       cell_of[i] = static_cast<std::uint32_t>(c);
       ++start[c + 1];
     }
     for (std::size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
     {
       std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-      for (std::size_t i = 0; i < np; ++i) order[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+      for (std::size_t i = 0; i < np; ++i)
+        order[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
     }
     // Positions copied in cell order: the pair loops read contiguous memory.
     std::vector<double> sp(3 * np);
@@ -87,13 +91,14 @@ void ParticleClusters::compute(const double* pos, std::size_t np, double L) {
       t = omp_get_thread_num();
 #endif
       auto& out = local[static_cast<std::size_t>(t)];
-      const int cx = static_cast<int>(c / (static_cast<long long>(nc) * nc)), cy = static_cast<int>((c / nc) % nc),
-                cz = static_cast<int>(c % nc);
+      const int cx = static_cast<int>(c / (static_cast<long long>(nc) * nc)),
+                cy = static_cast<int>((c / nc) % nc), cz = static_cast<int>(c % nc);
       // Same cell: no periodic shift. Neighbour cells across a face of the box: the whole cell is
       // shifted by +-L (nc >= 3, so a neighbour is never reached both ways); branch-free distances.
       auto pairsWith = [&](std::uint32_t b0, std::uint32_t b1, const double shift[3], bool same) {
         for (std::uint32_t a = start[c]; a < start[c + 1]; ++a) {
-          const double xa = sp[3 * a] - shift[0], ya = sp[3 * a + 1] - shift[1], za = sp[3 * a + 2] - shift[2];
+          const double xa = sp[3 * a] - shift[0], ya = sp[3 * a + 1] - shift[1],
+                       za = sp[3 * a + 2] - shift[2];
           for (std::uint32_t b = same ? a + 1 : b0; b < b1; ++b) {
             const double dx = xa - sp[3 * b], dy = ya - sp[3 * b + 1], dz = za - sp[3 * b + 2];
             if (dx * dx + dy * dy + dz * dz <= rc2) out.emplace_back(order[a], order[b]);

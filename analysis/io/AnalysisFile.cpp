@@ -19,7 +19,8 @@ struct AnalysisFile::Impl {
 
   h5::Handle group(const std::string& g) {
     const std::string p = "/" + g;
-    if (h5::exists(file.get(), p)) return h5::check(H5Gopen2(file.get(), p.c_str(), H5P_DEFAULT), path + " " + p);
+    if (h5::exists(file.get(), p))
+      return h5::check(H5Gopen2(file.get(), p.c_str(), H5P_DEFAULT), path + " " + p);
     return h5::createGroup(file.get(), p, "'" + path + "'");
   }
 
@@ -50,7 +51,8 @@ struct AnalysisFile::Impl {
     h5::Handle fs(H5Dget_space(d));
     H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
     h5::Handle ms(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr));
-    h5::checkStatus(H5Dwrite(d, mem, ms.get(), fs.get(), H5P_DEFAULT, data), "'" + path + "': cannot write the grid");
+    h5::checkStatus(H5Dwrite(d, mem, ms.get(), fs.get(), H5P_DEFAULT, data),
+                    "'" + path + "': cannot write the grid");
   }
 };
 
@@ -59,12 +61,14 @@ AnalysisFile::AnalysisFile(const std::string& path, bool overwrite, const common
   common::refuseToOverwrite(path, overwrite);
   h5::silenceErrors();
   m_impl->path = path;
-  m_impl->file = h5::check(H5Fcreate(path.c_str(), overwrite ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT),
-                           "cannot create '" + path + "'");
+  m_impl->file = h5::check(
+      H5Fcreate(path.c_str(), overwrite ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT),
+      "cannot create '" + path + "'");
   const std::string c = "'" + path + "'";
   h5::writeStringAttribute(m_impl->file.get(), "command", prov.command(), c);
   h5::writeStringAttribute(m_impl->file.get(), "version", common::versionString(), c);
-  for (const auto& [k, v] : prov.parameters()) h5::writeStringAttribute(m_impl->file.get(), k, v, c);
+  for (const auto& [k, v] : prov.parameters())
+    h5::writeStringAttribute(m_impl->file.get(), k, v, c);
 }
 
 AnalysisFile::~AnalysisFile() {
@@ -85,11 +89,13 @@ void AnalysisFile::writeTable(const std::string& group, const Table& t) {
     std::vector<double> v;
     v.reserve(t.rows.size());
     for (const auto& r : t.rows) v.push_back(r[k]);
-    h5::writeDataset(g.get(), t.columns[k], H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {v.size()}, v.data(), c);
+    h5::writeDataset(g.get(), t.columns[k], H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {v.size()}, v.data(),
+                     c);
   }
 }
 
-void AnalysisFile::writeAttributes(const std::string& group, const std::map<std::string, std::string>& attrs) {
+void AnalysisFile::writeAttributes(const std::string& group,
+                                   const std::map<std::string, std::string>& attrs) {
   Impl& m = *m_impl;
   h5::Handle g = m.group(group);
   for (const auto& [k, v] : attrs) {
@@ -111,7 +117,9 @@ void AnalysisFile::writeGridFrame(std::size_t run, const Frame& f, const GridClu
     h5::writeNumberAttribute(g.get(), "cells_per_side", n, c);
     h5::writeNumberAttribute(g.get(), "cell_size", gc.cellSize(), c);
     h5::writeNumberAttribute(g.get(), "min_count", gc.minCount(), c);
-    h5::writeStringAttribute(g.get(), "layout", "[frame, ix, iy, iz]; labels -1 = empty, clusters from 0 (6-connectivity, periodic)", c);
+    h5::writeStringAttribute(
+        g.get(), "layout",
+        "[frame, ix, iy, iz]; labels -1 = empty, clusters from 0 (6-connectivity, periodic)", c);
     m.occ = m.extendible(g.get(), "occupancy", H5T_STD_U8LE, n);
     m.lab = m.extendible(g.get(), "labels", H5T_STD_I32LE, n);
     m.time = m.extendible(g.get(), "time", H5T_IEEE_F64LE, 0);
@@ -120,7 +128,9 @@ void AnalysisFile::writeGridFrame(std::size_t run, const Frame& f, const GridClu
     m.grid_n = n;
     m.grid_frames = 0;
   }
-  if (n != m.grid_n) throw std::runtime_error("--write-grid: the grid size changed within run " + std::to_string(run) + " (box changed)");
+  if (n != m.grid_n)
+    throw std::runtime_error("--write-grid: the grid size changed within run " +
+                             std::to_string(run) + " (box changed)");
   m.append(m.occ.get(), H5T_NATIVE_UINT8, gc.occupancy().data(), n);
   m.append(m.lab.get(), H5T_NATIVE_INT32, gc.labels().data(), n);
   m.append(m.time.get(), H5T_NATIVE_DOUBLE, &f.time, 0);

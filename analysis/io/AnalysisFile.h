@@ -32,7 +32,8 @@ class AnalysisFile {
   /// Writes `table` under /<group>/<table name>/.
   void writeTable(const std::string& group, const Table& table);
   /// String attributes on /<group> (created if needed).
-  void writeAttributes(const std::string& group, const std::map<std::string, std::string>& attributes);
+  void writeAttributes(const std::string& group,
+                       const std::map<std::string, std::string>& attributes);
   /// Appends one frame's occupancy and labels to /runs/<run>/grid (streamed: one frame in memory).
   void writeGridFrame(std::size_t run, const Frame& frame, const GridClusters& grid);
   /// Flushes and closes; throws std::runtime_error when HDF5 fails.

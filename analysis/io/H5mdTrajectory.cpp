@@ -17,10 +17,10 @@ struct Element {
   std::string name;
   bool present = false, time_dependent = false;
   h5::Handle value;
-  std::vector<hsize_t> shape;                      // of value
-  std::vector<std::int64_t> steps;                 // one per row (time-dependent only)
+  std::vector<hsize_t> shape;                             // of value
+  std::vector<std::int64_t> steps;                        // one per row (time-dependent only)
   std::unordered_map<std::int64_t, hsize_t> row_of_step;  // when rows do not follow position's
-  bool same_rows = true;                           // row k belongs to frame k
+  bool same_rows = true;                                  // row k belongs to frame k
 };
 
 }  // namespace
@@ -35,13 +35,17 @@ struct H5mdTrajectory::Impl {
   std::vector<double> fixed_edges;  // time-independent box
   std::map<std::string, std::string> params;
 
-  [[noreturn]] void error(std::size_t frame, const std::string& what) const { throw TrajectoryError(path, frame, what); }
+  [[noreturn]] void error(std::size_t frame, const std::string& what) const {
+    throw TrajectoryError(path, frame, what);
+  }
   std::string where(const std::string& e) const { return "/particles/" + group + "/" + e; }
 
   template <class T>
-  std::vector<T> readGrid(hid_t grp, const std::string& elem, const char* name, hid_t mem_type, std::size_t rows) {
+  std::vector<T> readGrid(hid_t grp, const std::string& elem, const char* name, hid_t mem_type,
+                          std::size_t rows) {
     const std::string c = "'" + path + "' " + where(elem) + "/" + name;
-    if (h5::objectType(grp, name) != H5I_DATASET) error(0, "missing dataset " + where(elem) + "/" + name + " (required by H5MD)");
+    if (h5::objectType(grp, name) != H5I_DATASET)
+      error(0, "missing dataset " + where(elem) + "/" + name + " (required by H5MD)");
     h5::Handle d = h5::check(H5Dopen2(grp, name, H5P_DEFAULT), c);
     const auto dims = h5::dims(d.get(), c);
     if (dims.empty()) {  // H5MD fixed increment: value k = offset + k * increment
@@ -76,7 +80,8 @@ struct H5mdTrajectory::Impl {
       return e;
     }
     h5::Handle g = h5::check(H5Gopen2(part, name.c_str(), H5P_DEFAULT), c);
-    if (h5::objectType(g.get(), "value") != H5I_DATASET) error(0, "missing dataset " + where(name) + "/value");
+    if (h5::objectType(g.get(), "value") != H5I_DATASET)
+      error(0, "missing dataset " + where(name) + "/value");
     e.time_dependent = true;
     e.value = h5::check(H5Dopen2(g.get(), "value", H5P_DEFAULT), c + "/value");
     e.shape = h5::dims(e.value.get(), c + "/value");
@@ -90,10 +95,13 @@ struct H5mdTrajectory::Impl {
     file = h5::Handle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
     if (!file) {
       const std::string msg = h5::lastError();
-      error(0, "cannot open the HDF5 file (" + (msg.empty() ? std::string("unknown HDF5 error") : msg) +
-                   "); a file cut short by a crash or an interrupted copy cannot be opened by HDF5 at all");
+      error(0, "cannot open the HDF5 file (" +
+                   (msg.empty() ? std::string("unknown HDF5 error") : msg) +
+                   "); a file cut short by a crash or an interrupted copy cannot be opened by HDF5 "
+                   "at all");
     }
-    if (h5::objectType(file.get(), "/particles") != H5I_GROUP) error(0, "no /particles group: not an H5MD trajectory");
+    if (h5::objectType(file.get(), "/particles") != H5I_GROUP)
+      error(0, "no /particles group: not an H5MD trajectory");
     h5::Handle particles = h5::check(H5Gopen2(file.get(), "/particles", H5P_DEFAULT), path);
     const auto groups = h5::children(particles.get());
     if (groups.empty()) error(0, "/particles holds no particle group");
@@ -102,7 +110,8 @@ struct H5mdTrajectory::Impl {
         error(0, "no particle group /particles/" + requested_group);
       group = requested_group;
     } else {
-      group = std::find(groups.begin(), groups.end(), "all") != groups.end() ? "all" : groups.front();
+      group =
+          std::find(groups.begin(), groups.end(), "all") != groups.end() ? "all" : groups.front();
     }
     h5::Handle part = h5::check(H5Gopen2(particles.get(), group.c_str(), H5P_DEFAULT), path);
     pos = openElement(part.get(), "position", true);
@@ -123,7 +132,8 @@ struct H5mdTrajectory::Impl {
       // A frame exists once its step and time rows exist (writers add them last).
       frames = std::min({rows, steps.size(), times.size()});
     }
-    if (h5::objectType(part.get(), "box") != H5I_GROUP) error(0, "missing " + where("box") + " (required by H5MD)");
+    if (h5::objectType(part.get(), "box") != H5I_GROUP)
+      error(0, "missing " + where("box") + " (required by H5MD)");
     {
       h5::Handle box = h5::check(H5Gopen2(part.get(), "box", H5P_DEFAULT), path);
       if (H5Aexists(box.get(), "boundary") > 0) {
@@ -133,8 +143,10 @@ struct H5mdTrajectory::Impl {
         if (H5Tget_class(type.get()) == H5T_STRING && H5Tis_variable_str(type.get()) <= 0) {
           const std::size_t len = H5Tget_size(type.get());
           std::vector<char> buf(len * 3 + 1, '\0');
-          if (H5Aread(a.get(), type.get(), buf.data()) >= 0 && std::string(buf.data(), buf.size()).find("none") != std::string::npos)
-            error(0, where("box") + " has non-periodic boundaries; the analysis needs a periodic box");
+          if (H5Aread(a.get(), type.get(), buf.data()) >= 0 &&
+              std::string(buf.data(), buf.size()).find("none") != std::string::npos)
+            error(0,
+                  where("box") + " has non-periodic boundaries; the analysis needs a periodic box");
         }
       }
       H5Eclear2(H5E_DEFAULT);
@@ -142,8 +154,10 @@ struct H5mdTrajectory::Impl {
       edges.name = "box/edges";
       if (!edges.present) error(0, "missing " + where("box/edges"));
       if (!edges.time_dependent) {
-        fixed_edges = h5::readAll<double>(edges.value.get(), H5T_NATIVE_DOUBLE, path + " box/edges");
-        if (fixed_edges.size() != 3 && fixed_edges.size() != 9) error(0, where("box/edges") + " must hold 3 or 3x3 values");
+        fixed_edges =
+            h5::readAll<double>(edges.value.get(), H5T_NATIVE_DOUBLE, path + " box/edges");
+        if (fixed_edges.size() != 3 && fixed_edges.size() != 9)
+          error(0, where("box/edges") + " must hold 3 or 3x3 values");
       }
     }
     img = openElement(part.get(), "image", false);
@@ -193,7 +207,8 @@ struct H5mdTrajectory::Impl {
   }
 
   template <class T>
-  void readElement(const Element& e, std::size_t k, hid_t mem_type, std::vector<T>& out, std::size_t per_particle) {
+  void readElement(const Element& e, std::size_t k, hid_t mem_type, std::vector<T>& out,
+                   std::size_t per_particle) {
     const std::string c = where(e.name);
     if (!e.present) {
       out.clear();
@@ -205,7 +220,8 @@ struct H5mdTrajectory::Impl {
     }
     const std::size_t expect = per_particle == 1 ? 2 : 3;
     if (e.shape.size() != expect || e.shape[1] != n || (per_particle == 3 && e.shape[2] != 3))
-      error(k, c + "/value must have shape [frames, " + std::to_string(n) + (per_particle == 3 ? ", 3]" : "]"));
+      error(k, c + "/value must have shape [frames, " + std::to_string(n) +
+                   (per_particle == 3 ? ", 3]" : "]"));
     const long long row = rowFor(e, k);
     if (row < 0) {
       out.clear();
@@ -233,16 +249,19 @@ struct H5mdTrajectory::Impl {
         if (row >= 0 && (inner == 3 || inner == 9)) {
           const auto d = h5::dims(edges.value.get(), where("box/edges"));
           if (static_cast<std::size_t>(row) >= d[0])
-            error(k, where("box/edges") + "/value has only " + std::to_string(d[0]) + " rows (truncated write?)");
+            error(k, where("box/edges") + "/value has only " + std::to_string(d[0]) +
+                         " rows (truncated write?)");
           ed.resize(inner);
-          h5::readRows(edges.value.get(), static_cast<hsize_t>(row), 1, H5T_NATIVE_DOUBLE, ed.data(), where("box/edges"));
+          h5::readRows(edges.value.get(), static_cast<hsize_t>(row), 1, H5T_NATIVE_DOUBLE,
+                       ed.data(), where("box/edges"));
         } else if (row >= 0) {
           error(k, where("box/edges") + "/value must hold 3 or 3x3 values per frame");
         }
       } else {
         ed = fixed_edges;
       }
-      if (ed.empty()) error(k, where("box/edges") + " has no value at step " + std::to_string(steps[k]));
+      if (ed.empty())
+        error(k, where("box/edges") + " has no value at step " + std::to_string(steps[k]));
       double L[3];
       if (ed.size() == 9) {
         for (int d = 0; d < 3; ++d) L[d] = ed[4 * d];
@@ -253,10 +272,12 @@ struct H5mdTrajectory::Impl {
       } else {
         error(k, where("box/edges") + " must hold 3 or 3x3 values per frame");
       }
-      if (!(L[0] > 0) || !std::isfinite(L[0])) error(k, "box edge is not positive: " + common::formatReal(L[0]));
+      if (!(L[0] > 0) || !std::isfinite(L[0]))
+        error(k, "box edge is not positive: " + common::formatReal(L[0]));
       if (std::fabs(L[1] - L[0]) > 1e-9 * L[0] || std::fabs(L[2] - L[0]) > 1e-9 * L[0])
-        error(k, "the box is not cubic (" + common::formatReal(L[0]) + " x " + common::formatReal(L[1]) + " x " +
-                     common::formatReal(L[2]) + "); only cubic boxes are supported");
+        error(k, "the box is not cubic (" + common::formatReal(L[0]) + " x " +
+                     common::formatReal(L[1]) + " x " + common::formatReal(L[2]) +
+                     "); only cubic boxes are supported");
       f.box = L[0];
       readElement(pos, k, H5T_NATIVE_DOUBLE, f.position, 3);
       readElement(img, k, H5T_NATIVE_INT32, f.image, 3);
@@ -276,7 +297,8 @@ struct H5mdTrajectory::Impl {
     if (!had_images) f.image.assign(3 * n, 0);
     for (std::size_t j = 0; j < 3 * n; ++j) {
       double x = f.position[j];
-      if (!std::isfinite(x)) error(k, "particle " + std::to_string(j / 3) + " has a non-finite position");
+      if (!std::isfinite(x))
+        error(k, "particle " + std::to_string(j / 3) + " has a non-finite position");
       f.image[j] += box.wrap(x);
       f.position[j] = x;
     }
@@ -284,7 +306,8 @@ struct H5mdTrajectory::Impl {
   }
 };
 
-H5mdTrajectory::H5mdTrajectory(const std::string& path, const std::string& group) : m_impl(std::make_unique<Impl>()) {
+H5mdTrajectory::H5mdTrajectory(const std::string& path, const std::string& group)
+    : m_impl(std::make_unique<Impl>()) {
   m_impl->path = path;
   m_impl->open(group);
 }
@@ -299,7 +322,9 @@ bool H5mdTrajectory::next(Frame& f) {
 }
 
 std::size_t H5mdTrajectory::frameCountHint() const { return m_impl->frames; }
-const std::map<std::string, std::string>& H5mdTrajectory::parameters() const { return m_impl->params; }
+const std::map<std::string, std::string>& H5mdTrajectory::parameters() const {
+  return m_impl->params;
+}
 const std::string& H5mdTrajectory::path() const { return m_impl->path; }
 std::size_t H5mdTrajectory::size() const { return m_impl->n; }
 

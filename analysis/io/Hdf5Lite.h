@@ -63,14 +63,30 @@ class Handle {
     if (m_id < 0) return true;
     herr_t rc = 0;
     switch (H5Iget_type(m_id)) {
-      case H5I_FILE: rc = H5Fclose(m_id); break;
-      case H5I_GROUP: rc = H5Gclose(m_id); break;
-      case H5I_DATASET: rc = H5Dclose(m_id); break;
-      case H5I_DATASPACE: rc = H5Sclose(m_id); break;
-      case H5I_DATATYPE: rc = H5Tclose(m_id); break;
-      case H5I_ATTR: rc = H5Aclose(m_id); break;
-      case H5I_GENPROP_LST: rc = H5Pclose(m_id); break;
-      default: rc = H5Idec_ref(m_id) < 0 ? -1 : 0; break;
+      case H5I_FILE:
+        rc = H5Fclose(m_id);
+        break;
+      case H5I_GROUP:
+        rc = H5Gclose(m_id);
+        break;
+      case H5I_DATASET:
+        rc = H5Dclose(m_id);
+        break;
+      case H5I_DATASPACE:
+        rc = H5Sclose(m_id);
+        break;
+      case H5I_DATATYPE:
+        rc = H5Tclose(m_id);
+        break;
+      case H5I_ATTR:
+        rc = H5Aclose(m_id);
+        break;
+      case H5I_GENPROP_LST:
+        rc = H5Pclose(m_id);
+        break;
+      default:
+        rc = H5Idec_ref(m_id) < 0 ? -1 : 0;
+        break;
     }
     m_id = H5I_INVALID_HID;
     return rc >= 0;
@@ -142,7 +158,8 @@ inline std::vector<hsize_t> dims(hid_t dset, const std::string& context) {
 
 /// Reads `count` rows from `row` of a dataset whose first dimension is time, converted to
 /// `mem_type`; `out` holds count * (product of the inner dimensions) values.
-inline void readRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, void* out, const std::string& context) {
+inline void readRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, void* out,
+                     const std::string& context) {
   const std::vector<hsize_t> d = dims(dset, context);
   if (d.empty() || d[0] < row + count)
     throw std::runtime_error(context + ": row " + std::to_string(row) + " requested, dataset has " +
@@ -151,9 +168,12 @@ inline void readRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, voi
   std::vector<hsize_t> start(d.size(), 0), cnt = d;
   start[0] = row;
   cnt[0] = count;
-  checkStatus(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr), context);
+  checkStatus(
+      H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr),
+      context);
   Handle mspace(H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr));
-  checkStatus(H5Dread(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, out), context + ": cannot read");
+  checkStatus(H5Dread(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, out),
+              context + ": cannot read");
 }
 
 /// Reads a whole dataset converted to `mem_type` (T must match it).
@@ -162,12 +182,15 @@ std::vector<T> readAll(hid_t dset, hid_t mem_type, const std::string& context) {
   std::size_t n = 1;
   for (hsize_t k : dims(dset, context)) n *= static_cast<std::size_t>(k);
   std::vector<T> out(n);
-  if (n > 0) checkStatus(H5Dread(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), context + ": cannot read");
+  if (n > 0)
+    checkStatus(H5Dread(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
+                context + ": cannot read");
   return out;
 }
 
 /// A scalar string attribute (fixed or variable length) as text; "" when it is not a string.
-inline std::string readStringAttribute(hid_t obj, const std::string& name, const std::string& context) {
+inline std::string readStringAttribute(hid_t obj, const std::string& name,
+                                       const std::string& context) {
   Handle attr(H5Aopen(obj, name.c_str(), H5P_DEFAULT));
   if (!attr) fail(context + ": cannot open attribute '" + name + "'");
   Handle type = check(H5Aget_type(attr.get()), context);
@@ -177,14 +200,16 @@ inline std::string readStringAttribute(hid_t obj, const std::string& name, const
     H5Tset_size(mem.get(), H5T_VARIABLE);
     H5Tset_cset(mem.get(), H5Tget_cset(type.get()));
     char* p = nullptr;
-    checkStatus(H5Aread(attr.get(), mem.get(), &p), context + ": cannot read attribute '" + name + "'");
+    checkStatus(H5Aread(attr.get(), mem.get(), &p),
+                context + ": cannot read attribute '" + name + "'");
     std::string s = p ? p : "";
     H5free_memory(p);
     return s;
   }
   const std::size_t n = H5Tget_size(type.get());
   std::vector<char> buf(n + 1, '\0');
-  checkStatus(H5Aread(attr.get(), type.get(), buf.data()), context + ": cannot read attribute '" + name + "'");
+  checkStatus(H5Aread(attr.get(), type.get(), buf.data()),
+              context + ": cannot read attribute '" + name + "'");
   return std::string(buf.data());
 }
 
@@ -210,16 +235,21 @@ inline Handle createGroup(hid_t loc, const std::string& path, const std::string&
 
 /// Writes a whole dataset of shape `shape` (file type `file_type`, memory type `mem_type`).
 inline void writeDataset(hid_t loc, const std::string& name, hid_t file_type, hid_t mem_type,
-                         const std::vector<hsize_t>& shape, const void* data, const std::string& context) {
-  Handle space(shape.empty() ? H5Screate(H5S_SCALAR)
-                             : H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr));
-  Handle d = check(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                   context + ": cannot create dataset '" + name + "'");
-  checkStatus(H5Dwrite(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), context + ": cannot write '" + name + "'");
+                         const std::vector<hsize_t>& shape, const void* data,
+                         const std::string& context) {
+  Handle space(shape.empty()
+                   ? H5Screate(H5S_SCALAR)
+                   : H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr));
+  Handle d = check(
+      H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      context + ": cannot create dataset '" + name + "'");
+  checkStatus(H5Dwrite(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
+              context + ": cannot write '" + name + "'");
 }
 
 /// Scalar variable-length UTF-8 string attribute.
-inline void writeStringAttribute(hid_t obj, const std::string& name, const std::string& value, const std::string& context) {
+inline void writeStringAttribute(hid_t obj, const std::string& name, const std::string& value,
+                                 const std::string& context) {
   Handle type(H5Tcopy(H5T_C_S1));
   H5Tset_size(type.get(), H5T_VARIABLE);
   H5Tset_cset(type.get(), H5T_CSET_UTF8);
@@ -227,15 +257,19 @@ inline void writeStringAttribute(hid_t obj, const std::string& name, const std::
   Handle a = check(H5Acreate2(obj, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
                    context + ": cannot create attribute '" + name + "'");
   const char* p = value.c_str();
-  checkStatus(H5Awrite(a.get(), type.get(), &p), context + ": cannot write attribute '" + name + "'");
+  checkStatus(H5Awrite(a.get(), type.get(), &p),
+              context + ": cannot write attribute '" + name + "'");
 }
 
 /// Scalar double attribute.
-inline void writeNumberAttribute(hid_t obj, const std::string& name, double value, const std::string& context) {
+inline void writeNumberAttribute(hid_t obj, const std::string& name, double value,
+                                 const std::string& context) {
   Handle space(H5Screate(H5S_SCALAR));
-  Handle a = check(H5Acreate2(obj, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-                   context + ": cannot create attribute '" + name + "'");
-  checkStatus(H5Awrite(a.get(), H5T_NATIVE_DOUBLE, &value), context + ": cannot write attribute '" + name + "'");
+  Handle a =
+      check(H5Acreate2(obj, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+            context + ": cannot create attribute '" + name + "'");
+  checkStatus(H5Awrite(a.get(), H5T_NATIVE_DOUBLE, &value),
+              context + ": cannot write attribute '" + name + "'");
 }
 
 }  // namespace granagg::analysis::h5

@@ -17,7 +17,9 @@ namespace granagg::analysis {
 
 LammpsDump::LammpsDump(const std::string& path, double dt) : m_path(path), m_dt(dt), m_in(path) {
   if (!m_in) throw std::invalid_argument("cannot open LAMMPS dump '" + path + "'");
-  if (!(dt >= 0.0) || !std::isfinite(dt)) throw std::invalid_argument("the LAMMPS timestep dt must be >= 0, got " + common::formatReal(dt));
+  if (!(dt >= 0.0) || !std::isfinite(dt))
+    throw std::invalid_argument("the LAMMPS timestep dt must be >= 0, got " +
+                                common::formatReal(dt));
 }
 
 void LammpsDump::error(const std::string& what) const {
@@ -44,10 +46,12 @@ bool LammpsDump::next(Frame& f) {
   std::size_t n = 0;
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   auto need = [&](std::string& l, const char* what) {
-    if (!getLine(l)) error(std::string("file ends inside the frame header (expected ") + what + ")");
+    if (!getLine(l))
+      error(std::string("file ends inside the frame header (expected ") + what + ")");
   };
   while (true) {
-    if (line.rfind("ITEM:", 0) != 0) error("expected an 'ITEM:' line, found '" + line.substr(0, 60) + "'");
+    if (line.rfind("ITEM:", 0) != 0)
+      error("expected an 'ITEM:' line, found '" + line.substr(0, 60) + "'");
     const std::string item = common::trim(line.substr(5));
     if (item == "TIMESTEP") {
       need(line, "the timestep");
@@ -69,9 +73,11 @@ bool LammpsDump::next(Frame& f) {
       have_n = true;
     } else if (item.rfind("BOX BOUNDS", 0) == 0) {
       const auto flags = common::split(common::trim(item.substr(10)), ' ');
-      if (std::find(flags.begin(), flags.end(), "xy") != flags.end()) error("triclinic boxes are not supported");
+      if (std::find(flags.begin(), flags.end(), "xy") != flags.end())
+        error("triclinic boxes are not supported");
       for (const auto& fl : flags)
-        if (!fl.empty() && fl != "pp") error("box boundary '" + fl + "' is not periodic ('pp' needed)");
+        if (!fl.empty() && fl != "pp")
+          error("box boundary '" + fl + "' is not periodic ('pp' needed)");
       for (int d = 0; d < 3; ++d) {
         need(line, "the box bounds");
         std::istringstream is(line);
@@ -87,12 +93,15 @@ bool LammpsDump::next(Frame& f) {
     }
     need(line, "ITEM: ATOMS");
   }
-  if (!have_step || !have_n || !have_box) error("frame header lacks TIMESTEP, NUMBER OF ATOMS or BOX BOUNDS");
+  if (!have_step || !have_n || !have_box)
+    error("frame header lacks TIMESTEP, NUMBER OF ATOMS or BOX BOUNDS");
   if (m_n == 0) m_n = n;
-  if (n != m_n) error("has " + std::to_string(n) + " atoms, the first frame had " + std::to_string(m_n));
+  if (n != m_n)
+    error("has " + std::to_string(n) + " atoms, the first frame had " + std::to_string(m_n));
   const double L = hi[0] - lo[0];
   for (int d = 1; d < 3; ++d)
-    if (std::fabs((hi[d] - lo[d]) - L) > 1e-9 * L) error("the box is not cubic; only cubic boxes are supported");
+    if (std::fabs((hi[d] - lo[d]) - L) > 1e-9 * L)
+      error("the box is not cubic; only cubic boxes are supported");
 
   // Column layout.
   std::vector<std::string> cols;
@@ -127,19 +136,23 @@ bool LammpsDump::next(Frame& f) {
   std::vector<double> values(cols.size());
   for (std::size_t a = 0; a < n; ++a) {
     if (!getLine(line))
-      error("file ends after " + std::to_string(a) + " of " + std::to_string(n) + " atoms (truncated dump?)");
+      error("file ends after " + std::to_string(a) + " of " + std::to_string(n) +
+            " atoms (truncated dump?)");
     const char* p = line.c_str();
     for (std::size_t c = 0; c < cols.size(); ++c) {
       char* end = nullptr;
       values[c] = std::strtod(p, &end);
-      if (end == p) error("atom line has " + std::to_string(c) + " of " + std::to_string(cols.size()) + " values: '" + line.substr(0, 80) + "'");
+      if (end == p)
+        error("atom line has " + std::to_string(c) + " of " + std::to_string(cols.size()) +
+              " values: '" + line.substr(0, 80) + "'");
       p = end;
     }
     ids[a] = c_id >= 0 ? static_cast<std::int64_t>(values[c_id]) : static_cast<std::int64_t>(a);
     for (int d = 0; d < 3; ++d) {
       const double v = values[c_pos[d]];
       pos[3 * a + d] = kind == SCALED ? v * L : v - lo[d];
-      if (has_img && kind != UNWRAPPED) img[3 * a + d] = static_cast<std::int32_t>(values[c_img[d]]);
+      if (has_img && kind != UNWRAPPED)
+        img[3 * a + d] = static_cast<std::int32_t>(values[c_img[d]]);
       if (has_vel) vel[3 * a + d] = values[c_vel[d]];
     }
     if (c_q >= 0) q[a] = values[c_q];
@@ -148,15 +161,18 @@ bool LammpsDump::next(Frame& f) {
   // Sort by id (LAMMPS writes atoms in processor order).
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
   for (std::size_t k = 1; k < n; ++k)
-    if (ids[order[k]] == ids[order[k - 1]]) error("atom id " + std::to_string(ids[order[k]]) + " appears twice");
+    if (ids[order[k]] == ids[order[k - 1]])
+      error("atom id " + std::to_string(ids[order[k]]) + " appears twice");
 
   const common::Box box{L};
   const bool images = has_img || kind == UNWRAPPED;
   f.index = m_frame;
   f.step = step;
-  f.time = have_time ? time : (m_dt > 0 ? static_cast<double>(step) * m_dt : static_cast<double>(step));
+  f.time =
+      have_time ? time : (m_dt > 0 ? static_cast<double>(step) * m_dt : static_cast<double>(step));
   f.box = L;
   f.position.resize(3 * n);
   f.image.assign(images ? 3 * n : 0, 0);

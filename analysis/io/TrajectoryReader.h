@@ -18,7 +18,8 @@ class TrajectoryReader {
   virtual bool next(Frame& f) = 0;
   /// Number of frames if known in advance (H5MD), else 0 (LAMMPS dumps are not pre-scanned).
   virtual std::size_t frameCountHint() const = 0;
-  /// Run parameters stored in the file (H5MD /parameters attributes, e.g. "charging.kappa"); may be empty.
+  /// Run parameters stored in the file (H5MD /parameters attributes, e.g. "charging.kappa"); may be
+  /// empty.
   virtual const std::map<std::string, std::string>& parameters() const = 0;
   /// The file being read.
   virtual const std::string& path() const = 0;

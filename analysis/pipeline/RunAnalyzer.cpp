@@ -55,24 +55,65 @@ std::pair<double, double> fitWindow(const AnalysisOptions& o, const std::vector<
   return {last / 10.0, last};
 }
 
-const std::vector<std::string> FISHER_COLUMNS = {
-    "t", "tau_grid", "tau_grid_err", "xmin_grid", "tail_grid", "ks_grid", "tau_particle", "tau_particle_err",
-    "xmin_particle", "tail_particle", "ks_particle", "tau_ls_grid", "tau_ls_grid_err", "bins_ls_grid",
-    "tau_ls_particle", "tau_ls_particle_err", "bins_ls_particle"};
+const std::vector<std::string> FISHER_COLUMNS = {"t",
+                                                 "tau_grid",
+                                                 "tau_grid_err",
+                                                 "xmin_grid",
+                                                 "tail_grid",
+                                                 "ks_grid",
+                                                 "tau_particle",
+                                                 "tau_particle_err",
+                                                 "xmin_particle",
+                                                 "tail_particle",
+                                                 "ks_particle",
+                                                 "tau_ls_grid",
+                                                 "tau_ls_grid_err",
+                                                 "bins_ls_grid",
+                                                 "tau_ls_particle",
+                                                 "tau_ls_particle_err",
+                                                 "bins_ls_particle"};
 
-const std::vector<std::string> FITS_COLUMNS = {
-    "z_grid", "z_grid_err", "z_grid_low", "z_grid_high", "z_particle", "z_particle_err", "z_particle_low",
-    "z_particle_high", "fit_t_min", "fit_t_max", "fit_points", "charging_rate_exponent", "charging_rate_exponent_err",
-    "charging_rate_low", "charging_rate_high", "charging_rate_expected", "kappa", "charge_fit_t_min",
-    "charge_fit_t_max", "charge_fit_points", "runs", "onset_time_grid", "onset_time_grid_err",
-    "onset_time_particle", "onset_time_particle_err", "onset_S_base_grid", "onset_factor", "onset_t_base"};
+const std::vector<std::string> FITS_COLUMNS = {"z_grid",
+                                               "z_grid_err",
+                                               "z_grid_low",
+                                               "z_grid_high",
+                                               "z_particle",
+                                               "z_particle_err",
+                                               "z_particle_low",
+                                               "z_particle_high",
+                                               "fit_t_min",
+                                               "fit_t_max",
+                                               "fit_points",
+                                               "charging_rate_exponent",
+                                               "charging_rate_exponent_err",
+                                               "charging_rate_low",
+                                               "charging_rate_high",
+                                               "charging_rate_expected",
+                                               "kappa",
+                                               "charge_fit_t_min",
+                                               "charge_fit_t_max",
+                                               "charge_fit_points",
+                                               "runs",
+                                               "onset_time_grid",
+                                               "onset_time_grid_err",
+                                               "onset_time_particle",
+                                               "onset_time_particle_err",
+                                               "onset_S_base_grid",
+                                               "onset_factor",
+                                               "onset_t_base"};
 const char* FITS_DESCRIPTION =
-    "growth exponent z of S(t) ~ t^z (grid and particle clusters) by least squares of ln S on ln t over "
-    "[fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; bootstrap over runs, percentile "
-    "interval, for the ensemble); err = standard error (bootstrap: std of replicates); charging_rate_exponent: "
-    "the same fit to d<|q|>/dt over [charge_fit_t_min, charge_fit_t_max], beside the expected -5/6 - 5 kappa/3; "
-    "onset_time: first time S reaches onset_factor x its median over 0 < t <= onset_t_base (onset_S_base_grid), "
-    "interpolated in (ln t, ln S); ensemble: onset of the mean S, err = standard error of the runs' onsets";
+    "growth exponent z of S(t) ~ t^z (grid and particle clusters) by least squares of ln S on ln t "
+    "over "
+    "[fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; bootstrap "
+    "over runs, percentile "
+    "interval, for the ensemble); err = standard error (bootstrap: std of replicates); "
+    "charging_rate_exponent: "
+    "the same fit to d<|q|>/dt over [charge_fit_t_min, charge_fit_t_max], beside the expected -5/6 "
+    "- 5 kappa/3; "
+    "onset_time: first time S reaches onset_factor x its median over 0 < t <= onset_t_base "
+    "(onset_S_base_grid), "
+    "interpolated in (ln t, ln S); ensemble: onset of the mean S, err = standard error of the "
+    "runs' onsets";
 
 /// Onset times of one table's S_grid and S_particle, with the standard errors over runs (ensemble).
 struct Onsets {
@@ -80,22 +121,44 @@ struct Onsets {
   double grid_err = NaN, particle_err = NaN;
 };
 
-std::vector<double> fitColumns(const PowerLawFitResult& g, const PowerLawFitResult& p, double t0, double t1,
-                               const PowerLawFitResult& q, double kappa, double q0, double q1, double runs,
-                               const Onsets& on, const AnalysisOptions& o) {
+std::vector<double> fitColumns(const PowerLawFitResult& g, const PowerLawFitResult& p, double t0,
+                               double t1, const PowerLawFitResult& q, double kappa, double q0,
+                               double q1, double runs, const Onsets& on, const AnalysisOptions& o) {
   auto v = [](const PowerLawFitResult& f, double x) { return f.valid ? x : NaN; };
   auto ov = [](const OnsetTime& m, double x) { return m.valid ? x : NaN; };
-  return {v(g, g.exponent), v(g, g.stderr_z), v(g, g.low),  v(g, g.high), v(p, p.exponent), v(p, p.stderr_z),
-          v(p, p.low),      v(p, p.high),     t0,           t1,           static_cast<double>(std::max(g.points, p.points)),
-          v(q, q.exponent), v(q, q.stderr_z), v(q, q.low),  v(q, q.high), expectedChargingRateExponent(kappa),
-          kappa,            q0,               q1,           static_cast<double>(q.points), runs,
-          ov(on.grid, on.grid.t_c), on.grid_err, ov(on.particle, on.particle.t_c), on.particle_err,
-          on.grid.S_base > 0 ? on.grid.S_base : NaN, o.onset_factor, o.onset_t_base};
+  return {v(g, g.exponent),
+          v(g, g.stderr_z),
+          v(g, g.low),
+          v(g, g.high),
+          v(p, p.exponent),
+          v(p, p.stderr_z),
+          v(p, p.low),
+          v(p, p.high),
+          t0,
+          t1,
+          static_cast<double>(std::max(g.points, p.points)),
+          v(q, q.exponent),
+          v(q, q.stderr_z),
+          v(q, q.low),
+          v(q, q.high),
+          expectedChargingRateExponent(kappa),
+          kappa,
+          q0,
+          q1,
+          static_cast<double>(q.points),
+          runs,
+          ov(on.grid, on.grid.t_c),
+          on.grid_err,
+          ov(on.particle, on.particle.t_c),
+          on.particle_err,
+          on.grid.S_base > 0 ? on.grid.S_base : NaN,
+          o.onset_factor,
+          o.onset_t_base};
 }
 
 /// Onsets of S_grid and S_particle; empty series give invalid onsets.
-Onsets onsetsOf(const std::vector<double>& t, const std::vector<double>& Sg, const std::vector<double>& Sp,
-                const AnalysisOptions& o) {
+Onsets onsetsOf(const std::vector<double>& t, const std::vector<double>& Sg,
+                const std::vector<double>& Sp, const AnalysisOptions& o) {
   Onsets on;
   on.grid = onsetTime(t, Sg, o.onset_factor, o.onset_t_base);
   on.particle = onsetTime(t, Sp, o.onset_factor, o.onset_t_base);
@@ -125,10 +188,12 @@ std::vector<double> lsColumns(const std::map<std::uint64_t, std::uint64_t>& n_s,
 }  // namespace
 
 void AnalysisOptions::validate() const {
-  require(slope_ratio > 1.0 && std::isfinite(slope_ratio), "--slope-ratio must be > 1 (got " + common::formatReal(slope_ratio) + ").");
+  require(slope_ratio > 1.0 && std::isfinite(slope_ratio),
+          "--slope-ratio must be > 1 (got " + common::formatReal(slope_ratio) + ").");
   require(fit_t_min >= 0 && fit_t_max >= 0 && (fit_t_max == 0 || fit_t_max > fit_t_min),
           "--fit-window must be two times 0 <= t_min < t_max.");
-  require(charge_fit_t_max > charge_fit_t_min && charge_fit_t_min >= 0, "--charge-fit-window must be two times 0 <= t_min < t_max.");
+  require(charge_fit_t_max > charge_fit_t_min && charge_fit_t_min >= 0,
+          "--charge-fit-window must be two times 0 <= t_min < t_max.");
   require(speed_max > 0 && std::isfinite(speed_max), "--speed-max must be positive.");
   require(speed_bins >= 1 && speed_bins <= 100000, "--speed-bins must lie in [1, 100000].");
   require(msd_origins == "auto" || msd_origins == "t0" || msd_origins == "all",
@@ -138,9 +203,13 @@ void AnalysisOptions::validate() const {
   require(mle_min_tail >= 2, "--mle-min-tail must be at least 2.");
   require(bootstrap_replicates >= 10, "--bootstrap must be at least 10 replicates.");
   require(lammps_dt >= 0 && std::isfinite(lammps_dt), "--lammps-dt must be >= 0.");
-  require(onset_factor > 1 && std::isfinite(onset_factor), "--onset-factor must be > 1 (got " + common::formatReal(onset_factor) + ").");
-  require(onset_t_base > 0 && std::isfinite(onset_t_base), "--onset-baseline must be > 0 (got " + common::formatReal(onset_t_base) + ").");
-  require(fisher_bin_ratio > 1 && fisher_bin_ratio <= 100, "--fisher-bin-ratio must lie in (1, 100] (got " + common::formatReal(fisher_bin_ratio) + ").");
+  require(onset_factor > 1 && std::isfinite(onset_factor),
+          "--onset-factor must be > 1 (got " + common::formatReal(onset_factor) + ").");
+  require(onset_t_base > 0 && std::isfinite(onset_t_base),
+          "--onset-baseline must be > 0 (got " + common::formatReal(onset_t_base) + ").");
+  require(fisher_bin_ratio > 1 && fisher_bin_ratio <= 100,
+          "--fisher-bin-ratio must lie in (1, 100] (got " + common::formatReal(fisher_bin_ratio) +
+              ").");
   // The constructors validate their own parameters (and name them).
   GridClusters g(grid);
   ParticleClusters p(particle);
@@ -173,34 +242,52 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   MsdFromOrigin msd0;
   MsdAllOrigins msd_all(o.msd_origins == "t0" ? 0 : o.msd_max_bytes);
 
-  Table S_t("S_t",
-            "t: time [sqrt(m d^2/T0)]; step; S = sum s^2 N_s / sum s N_s (grid: s in sites; particle: s in particles); "
-            "clusters = number of clusters; largest = largest s; occupied_fraction = occupied grid sites / all sites; "
-            "mean_contacts = partners within 1 + tolerance per particle; z_local = ln[S(t)/S(t/p)]/ln p",
-            {"t", "step", "S_grid", "S_particle", "clusters_grid", "clusters_particle", "largest_grid", "largest_particle",
-             "occupied_fraction", "mean_contacts", "z_local_grid", "z_local_particle"});
-  Table Ns_grid("N_s_grid", "t: time; s: cluster size in grid sites; N_s: number of grid clusters of s sites",
+  Table S_t(
+      "S_t",
+      "t: time [sqrt(m d^2/T0)]; step; S = sum s^2 N_s / sum s N_s (grid: s in sites; particle: s "
+      "in particles); "
+      "clusters = number of clusters; largest = largest s; occupied_fraction = occupied grid sites "
+      "/ all sites; "
+      "mean_contacts = partners within 1 + tolerance per particle; z_local = ln[S(t)/S(t/p)]/ln p",
+      {"t", "step", "S_grid", "S_particle", "clusters_grid", "clusters_particle", "largest_grid",
+       "largest_particle", "occupied_fraction", "mean_contacts", "z_local_grid",
+       "z_local_particle"});
+  Table Ns_grid("N_s_grid",
+                "t: time; s: cluster size in grid sites; N_s: number of grid clusters of s sites",
                 {"t", "s", "N_s"}, 2);
   Ns_grid.missing_is_zero = true;
-  Table Ns_part("N_s_particle", "t: time; s: cluster size in particles; N_s: number of particle clusters of s particles",
-                {"t", "s", "N_s"}, 2);
+  Table Ns_part(
+      "N_s_particle",
+      "t: time; s: cluster size in particles; N_s: number of particle clusters of s particles",
+      {"t", "s", "N_s"}, 2);
   Ns_part.missing_is_zero = true;
   Table fisher("fisher",
-               "Fisher exponent tau of N_s ~ s^-tau per frame: discrete power-law MLE with xmin by KS distance "
-               "(Clauset, Shalizi & Newman 2009); tau_err = 1/sqrt(n I(tau)); tail = clusters with s >= xmin; ks = KS "
-               "distance; NaN when fewer than min_tail clusters or no maximum; tau_ls: the paper's estimator, minus the "
-               "least-squares slope of ln N_s on ln s over logarithmic bins (analysis/stats/GrowthMarkers.h), "
+               "Fisher exponent tau of N_s ~ s^-tau per frame: discrete power-law MLE with xmin by "
+               "KS distance "
+               "(Clauset, Shalizi & Newman 2009); tau_err = 1/sqrt(n I(tau)); tail = clusters with "
+               "s >= xmin; ks = KS "
+               "distance; NaN when fewer than min_tail clusters or no maximum; tau_ls: the paper's "
+               "estimator, minus the "
+               "least-squares slope of ln N_s on ln s over logarithmic bins "
+               "(analysis/stats/GrowthMarkers.h), "
                "bins_ls = non-empty bins (NaN below 3)",
                FISHER_COLUMNS);
-  Table thermo("thermo",
-               "t: time; T_g = <|v - <v>|^2>/3 [T0]; a2 = (3/5)<c^4>/<c^2>^2 - 1 (Sonine) and its standard error; "
-               "mean_abs_q = <|q|> [q_ref]; rms_q; net_q = sum q; max_abs_q; corr_absq_speed = Pearson correlation of |q~| and v~",
-               {"t", "T_g", "a2", "a2_err", "mean_abs_q", "rms_q", "net_q", "max_abs_q", "corr_absq_speed"});
-  Table msd("msd", "t: time; msd = <|r(t) - r(t0)|^2> [d^2] from the first frame t0, unwrapped with image counts",
+  Table thermo(
+      "thermo",
+      "t: time; T_g = <|v - <v>|^2>/3 [T0]; a2 = (3/5)<c^4>/<c^2>^2 - 1 (Sonine) and its standard "
+      "error; "
+      "mean_abs_q = <|q|> [q_ref]; rms_q; net_q = sum q; max_abs_q; corr_absq_speed = Pearson "
+      "correlation of |q~| and v~",
+      {"t", "T_g", "a2", "a2_err", "mean_abs_q", "rms_q", "net_q", "max_abs_q", "corr_absq_speed"});
+  Table msd("msd",
+            "t: time; msd = <|r(t) - r(t0)|^2> [d^2] from the first frame t0, unwrapped with image "
+            "counts",
             {"t", "msd"});
   Table speed("speed_dist",
-              "t: time; v_low, v_high: bin of v~ = |c|/<|c|^2>^{1/2}; f: probability density of v~; f_maxwell: the "
-              "Maxwellian sqrt(54/pi) v~^2 exp(-3 v~^2/2) averaged over the bin; count: particles in the bin",
+              "t: time; v_low, v_high: bin of v~ = |c|/<|c|^2>^{1/2}; f: probability density of "
+              "v~; f_maxwell: the "
+              "Maxwellian sqrt(54/pi) v~^2 exp(-3 v~^2/2) averaged over the bin; count: particles "
+              "in the bin",
               {"t", "v_low", "v_high", "f", "f_maxwell", "count"}, 3);
   std::vector<std::string> stick_cols{"t", "n_stick_mean"};
   Table nstick("nstick", "", {});
@@ -220,10 +307,12 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
         n_particles = f.size();
       } else if (f.size() != n_particles) {
         throw TrajectoryError(reader->path(), f.index,
-                              "has " + std::to_string(f.size()) + " particles, the first frame had " + std::to_string(n_particles));
+                              "has " + std::to_string(f.size()) +
+                                  " particles, the first frame had " + std::to_string(n_particles));
       }
       if (!first && !t_series.empty() && !(f.time > t_series.back()))
-        throw TrajectoryError(reader->path(), f.index, "time " + common::formatReal(f.time) + " does not increase");
+        throw TrajectoryError(reader->path(), f.index,
+                              "time " + common::formatReal(f.time) + " does not increase");
     } catch (const TrajectoryError& e) {
       if (!o.allow_partial || r.frames == 0) throw;
       r.partial = true;
@@ -239,11 +328,13 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
         stick_cols.push_back("n_stick_id" + std::to_string(f.id[i]));
       }
       nstick = Table("nstick",
-                     "t: time; n_stick_id<k>: number of particles within 1 + tolerance of tracked particle k (N_stick, "
+                     "t: time; n_stick_id<k>: number of particles within 1 + tolerance of tracked "
+                     "particle k (N_stick, "
                      "contact persistence); n_stick_mean: their mean",
                      stick_cols);
       if (!f.hasImages()) r.notes.push_back("no image counts in the trajectory: MSD skipped");
-      if (!have_vel) r.notes.push_back("no velocities: T_g, a2, f(v~) and the charge-speed scatter skipped");
+      if (!have_vel)
+        r.notes.push_back("no velocities: T_g, a2, f(v~) and the charge-speed scatter skipped");
       if (!have_q) r.notes.push_back("no charges: charge observables skipped");
       first = false;
     }
@@ -259,7 +350,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       cg = static_cast<double>(c.clusters);
       lg = static_cast<double>(c.largest);
       occ = grid.occupiedFraction();
-      for (const auto& [s, count] : c.n_s) Ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
+      for (const auto& [s, count] : c.n_s)
+        Ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
       fg = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
       ls_g = lsColumns(c.n_s, o.fisher_bin_ratio);
       if (cb.grid) cb.grid(f, grid);
@@ -271,7 +363,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       cp = static_cast<double>(c.clusters);
       lp = static_cast<double>(c.largest);
       mc = 2.0 * static_cast<double>(part.bonds()) / static_cast<double>(f.size());
-      for (const auto& [s, count] : c.n_s) Ns_part.add({t, static_cast<double>(s), static_cast<double>(count)});
+      for (const auto& [s, count] : c.n_s)
+        Ns_part.add({t, static_cast<double>(s), static_cast<double>(count)});
       fp = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
       ls_p = lsColumns(c.n_s, o.fisher_bin_ratio);
       std::vector<double> row{t, 0.0};
@@ -287,9 +380,10 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
     Sp.push_back(sp);
     S_t.add({t, static_cast<double>(f.step), sg, sp, cg, cp, lg, lp, occ, mc, NaN, NaN});
     auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
-    fisher.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)), fv(fg, double(fg.n_tail)), fv(fg, fg.ks),
-                fv(fp, fp.tau), fv(fp, fp.tau_err), fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks),
-                ls_g[0], ls_g[1], ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
+    fisher.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)),
+                fv(fg, double(fg.n_tail)), fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err),
+                fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks), ls_g[0], ls_g[1],
+                ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
 
     std::vector<double> speeds;
     VelocityMoments vm;
@@ -301,8 +395,10 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       const auto dens = hist.density();
       for (int k = 0; k < hist.bins(); ++k) {
         const double lo = hist.binLow(k), hi = lo + hist.binWidth();
-        const double fm = (maxwellianScaledSpeedCdf(hi) - maxwellianScaledSpeedCdf(lo)) / hist.binWidth();
-        speed.add({t, lo, hi, dens[static_cast<std::size_t>(k)], fm, hist.counts()[static_cast<std::size_t>(k)]});
+        const double fm =
+            (maxwellianScaledSpeedCdf(hi) - maxwellianScaledSpeedCdf(lo)) / hist.binWidth();
+        speed.add({t, lo, hi, dens[static_cast<std::size_t>(k)], fm,
+                   hist.counts()[static_cast<std::size_t>(k)]});
       }
     }
     ChargeMoments qm{NaN, NaN, NaN, NaN};
@@ -343,14 +439,16 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   }
 
   // Local slopes of S(t).
-  const auto zg = localSlope(t_series, Sg, o.slope_ratio), zp = localSlope(t_series, Sp, o.slope_ratio);
+  const auto zg = localSlope(t_series, Sg, o.slope_ratio),
+             zp = localSlope(t_series, Sp, o.slope_ratio);
   for (std::size_t k = 0; k < S_t.rows.size(); ++k) {
     S_t.rows[k][10] = zg[k];
     S_t.rows[k][11] = zp[k];
   }
   // Fits.
   const auto [w0, w1] = fitWindow(o, t_series);
-  const PowerLawFitResult fit_g = fitPowerLaw(t_series, Sg, w0, w1), fit_p = fitPowerLaw(t_series, Sp, w0, w1);
+  const PowerLawFitResult fit_g = fitPowerLaw(t_series, Sg, w0, w1),
+                          fit_p = fitPowerLaw(t_series, Sp, w0, w1);
   PowerLawFitResult fit_q;
   if (have_q) {
     const auto [tr, rate] = chargingRate(t_series, mean_q);
@@ -358,8 +456,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   }
   Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
   fits.ensemble = false;
-  fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, r.kappa, o.charge_fit_t_min, o.charge_fit_t_max, 1,
-                      onsetsOf(t_series, Sg, Sp, o), o));
+  fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, r.kappa, o.charge_fit_t_min, o.charge_fit_t_max,
+                      1, onsetsOf(t_series, Sg, Sp, o), o));
 
   r.tables.push_back(std::move(S_t));
   if (o.grid_clusters) r.tables.push_back(std::move(Ns_grid));
@@ -372,13 +470,15 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       std::vector<double> lag;
       const auto m = msd_all.compute(lag);
       Table ma("msd_all_origins",
-               "lag: time lag [sqrt(m d^2/T0)]; msd = <|r(t0 + lag) - r(t0)|^2> averaged over all time origins t0 "
+               "lag: time lag [sqrt(m d^2/T0)]; msd = <|r(t0 + lag) - r(t0)|^2> averaged over all "
+               "time origins t0 "
                "(FFT method; frames evenly spaced)",
                {"lag", "msd"});
       for (std::size_t k = 0; k < m.size(); ++k) ma.add({lag[k], m[k]});
       r.tables.push_back(std::move(ma));
     } else if (o.msd_origins == "all") {
-      throw std::invalid_argument("--msd-origins all: not possible for '" + path + "': " + msd_all.reason());
+      throw std::invalid_argument("--msd-origins all: not possible for '" + path +
+                                  "': " + msd_all.reason());
     } else {
       r.notes.push_back("all-origins MSD skipped: " + msd_all.reason());
     }
@@ -386,7 +486,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   if (!speed.rows.empty()) r.tables.push_back(std::move(speed));
   if (!last_q.empty()) {
     Table sc("charge_speed",
-             "id: particle id; q_tilde = q / <q^2>^{1/2}; v_tilde = |c| / <|c|^2>^{1/2} (last frame analysed, at time t)",
+             "id: particle id; q_tilde = q / <q^2>^{1/2}; v_tilde = |c| / <|c|^2>^{1/2} (last "
+             "frame analysed, at time t)",
              {"t", "id", "q_tilde", "v_tilde"});
     sc.ensemble = false;
     sc.rows.reserve(last_q.size());
@@ -429,7 +530,8 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
   // Pooled Fisher exponents: N_s summed over runs at each time.
   {
     Table pooled("fisher_pooled",
-                 "Fisher exponent of N_s summed over all runs at each time (MLE, xmin by KS, and the paper's "
+                 "Fisher exponent of N_s summed over all runs at each time (MLE, xmin by KS, and "
+                 "the paper's "
                  "log-binned least squares, as in fisher.csv)",
                  FISHER_COLUMNS);
     std::map<double, std::map<std::uint64_t, std::uint64_t>> g, p;
@@ -440,7 +542,8 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
         for (const auto& row : r.table(name).rows) {
           char buf[32];
           std::snprintf(buf, sizeof buf, "%.9g", row[0]);
-          target[std::strtod(buf, nullptr)][static_cast<std::uint64_t>(row[1])] += static_cast<std::uint64_t>(row[2]);
+          target[std::strtod(buf, nullptr)][static_cast<std::uint64_t>(row[1])] +=
+              static_cast<std::uint64_t>(row[2]);
         }
       }
     }
@@ -460,9 +563,10 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
         ls_p = lsColumns(p[t], o.fisher_bin_ratio);
       }
       auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
-      pooled.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)), fv(fg, double(fg.n_tail)),
-                  fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err), fv(fp, double(fp.xmin)),
-                  fv(fp, double(fp.n_tail)), fv(fp, fp.ks), ls_g[0], ls_g[1], ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
+      pooled.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)),
+                  fv(fg, double(fg.n_tail)), fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err),
+                  fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks), ls_g[0],
+                  ls_g[1], ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
     }
     out.push_back(std::move(pooled));
   }
@@ -486,7 +590,8 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
           std::vector<double> v;
           std::size_t j = 0;
           for (double tk : t) {
-            while (j < tt.size() && std::fabs(tt[j] - tk) > 1e-9 * std::max(1.0, std::fabs(tk))) ++j;
+            while (j < tt.size() && std::fabs(tt[j] - tk) > 1e-9 * std::max(1.0, std::fabs(tk)))
+              ++j;
             v.push_back(j < tt.size() ? y[j] : NaN);
           }
           ys.push_back(std::move(v));
@@ -494,8 +599,10 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
         return ys;
       };
       const auto [w0, w1] = fitWindow(o, t);
-      auto fitOf = [&](const std::vector<std::vector<double>>& ys, const std::vector<double>& tt, double a, double b) {
-        if (ys.size() >= 2) return bootstrapPowerLaw(tt, ys, a, b, o.bootstrap_replicates, o.bootstrap_seed);
+      auto fitOf = [&](const std::vector<std::vector<double>>& ys, const std::vector<double>& tt,
+                       double a, double b) {
+        if (ys.size() >= 2)
+          return bootstrapPowerLaw(tt, ys, a, b, o.bootstrap_replicates, o.bootstrap_seed);
         return fitPowerLaw(tt, ys.front(), a, b);
       };
       const auto fg = fitOf(seriesOf("S_grid", "S_t"), t, w0, w1);
@@ -518,18 +625,20 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
       }
       // Onset: of the ensemble-mean S (every frame time, as the local slope of the mean), with the
       // standard error of the runs' own onsets.
-      Onsets on = onsetsOf(st->values("t"), st->values("S_grid_mean"), st->values("S_particle_mean"), o);
+      Onsets on =
+          onsetsOf(st->values("t"), st->values("S_grid_mean"), st->values("S_particle_mean"), o);
       std::vector<double> tg, tp;
       for (const auto& r : runs) {
         const Table& tb = r.table("S_t");
-        const Onsets one = onsetsOf(tb.values("t"), tb.values("S_grid"), tb.values("S_particle"), o);
+        const Onsets one =
+            onsetsOf(tb.values("t"), tb.values("S_grid"), tb.values("S_particle"), o);
         tg.push_back(one.grid.valid ? one.grid.t_c : NaN);
         tp.push_back(one.particle.valid ? one.particle.t_c : NaN);
       }
       on.grid_err = standardErrorOfAll(tg);
       on.particle_err = standardErrorOfAll(tp);
-      fits.add(fitColumns(fg, fp, w0, w1, fq, runs.front().kappa, o.charge_fit_t_min, o.charge_fit_t_max,
-                          static_cast<double>(runs.size()), on, o));
+      fits.add(fitColumns(fg, fp, w0, w1, fq, runs.front().kappa, o.charge_fit_t_min,
+                          o.charge_fit_t_max, static_cast<double>(runs.size()), on, o));
     }
     out.push_back(std::move(fits));
   }

@@ -9,8 +9,8 @@ namespace granagg::analysis {
 
 void Table::add(std::vector<double> row) {
   if (row.size() != columns.size())
-    throw std::logic_error("table " + name + ": row of " + std::to_string(row.size()) + " values, " +
-                           std::to_string(columns.size()) + " columns");
+    throw std::logic_error("table " + name + ": row of " + std::to_string(row.size()) +
+                           " values, " + std::to_string(columns.size()) + " columns");
   rows.push_back(std::move(row));
 }
 
@@ -43,8 +43,9 @@ Table ensembleAverage(const std::vector<const Table*>& runs) {
   const std::size_t nk = first.key_columns, nc = first.columns.size();
   Table out;
   out.name = first.name;
-  out.description = first.description + "; ensemble: <col>_mean over runs, <col>_se = standard error of the mean, "
-                                        "n_runs = runs holding the row";
+  out.description = first.description +
+                    "; ensemble: <col>_mean over runs, <col>_se = standard error of the mean, "
+                    "n_runs = runs holding the row";
   out.key_columns = nk;
   out.missing_is_zero = first.missing_is_zero;
   for (std::size_t k = 0; k < nk; ++k) out.columns.push_back(first.columns[k]);
@@ -61,7 +62,9 @@ Table ensembleAverage(const std::vector<const Table*>& runs) {
   };
   std::map<std::vector<double>, Acc> acc;
   for (const Table* t : runs) {
-    if (t->columns != first.columns) throw std::invalid_argument("ensembleAverage: table " + first.name + " differs between runs.");
+    if (t->columns != first.columns)
+      throw std::invalid_argument("ensembleAverage: table " + first.name +
+                                  " differs between runs.");
     for (const auto& r : t->rows) {
       std::vector<double> key(r.begin(), r.begin() + static_cast<long>(nk));
       for (double& x : key) x = round9(x);
@@ -93,7 +96,8 @@ Table ensembleAverage(const std::vector<const Table*>& runs) {
         continue;
       }
       const double mean = a.sum[k] / n;
-      const double var = n > 1 ? std::max(0.0, (a.sum2[k] - n * mean * mean) / (n - 1)) : std::nan("");
+      const double var =
+          n > 1 ? std::max(0.0, (a.sum2[k] - n * mean * mean) / (n - 1)) : std::nan("");
       row.push_back(mean);
       row.push_back(n > 1 ? std::sqrt(var / n) : std::nan(""));
     }
@@ -120,7 +124,8 @@ Table stackRuns(const std::vector<const Table*>& runs) {
   return out;
 }
 
-void writeCsv(const Table& t, const std::string& path, const common::Provenance& provenance, bool overwrite) {
+void writeCsv(const Table& t, const std::string& path, const common::Provenance& provenance,
+              bool overwrite) {
   common::Provenance p = provenance;
   p.add("table", t.name);
   p.add("columns", t.description);

@@ -9,17 +9,21 @@
 namespace granagg::analysis {
 
 struct Table {
-  std::string name;                  ///< file stem, e.g. "S_t"
-  std::string description;           ///< what the columns mean, with units (goes into provenance)
+  std::string name;         ///< file stem, e.g. "S_t"
+  std::string description;  ///< what the columns mean, with units (goes into provenance)
   std::vector<std::string> columns;
-  std::size_t key_columns = 1;       ///< leading columns that identify a row across runs (t; t and s)
-  bool missing_is_zero = false;      ///< ensemble: a key absent from a run counts as 0 (counts N_s)
-  bool ensemble = true;              ///< false: per-run only (e.g. per-particle scatter)
+  std::size_t key_columns = 1;   ///< leading columns that identify a row across runs (t; t and s)
+  bool missing_is_zero = false;  ///< ensemble: a key absent from a run counts as 0 (counts N_s)
+  bool ensemble = true;          ///< false: per-run only (e.g. per-particle scatter)
   std::vector<std::vector<double>> rows;
 
   Table() = default;
-  Table(std::string name_, std::string description_, std::vector<std::string> columns_, std::size_t keys = 1)
-      : name(std::move(name_)), description(std::move(description_)), columns(std::move(columns_)), key_columns(keys) {}
+  Table(std::string name_, std::string description_, std::vector<std::string> columns_,
+        std::size_t keys = 1)
+      : name(std::move(name_)),
+        description(std::move(description_)),
+        columns(std::move(columns_)),
+        key_columns(keys) {}
   /// Appends a row; throws std::logic_error when its length differs from the columns.
   void add(std::vector<double> row);
   /// Index of a column; throws std::out_of_range naming it.
@@ -39,6 +43,7 @@ Table ensembleAverage(const std::vector<const Table*>& runs);
 Table stackRuns(const std::vector<const Table*>& runs);
 
 /// Writes a table as CSV with provenance (description added as "columns = ...").
-void writeCsv(const Table& table, const std::string& path, const common::Provenance& provenance, bool overwrite);
+void writeCsv(const Table& table, const std::string& path, const common::Provenance& provenance,
+              bool overwrite);
 
 }  // namespace granagg::analysis

@@ -25,8 +25,8 @@ double pearson(const std::vector<double>& x, const std::vector<double>& y);
 
 /// Charging rate between consecutive frames: r_k = (m_{k+1} - m_k) / (t_{k+1} - t_k) placed at
 /// the geometric mean time sqrt(t_k t_{k+1}) (log-spaced frames; arithmetic mean when t_k = 0).
-std::pair<std::vector<double>, std::vector<double>> chargingRate(const std::vector<double>& t,
-                                                                 const std::vector<double>& mean_abs_q);
+std::pair<std::vector<double>, std::vector<double>> chargingRate(
+    const std::vector<double>& t, const std::vector<double>& mean_abs_q);
 
 /// Exponent of d<|q|>/dt ~ t^x expected from T_g ~ t^{-5/3} and |dq| ~ v^{2 kappa}:
 /// x = -5/6 - 5 kappa / 3 (design.md section 2, the paper's corrected law; -13/6 at kappa = 0.8).

@@ -11,14 +11,16 @@ namespace granagg::analysis {
 
 void MsdFromOrigin::accumulate(const Frame& f) {
   if (!f.hasImages())
-    throw std::invalid_argument("MSD needs image counts (or unwrapped positions); frame " + std::to_string(f.index) + " has none");
+    throw std::invalid_argument("MSD needs image counts (or unwrapped positions); frame " +
+                                std::to_string(f.index) + " has none");
   const std::size_t n = f.size();
   if (m_t.empty()) {
     m_origin.resize(3 * n);
     for (std::size_t i = 0; i < n; ++i)
       for (int d = 0; d < 3; ++d) m_origin[3 * i + d] = f.unwrapped(i, d);
   } else if (3 * n != m_origin.size()) {
-    throw std::invalid_argument("MSD: frame " + std::to_string(f.index) + " has " + std::to_string(n) + " particles, the origin had " +
+    throw std::invalid_argument("MSD: frame " + std::to_string(f.index) + " has " +
+                                std::to_string(n) + " particles, the origin had " +
                                 std::to_string(m_origin.size() / 3));
   }
   double sum = 0.0;
@@ -69,7 +71,8 @@ void MsdAllOrigins::accumulate(const Frame& f) {
 }
 
 std::vector<double> MsdAllOrigins::compute(std::vector<double>& lag) const {
-  if (!available()) throw std::logic_error("MsdAllOrigins::compute: unavailable (" + m_reason + ")");
+  if (!available())
+    throw std::logic_error("MsdAllOrigins::compute: unavailable (" + m_reason + ")");
   const std::size_t F = m_frames, N = m_n, P = 2 * F;  // zero padding to 2F: no circular wrap
   lag.resize(F);
   for (std::size_t m = 0; m < F; ++m) lag[m] = m_dt * static_cast<double>(m);
@@ -78,8 +81,10 @@ std::vector<double> MsdAllOrigins::compute(std::vector<double>& lag) const {
   std::vector<std::complex<double>> spec(P / 2 + 1);
   std::vector<double> ac(P), D(F);
   // FFTW planning is not thread-safe and this loop is cheap next to the frame loop: one thread.
-  fftw_plan fwd = fftw_plan_dft_r2c_1d(static_cast<int>(P), in.data(), reinterpret_cast<fftw_complex*>(spec.data()), FFTW_ESTIMATE);
-  fftw_plan bwd = fftw_plan_dft_c2r_1d(static_cast<int>(P), reinterpret_cast<fftw_complex*>(spec.data()), ac.data(), FFTW_ESTIMATE);
+  fftw_plan fwd = fftw_plan_dft_r2c_1d(static_cast<int>(P), in.data(),
+                                       reinterpret_cast<fftw_complex*>(spec.data()), FFTW_ESTIMATE);
+  fftw_plan bwd = fftw_plan_dft_c2r_1d(
+      static_cast<int>(P), reinterpret_cast<fftw_complex*>(spec.data()), ac.data(), FFTW_ESTIMATE);
   for (std::size_t i = 0; i < N; ++i) {
     std::fill(D.begin(), D.end(), 0.0);
     std::vector<double> s2(F, 0.0);
@@ -94,9 +99,11 @@ std::vector<double> MsdAllOrigins::compute(std::vector<double>& lag) const {
       fftw_execute(fwd);
       for (auto& c : spec) c = std::norm(c);
       fftw_execute(bwd);  // unnormalised: divide by P
-      for (std::size_t m = 0; m < F; ++m) s2[m] += ac[m] / static_cast<double>(P) / static_cast<double>(F - m);
+      for (std::size_t m = 0; m < F; ++m)
+        s2[m] += ac[m] / static_cast<double>(P) / static_cast<double>(F - m);
     }
-    // S1(m) = (1/(F-m)) sum_{k=0}^{F-1-m} [D(k) + D(k+m)], by the recursion Q(m) = Q(m-1) - D(m-1) - D(F-m).
+    // S1(m) = (1/(F-m)) sum_{k=0}^{F-1-m} [D(k) + D(k+m)], by the recursion Q(m) = Q(m-1) - D(m-1)
+    // - D(F-m).
     double Q = 0;
     for (double v : D) Q += 2 * v;
     for (std::size_t m = 0; m < F; ++m) {

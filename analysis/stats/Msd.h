@@ -44,7 +44,8 @@ class MsdAllOrigins {
   bool available() const { return m_available && m_frames >= 2; }
   /// Why it is unavailable ("" when available).
   const std::string& reason() const { return m_reason; }
-  /// Computes MSD(lag m * dt), m = 0..F-1; lag times in `lag`. Throws std::logic_error when unavailable.
+  /// Computes MSD(lag m * dt), m = 0..F-1; lag times in `lag`. Throws std::logic_error when
+  /// unavailable.
   std::vector<double> compute(std::vector<double>& lag) const;
   void reset();
 

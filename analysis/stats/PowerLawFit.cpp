@@ -10,15 +10,17 @@
 
 namespace granagg::analysis {
 
-PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<double>& y, double t_min, double t_max,
-                              double confidence) {
+PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<double>& y,
+                              double t_min, double t_max, double confidence) {
   if (t.size() != y.size()) throw std::invalid_argument("fitPowerLaw: t and y differ in length.");
-  if (!(confidence > 0.0 && confidence < 1.0)) throw std::invalid_argument("fitPowerLaw: confidence must lie in (0, 1).");
+  if (!(confidence > 0.0 && confidence < 1.0))
+    throw std::invalid_argument("fitPowerLaw: confidence must lie in (0, 1).");
   std::vector<double> lx, ly;
   for (std::size_t k = 0; k < t.size(); ++k)
     // Window ends include samples within a relative 1e-4 (WINDOW_SLACK): MD frames sit on whole
     // steps, so the frame meant for t = 1000 may be at 1000.001 and must not drop out.
-    if (t[k] > 0 && t[k] >= t_min * (1 - WINDOW_SLACK) && t[k] <= t_max * (1 + WINDOW_SLACK) && y[k] > 0 && std::isfinite(y[k]) && std::isfinite(t[k])) {
+    if (t[k] > 0 && t[k] >= t_min * (1 - WINDOW_SLACK) && t[k] <= t_max * (1 + WINDOW_SLACK) &&
+        y[k] > 0 && std::isfinite(y[k]) && std::isfinite(t[k])) {
       lx.push_back(std::log(t[k]));
       ly.push_back(std::log(y[k]));
     }
@@ -38,12 +40,16 @@ PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<do
   return r;
 }
 
-PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t, const std::vector<std::vector<double>>& runs,
-                                    double t_min, double t_max, int replicates, std::uint64_t seed, double confidence) {
+PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t,
+                                    const std::vector<std::vector<double>>& runs, double t_min,
+                                    double t_max, int replicates, std::uint64_t seed,
+                                    double confidence) {
   if (runs.size() < 2) throw std::invalid_argument("bootstrapPowerLaw needs at least 2 runs.");
-  if (replicates < 10) throw std::invalid_argument("bootstrapPowerLaw needs at least 10 replicates.");
+  if (replicates < 10)
+    throw std::invalid_argument("bootstrapPowerLaw needs at least 10 replicates.");
   for (const auto& r : runs)
-    if (r.size() != t.size()) throw std::invalid_argument("bootstrapPowerLaw: every run needs one value per time.");
+    if (r.size() != t.size())
+      throw std::invalid_argument("bootstrapPowerLaw: every run needs one value per time.");
   auto meanOver = [&](const std::vector<std::size_t>& pick) {
     std::vector<double> m(t.size(), 0.0);
     for (std::size_t r : pick)
@@ -81,7 +87,8 @@ PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t, const std::vec
   return out;
 }
 
-std::vector<double> localSlope(const std::vector<double>& t, const std::vector<double>& y, double p) {
+std::vector<double> localSlope(const std::vector<double>& t, const std::vector<double>& y,
+                               double p) {
   if (t.size() != y.size()) throw std::invalid_argument("localSlope: t and y differ in length.");
   if (!(p > 1.0)) throw std::invalid_argument("localSlope requires p > 1.");
   std::vector<double> z(t.size(), std::nan(""));

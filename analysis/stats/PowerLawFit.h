@@ -25,20 +25,22 @@ struct PowerLawFitResult {
 /// Ordinary least squares of ln y on ln t over t_min <= t <= t_max; the interval is
 /// z +- t_{n-2, (1+confidence)/2} * stderr (GSL's Student-t quantile). Needs 3 points.
 /// Throws std::invalid_argument when t and y differ in length or confidence is not in (0, 1).
-PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<double>& y, double t_min,
-                              double t_max, double confidence = 0.95);
+PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<double>& y,
+                              double t_min, double t_max, double confidence = 0.95);
 
 /// Bootstrap over runs: `runs[r][k]` is run r's y at time t[k]. Each replicate draws the runs with
 /// replacement (std::mt19937_64 seeded with `seed`, so results are reproducible), averages y over
 /// them and fits the power law; the interval is the percentile interval of the replicate
 /// exponents. `exponent` is the fit to the mean over all runs. Needs 2 runs.
-PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t, const std::vector<std::vector<double>>& runs,
-                                    double t_min, double t_max, int replicates = 2000, std::uint64_t seed = 20091,
+PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t,
+                                    const std::vector<std::vector<double>>& runs, double t_min,
+                                    double t_max, int replicates = 2000, std::uint64_t seed = 20091,
                                     double confidence = 0.95);
 
 /// Local slope z(t_k) = ln[y(t_k) / y(t_k/p)] / ln p, y(t_k/p) interpolated linearly in
 /// (ln t, ln y) between the bracketing samples (exact for a power law). NaN where t_k/p lies
 /// before the first positive time or a y involved is not positive. t must increase. p > 1.
-std::vector<double> localSlope(const std::vector<double>& t, const std::vector<double>& y, double p);
+std::vector<double> localSlope(const std::vector<double>& t, const std::vector<double>& y,
+                               double p);
 
 }  // namespace granagg::analysis

@@ -20,7 +20,8 @@ constexpr double TAU_HI = 30.0;        // beyond this the tail is a single value
 /// ln zeta(tau, q); +inf on error (GSL's error handler is off: errors come back as status codes).
 double logHzeta(double tau, double q) {
   gsl_sf_result r;
-  if (gsl_sf_hzeta_e(tau, q, &r) != GSL_SUCCESS || !(r.val > 0)) return std::numeric_limits<double>::infinity();
+  if (gsl_sf_hzeta_e(tau, q, &r) != GSL_SUCCESS || !(r.val > 0))
+    return std::numeric_limits<double>::infinity();
   return std::log(r.val);
 }
 
@@ -48,15 +49,18 @@ double discretePowerLawCcdf(double tau, std::uint64_t xmin, std::uint64_t x) {
 
 namespace {
 
-using Histogram = std::vector<std::pair<std::uint64_t, std::uint64_t>>;  // (value, count), increasing values
+using Histogram =
+    std::vector<std::pair<std::uint64_t, std::uint64_t>>;  // (value, count), increasing values
 
 Histogram histogramOf(const std::vector<std::uint64_t>& samples) {
   std::vector<std::uint64_t> sorted = samples;
   std::sort(sorted.begin(), sorted.end());
   Histogram h;
   for (std::uint64_t x : sorted) {
-    if (!h.empty() && h.back().first == x) ++h.back().second;
-    else h.emplace_back(x, 1);
+    if (!h.empty() && h.back().first == x)
+      ++h.back().second;
+    else
+      h.emplace_back(x, 1);
   }
   return h;
 }
@@ -78,7 +82,8 @@ PowerLawMleResult fitTail(const Histogram& h, std::size_t first, std::uint64_t x
   gsl_function F{&negLogLik, &obj};
   // Starting point: the continuous approximation with the 1/2 shift (Clauset et al. eq. 3.7).
   double guess = 1.0 + static_cast<double>(r.n_tail) /
-                           (sum_log - static_cast<double>(r.n_tail) * std::log(static_cast<double>(xmin) - 0.5));
+                           (sum_log - static_cast<double>(r.n_tail) *
+                                          std::log(static_cast<double>(xmin) - 0.5));
   if (!std::isfinite(guess)) guess = 2.5;
   guess = std::clamp(guess, TAU_LO + 1e-3, TAU_HI - 1e-3);
   const double f_lo = negLogLik(TAU_LO, &obj), f_hi = negLogLik(TAU_HI, &obj);
@@ -104,7 +109,8 @@ PowerLawMleResult fitTail(const Histogram& h, std::size_t first, std::uint64_t x
   int status = GSL_CONTINUE;
   for (int it = 0; it < 200 && status == GSL_CONTINUE; ++it) {
     if (gsl_min_fminimizer_iterate(s) != GSL_SUCCESS) break;
-    status = gsl_min_test_interval(gsl_min_fminimizer_x_lower(s), gsl_min_fminimizer_x_upper(s), 1e-7, 0.0);
+    status = gsl_min_test_interval(gsl_min_fminimizer_x_lower(s), gsl_min_fminimizer_x_upper(s),
+                                   1e-7, 0.0);
   }
   r.tau = gsl_min_fminimizer_x_minimum(s);
   gsl_min_fminimizer_free(s);
@@ -112,7 +118,8 @@ PowerLawMleResult fitTail(const Histogram& h, std::size_t first, std::uint64_t x
   // step (1e-3) where truncation (~h^2) and round-off (~1e-16/h^2) errors are both ~1e-6.
   const double hstep = 1e-3;
   const double t0 = std::max(r.tau, TAU_LO + hstep);
-  const double d2 = (logHzeta(t0 + hstep, obj.xmin) - 2 * logHzeta(t0, obj.xmin) + logHzeta(t0 - hstep, obj.xmin)) /
+  const double d2 = (logHzeta(t0 + hstep, obj.xmin) - 2 * logHzeta(t0, obj.xmin) +
+                     logHzeta(t0 - hstep, obj.xmin)) /
                     (hstep * hstep);
   r.tau_err = d2 > 0 ? 1.0 / std::sqrt(static_cast<double>(r.n_tail) * d2) : std::nan("");
   r.valid = status == GSL_SUCCESS && std::isfinite(r.tau);
@@ -120,14 +127,17 @@ PowerLawMleResult fitTail(const Histogram& h, std::size_t first, std::uint64_t x
   // gap lies at a sample value or just below the next one.
   const double n = static_cast<double>(r.n_tail);
   const double lz = logHzeta(r.tau, obj.xmin);
-  auto cdf = [&](std::uint64_t v) { return 1.0 - std::exp(logHzeta(r.tau, static_cast<double>(v + 1)) - lz); };
+  auto cdf = [&](std::uint64_t v) {
+    return 1.0 - std::exp(logHzeta(r.tau, static_cast<double>(v + 1)) - lz);
+  };
   double D = 0.0, below = 0.0;
   if (h[first].first > xmin) D = std::fabs(0.0 - cdf(h[first].first - 1));
   for (std::size_t k = first; k < h.size(); ++k) {
     below += static_cast<double>(h[k].second);
     const double emp = below / n;
     D = std::max(D, std::fabs(emp - cdf(h[k].first)));
-    if (k + 1 < h.size() && h[k + 1].first > h[k].first + 1) D = std::max(D, std::fabs(emp - cdf(h[k + 1].first - 1)));
+    if (k + 1 < h.size() && h[k + 1].first > h[k].first + 1)
+      D = std::max(D, std::fabs(emp - cdf(h[k + 1].first - 1)));
   }
   r.ks = D;
   return r;
@@ -152,18 +162,21 @@ PowerLawMleResult scanXmin(const Histogram& h, std::size_t min_tail) {
 
 }  // namespace
 
-PowerLawMleResult fitDiscretePowerLaw(const std::vector<std::uint64_t>& samples, std::uint64_t xmin) {
+PowerLawMleResult fitDiscretePowerLaw(const std::vector<std::uint64_t>& samples,
+                                      std::uint64_t xmin) {
   const Histogram h = histogramOf(samples);
   std::size_t first = 0;
   while (first < h.size() && h[first].first < xmin) ++first;
   return fitTail(h, first, xmin);
 }
 
-PowerLawMleResult fitDiscretePowerLawKs(const std::vector<std::uint64_t>& samples, std::size_t min_tail) {
+PowerLawMleResult fitDiscretePowerLawKs(const std::vector<std::uint64_t>& samples,
+                                        std::size_t min_tail) {
   return scanXmin(histogramOf(samples), min_tail);
 }
 
-PowerLawMleResult fitDiscretePowerLawKs(const std::map<std::uint64_t, std::uint64_t>& counts, std::size_t min_tail) {
+PowerLawMleResult fitDiscretePowerLawKs(const std::map<std::uint64_t, std::uint64_t>& counts,
+                                        std::size_t min_tail) {
   Histogram h;
   for (const auto& [v, c] : counts)
     if (c > 0) h.emplace_back(v, c);

@@ -25,15 +25,18 @@ struct PowerLawMleResult {
 
 /// MLE of tau for fixed xmin (samples below xmin are ignored). Needs at least 2 tail samples
 /// with at least two distinct values; otherwise `valid` is false.
-PowerLawMleResult fitDiscretePowerLaw(const std::vector<std::uint64_t>& samples, std::uint64_t xmin);
+PowerLawMleResult fitDiscretePowerLaw(const std::vector<std::uint64_t>& samples,
+                                      std::uint64_t xmin);
 
 /// MLE with xmin chosen among the sample values by the smallest KS distance, considering only
 /// candidates that leave at least `min_tail` samples in the tail (small tails make spuriously
 /// small KS distances; Clauset et al. recommend n_tail of order 50 or more for a reliable fit).
-PowerLawMleResult fitDiscretePowerLawKs(const std::vector<std::uint64_t>& samples, std::size_t min_tail = 10);
+PowerLawMleResult fitDiscretePowerLawKs(const std::vector<std::uint64_t>& samples,
+                                        std::size_t min_tail = 10);
 
 /// Same from a size histogram (value -> count), e.g. ClusterSizes::n_s: O(distinct values^2).
-PowerLawMleResult fitDiscretePowerLawKs(const std::map<std::uint64_t, std::uint64_t>& counts, std::size_t min_tail = 10);
+PowerLawMleResult fitDiscretePowerLawKs(const std::map<std::uint64_t, std::uint64_t>& counts,
+                                        std::size_t min_tail = 10);
 
 /// P(X >= x) of the discrete power law: zeta(tau, x) / zeta(tau, xmin).
 double discretePowerLawCcdf(double tau, std::uint64_t xmin, std::uint64_t x);

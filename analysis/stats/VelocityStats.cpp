@@ -19,7 +19,8 @@ void meanVelocity(const std::vector<double>& v, double m[3]) {
 
 VelocityMoments velocityMoments(const std::vector<double>& v) {
   const std::size_t n = v.size() / 3;
-  if (n < 2 || v.size() % 3 != 0) throw std::invalid_argument("velocityMoments needs at least 2 particles (3N values).");
+  if (n < 2 || v.size() % 3 != 0)
+    throw std::invalid_argument("velocityMoments needs at least 2 particles (3N values).");
   double m[3];
   meanVelocity(v, m);
   // Moments of u = c^2 and w = c^4 with their sample covariance for the delta method.
@@ -55,7 +56,9 @@ VelocityMoments velocityMoments(const std::vector<double>& v) {
   return r;
 }
 
-double maxwellianScaledSpeedDensity(double x) { return std::sqrt(54.0 / M_PI) * x * x * std::exp(-1.5 * x * x); }
+double maxwellianScaledSpeedDensity(double x) {
+  return std::sqrt(54.0 / M_PI) * x * x * std::exp(-1.5 * x * x);
+}
 
 double maxwellianScaledSpeedCdf(double x) {
   const double a = std::sqrt(1.5);
@@ -81,8 +84,12 @@ std::vector<double> scaledSpeeds(const std::vector<double>& v) {
 }
 
 SpeedHistogram::SpeedHistogram(double v_max, int bins) : m_vmax(v_max) {
-  if (!(v_max > 0) || !std::isfinite(v_max)) throw std::invalid_argument("SpeedHistogram requires v_max > 0, got " + common::formatReal(v_max) + ".");
-  if (bins < 1) throw std::invalid_argument("SpeedHistogram requires at least 1 bin, got " + std::to_string(bins) + ".");
+  if (!(v_max > 0) || !std::isfinite(v_max))
+    throw std::invalid_argument("SpeedHistogram requires v_max > 0, got " +
+                                common::formatReal(v_max) + ".");
+  if (bins < 1)
+    throw std::invalid_argument("SpeedHistogram requires at least 1 bin, got " +
+                                std::to_string(bins) + ".");
   m_width = v_max / bins;
   m_counts.assign(static_cast<std::size_t>(bins), 0.0);
 }
@@ -91,7 +98,8 @@ std::vector<double> SpeedHistogram::add(const std::vector<double>& v) {
   std::vector<double> s = scaledSpeeds(v);
   for (double x : s) {
     const long k = static_cast<long>(x / m_width);
-    if (k >= 0 && k < static_cast<long>(m_counts.size())) m_counts[static_cast<std::size_t>(k)] += 1.0;
+    if (k >= 0 && k < static_cast<long>(m_counts.size()))
+      m_counts[static_cast<std::size_t>(k)] += 1.0;
   }
   m_total += static_cast<double>(s.size());
   return s;

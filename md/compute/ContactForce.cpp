@@ -20,9 +20,7 @@
 
 namespace granagg::md {
 
-void ContactWork::resize(std::size_t n) {
-  f.resize(n);
-}
+void ContactWork::resize(std::size_t n) { f.resize(n); }
 
 bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step) {
   return nl.hasPairs() && !(step.fast.r2 > 0.0);
@@ -43,7 +41,8 @@ struct ContactForceFunctor {
   int cap;
   // the same list in compressed pair form (NeighborList::keepPairs), for pairs() and gather();
   // null: operator() only
-  const int *pair_offsets, *pair_owners, *pair_partners, *entry_offsets, *entry_owners, *entry_pairs, *pair_entries;
+  const int *pair_offsets, *pair_owners, *pair_partners, *entry_offsets, *entry_owners,
+      *entry_pairs, *pair_entries;
   common::Box box;
   typename Potential::Params params;
   double h_pred, dt_prev;
@@ -66,12 +65,12 @@ struct ContactForceFunctor {
   int *ix, *iy, *iz;
   double advance_dt;
   // pair form only: each pair's contact, written by pairs() and read by gather() (ContactWork)
-  unsigned char* pair_hit;  // in contact
+  unsigned char* pair_hit;   // in contact
   unsigned char* entry_hit;  // in contact, per entry
-  Vec3* pair_f;             // force on the owner (where in contact)
-  double* pair_dq;          // charge the owner gains (CHARGING, where in contact)
-  double* pair_next;        // displacement bound up to which each pair cannot be in contact
-  double bound;             // the displacement bound of this pass (ContactStep::displacement_bound)
+  Vec3* pair_f;              // force on the owner (where in contact)
+  double* pair_dq;           // charge the owner gains (CHARGING, where in contact)
+  double* pair_next;         // displacement bound up to which each pair cannot be in contact
+  double bound;  // the displacement bound of this pass (ContactStep::displacement_bound)
 
   /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old, corrected for
   /// a multiple-time-step impulse given or about to be given (ContactStep::ext_predict_scale)
@@ -90,12 +89,12 @@ struct ContactForceFunctor {
   /// The contact of pair (i, j) at separation r = (rx, ry, rz), r2 = |r|^2 < 1: adds its force on i
   /// to (f0, f1, f2), its overlap to the maximum mx, a collision that started this step (counted
   /// for j > i) to nnew, and with charging the charge i gains to dqi.
-  HD void contact(int i, int j, double rx, double ry, double rz, double r2, double& f0, double& f1, double& f2,
-                  double& mx, int& nnew, double& dqi) const {
+  HD void contact(int i, int j, double rx, double ry, double rz, double r2, double& f0, double& f1,
+                  double& f2, double& mx, int& nnew, double& dqi) const {
     const double r = sqrt(r2);
     const double inv_r = 1.0 / r;
     const double nx = rx * inv_r, ny = ry * inv_r, nz = rz * inv_r;  // unit vector from j to i
-    const double xi = 1.0 - r;                                        // overlap
+    const double xi = 1.0 - r;                                       // overlap
     double vi0, vi1, vi2, vj0, vj1, vj2;  // contacts are rare: predicted velocities on demand
     predicted(i, vi0, vi1, vi2);
     predicted(j, vj0, vj1, vj2);
@@ -122,7 +121,8 @@ struct ContactForceFunctor {
 
   /// Separation r_i - r_j (minimum image; positions are wrapped into [0, L), so one conditional
   /// shift per component is enough) and its square.
-  HD double separation(const Scalar4& ri, const Scalar4& rj, double& rx, double& ry, double& rz) const {
+  HD double separation(const Scalar4& ri, const Scalar4& rj, double& rx, double& ry,
+                       double& rz) const {
     rx = box.minimumImageWrapped(ri.x - rj.x);
     ry = box.minimumImageWrapped(ri.y - rj.y);
     rz = box.minimumImageWrapped(ri.z - rj.z);
@@ -173,7 +173,8 @@ struct ContactForceFunctor {
         if (r2 < 1.0) contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
       }
     }
-    if (CHARGING && dqi != 0.0) dq[i] = dqi;  // applied by the next kick pass (charges are read by others now)
+    if (CHARGING && dqi != 0.0)
+      dq[i] = dqi;  // applied by the next kick pass (charges are read by others now)
     StepAccum res;
     res.collisions = nnew;
     res.max_overlap = mx;
@@ -211,8 +212,9 @@ struct ContactForceFunctor {
     else if (EXT)
       res.probe += f0 + f1 + f2;
     if (ADVANCE) {  // this step's closing kick, the next step's opening kick and drift (kickDrift)
-      const double u2 = kickDriftParticle(box, 0.5 * advance_dt, advance_dt, true, Vec3{f0, f1, f2}, vel[i], ri,
-                                          CHARGING ? dq + i : nullptr, ix[i], iy[i], iz[i], next_vel[i], next_pos[i]);
+      const double u2 = kickDriftParticle(box, 0.5 * advance_dt, advance_dt, true, Vec3{f0, f1, f2},
+                                          vel[i], ri, CHARGING ? dq + i : nullptr, ix[i], iy[i],
+                                          iz[i], next_vel[i], next_pos[i]);
       res.max_u2 = u2 > res.max_u2 ? u2 : res.max_u2;
     }
   }
@@ -247,10 +249,12 @@ struct ContactForceFunctor {
         double rx, ry, rz;
         const double r2 = separation(pos[pair_owners[p]], pos[pair_partners[p]], rx, ry, rz);
         const unsigned char in_contact = r2 < 1.0;
-        if (in_contact != pair_hit[p]) {  // a contact begins or ends (rare): the flags of both entries
+        if (in_contact !=
+            pair_hit[p]) {  // a contact begins or ends (rare): the flags of both entries
           pair_hit[p] = in_contact;
           entry_hit[pair_entries[2 * p]] = in_contact;
-          entry_hit[pair_entries[2 * p + 1]] = in_contact;  // the partner's row: this pass alone writes it
+          entry_hit[pair_entries[2 * p + 1]] =
+              in_contact;  // the partner's row: this pass alone writes it
         }
         hit[nhit] = p;
         nhit += in_contact;
@@ -263,7 +267,8 @@ struct ContactForceFunctor {
         double rx, ry, rz;
         const double r2 = separation(pos[i], pos[j], rx, ry, rz);
         double f0 = 0.0, f1 = 0.0, f2 = 0.0, dqi = 0.0;
-        contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);  // j > i: counts each collision once
+        contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew,
+                dqi);           // j > i: counts each collision once
         probe += f0 + f1 + f2;  // (gather() probes only slow forces)
         pair_f[p] = Vec3{f0, f1, f2};
         if (CHARGING) pair_dq[p] = dqi;
@@ -310,7 +315,9 @@ struct ContactForceFunctor {
           fi.z += -fp.z;
         }
         f_new[i] = fi;
-        if (CHARGING) dq[i] += q >= 0 ? pair_dq[q] : -pair_dq[~q];  // dq is zero before the pass (kick clears it)
+        if (CHARGING)
+          dq[i] +=
+              q >= 0 ? pair_dq[q] : -pair_dq[~q];  // dq is zero before the pass (kick clears it)
       }
     }
     for (int i = first; i < last; ++i) {
@@ -364,7 +371,8 @@ struct SummaryFunctor {
     for (int k = 0; k < counts[i]; ++k) {
       const int j = row[k];
       const Scalar4 ri = pos[i], rj = pos[j];
-      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+      const double rx = box.minimumImageWrapped(ri.x - rj.x),
+                   ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
       if (r2 >= 1.0) continue;
@@ -397,7 +405,8 @@ struct MaxOverlapOf {
 
 template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING, bool ADVANCE = false>
 ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                            const typename Potential::Params& params, const ContactStep& st, ContactWork& w) {
+                            const typename Potential::Params& params, const ContactStep& st,
+                            ContactWork& w) {
   const int N = static_cast<int>(p.size());
   const double dt = st.dt, half_dt = 0.5 * dt;
   if (w.f.size() != p.size()) w.resize(p.size());
@@ -422,16 +431,50 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
     w.next_bound = bound >= 0.0 ? bound : -1.0;
   }
   ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING, ADVANCE> f{
-      raw(p.pos), raw(p.vel), raw(p.force), nl.rows(), nl.counts(), nl.capacity(),
-      paired ? nl.pairOffsets() : nullptr, paired ? nl.pairOwners() : nullptr, paired ? nl.pairPartners() : nullptr,
-      paired ? nl.entryOffsets() : nullptr, paired ? nl.entryOwners() : nullptr, paired ? nl.entryPairs() : nullptr,
+      raw(p.pos),
+      raw(p.vel),
+      raw(p.force),
+      nl.rows(),
+      nl.counts(),
+      nl.capacity(),
+      paired ? nl.pairOffsets() : nullptr,
+      paired ? nl.pairOwners() : nullptr,
+      paired ? nl.pairPartners() : nullptr,
+      paired ? nl.entryOffsets() : nullptr,
+      paired ? nl.entryOwners() : nullptr,
+      paired ? nl.entryPairs() : nullptr,
       paired ? nl.pairEntries() : nullptr,
-      box, params, half_dt, dt, raw(w.f), raw(p.id),
-      st.charging, st.step, st.dq, st.ext_fx, st.ext_fy, st.ext_fz, st.ext_force_scale, st.ext_predict_scale,
-      st.coulomb_K, st.fast.r2 * st.fast.r2, st.fast_table, raw(w.pos), raw(w.vel), raw(p.ix),
-      raw(p.iy), raw(p.iz), st.advance_dt, raw(w.pair_hit), raw(w.entry_hit), raw(w.pair_f), raw(w.pair_dq), raw(w.pair_next),
+      box,
+      params,
+      half_dt,
+      dt,
+      raw(w.f),
+      raw(p.id),
+      st.charging,
+      st.step,
+      st.dq,
+      st.ext_fx,
+      st.ext_fy,
+      st.ext_fz,
+      st.ext_force_scale,
+      st.ext_predict_scale,
+      st.coulomb_K,
+      st.fast.r2 * st.fast.r2,
+      st.fast_table,
+      raw(w.pos),
+      raw(w.vel),
+      raw(p.ix),
+      raw(p.iy),
+      raw(p.iz),
+      st.advance_dt,
+      raw(w.pair_hit),
+      raw(w.entry_hit),
+      raw(w.pair_f),
+      raw(w.pair_dq),
+      raw(w.pair_next),
       st.displacement_bound >= 0.0 ? st.displacement_bound : 0.0};
-  // forces and, per block, collisions, probe sum and largest overlap; then one reduction over blocks
+  // forces and, per block, collisions, probe sum and largest overlap; then one reduction over
+  // blocks
   const int block = blockSizeFor(N);
   const int nblocks = blockCount(N, block);
   if (paired) {
@@ -442,7 +485,8 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
     w.block_flags.resize(nblocks);
     forEachBlocked(N, block, f, CombineStepAccum{}, raw(w.block_flags));
   }
-  p.force.swap(w.f);  // p.force = f(t); the old forces stay in w until the next pass overwrites them
+  p.force.swap(
+      w.f);  // p.force = f(t); the old forces stay in w until the next pass overwrites them
   const StepAccum a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
   ContactStepResult r;
   r.collisions = a.collisions;
@@ -457,15 +501,17 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
 }
 
 template <class Potential>
-ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                                       const typename Potential::Params& params, const ContactStep& st,
-                                       ContactWork& w) {
+ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl,
+                                       const common::Box& box,
+                                       const typename Potential::Params& params,
+                                       const ContactStep& st, ContactWork& w) {
   const bool fast = st.fast.r2 > 0.0;
   if (fast && (nl.listRange() < st.fast.r2 || !st.fast_table.data))
     throw std::logic_error("neighbour list range below the fast Coulomb range");
   if (st.advance_dt > 0.0) {
     if (!canAdvanceInForcePass(nl, st) || st.advance_dt != st.dt)
-      throw std::logic_error("computeContactForces: this pass cannot advance the step (ContactStep::advance_dt)");
+      throw std::logic_error(
+          "computeContactForces: this pass cannot advance the step (ContactStep::advance_dt)");
     if (st.dq)
       return st.ext_fx ? forcePass<Potential, true, false, true, true>(p, nl, box, params, st, w)
                        : forcePass<Potential, false, false, true, true>(p, nl, box, params, st, w);
@@ -499,18 +545,19 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
   const int N = static_cast<int>(p.size());
   out.resize(p.size());
   SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
-  thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N), out.begin(),
-                    MaxOverlapOf<Potential>{s});
+  thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+                    out.begin(), MaxOverlapOf<Potential>{s});
 }
 
 // the contact models: adding one = one header + one line per function here
-#define GRANAGG_CONTACT_MODEL(P)                                                                                  \
-  template ContactStepResult computeContactForces<P>(ParticleData&, const NeighborList&, const common::Box&,      \
-                                                     const P::Params&, const ContactStep&, ContactWork&);        \
-  template ContactSummary contactSummary<P>(const ParticleData&, const NeighborList&, const common::Box&,          \
-                                            const P::Params&);                                                    \
-  template void maxOverlapPerParticle<P>(const ParticleData&, const NeighborList&, const common::Box&,             \
-                                         const P::Params&, DVec<double>&);
+#define GRANAGG_CONTACT_MODEL(P)                                                           \
+  template ContactStepResult computeContactForces<P>(ParticleData&, const NeighborList&,   \
+                                                     const common::Box&, const P::Params&, \
+                                                     const ContactStep&, ContactWork&);    \
+  template ContactSummary contactSummary<P>(const ParticleData&, const NeighborList&,      \
+                                            const common::Box&, const P::Params&);         \
+  template void maxOverlapPerParticle<P>(const ParticleData&, const NeighborList&,         \
+                                         const common::Box&, const P::Params&, DVec<double>&);
 GRANAGG_CONTACT_MODEL(HertzViscoelastic)
 GRANAGG_CONTACT_MODEL(SpringDashpot)
 #undef GRANAGG_CONTACT_MODEL

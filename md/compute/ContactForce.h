@@ -47,24 +47,25 @@ namespace granagg::md {
 /// What one force pass found.
 struct ContactStepResult {
   std::int64_t collisions = 0;  ///< pairs whose contact started at this step
-  int worst = 0;                ///< worst particle: 0 all good, 1 non-finite force or position, 2 overlap beyond the bound
-  double max_u2 = 0.0;          ///< with ContactStep::advance_dt: largest |u|^2 of the new drift velocities
+  int worst = 0;  ///< worst particle: 0 all good, 1 non-finite force or position, 2 overlap beyond
+                  ///< the bound
+  double max_u2 = 0.0;  ///< with ContactStep::advance_dt: largest |u|^2 of the new drift velocities
 };
 
 /// Per-block partial result of a force pass (md/engine/Launch.h).
 struct StepAccum {
   std::int64_t collisions = 0;
-  double probe = 0.0;        ///< sum of forces and positions: not finite iff one of them is not
+  double probe = 0.0;  ///< sum of forces and positions: not finite iff one of them is not
   double max_overlap = 0.0;
   double max_u2 = 0.0;
 };
 
 /// Scratch of the force pass.
 struct ContactWork {
-  DVec<Vec3> f;                  ///< forces being computed (swapped with ParticleData's)
-  DVec<Scalar4> pos;             ///< advance_dt: the next positions (swapped with ParticleData's)
-  DVec<Vec3> vel;                ///< advance_dt: the next drift velocities (swapped likewise)
-  DVec<StepAccum> block_flags;   ///< per-block partial results (md/engine/Launch.h)
+  DVec<Vec3> f;                 ///< forces being computed (swapped with ParticleData's)
+  DVec<Scalar4> pos;            ///< advance_dt: the next positions (swapped with ParticleData's)
+  DVec<Vec3> vel;               ///< advance_dt: the next drift velocities (swapped likewise)
+  DVec<StepAccum> block_flags;  ///< per-block partial results (md/engine/Launch.h)
   // compressed pair form (ContactForce.cpp), kept from pass to pass for the list of generation
   // `pairs_of` (NeighborList::generation):
   DVec<unsigned char> pair_hit;   ///< each pair's contact at the last pass
@@ -81,8 +82,8 @@ struct ContactWork {
 
 /// What the force pass needs to know about the step.
 struct ContactStep {
-  double dt = 0.0;           ///< the step just taken (0 for a state given at full step, e.g. an initial
-                             ///< state: v is then v(t) itself and no pair counts as a new collision)
+  double dt = 0.0;  ///< the step just taken (0 for a state given at full step, e.g. an initial
+                    ///< state: v is then v(t) itself and no pair counts as a new collision)
   double max_overlap = 1.0;  ///< an overlap beyond this flags the result
   std::int64_t step = 0;     ///< step number (counter of the charge-exchange random numbers)
   ChargeExchange::Params charging{};
@@ -106,16 +107,16 @@ struct ContactStep {
   RealSpaceSwitch fast{};
   PairTable fast_table{};
   double coulomb_K = 0.0;
-  /// > 0: the pass also completes the step and opens the next one (velocity Verlet, VelocityVerlet.h)
-  /// for each particle as soon as its force f(t) is known: closing kick v(t) = u + (dt/2) f(t),
-  /// opening kick u' = v(t) + (dt/2) f(t), drift x' = x + dt u' (wrapped, images counted), and
-  /// with charging q' = q + dq. The same arithmetic as kickDrift() after the pass, in one sweep
-  /// over the particles instead of two; the new positions and velocities go to ContactWork and are
-  /// swapped in after the pass, so every partner's x and u stay those of t while others read them.
-  /// dt must equal this value (fixed step). Needs the compressed list and no fast Coulomb part
-  /// (canAdvanceInForcePass). On a non-finite force or deep overlap nothing is advanced (the forces
-  /// are stored, positions and velocities stay those of t, for the error report; image counts may
-  /// already have moved).
+  /// > 0: the pass also completes the step and opens the next one (velocity Verlet,
+  /// VelocityVerlet.h) for each particle as soon as its force f(t) is known: closing kick v(t) = u
+  /// + (dt/2) f(t), opening kick u' = v(t) + (dt/2) f(t), drift x' = x + dt u' (wrapped, images
+  /// counted), and with charging q' = q + dq. The same arithmetic as kickDrift() after the pass, in
+  /// one sweep over the particles instead of two; the new positions and velocities go to
+  /// ContactWork and are swapped in after the pass, so every partner's x and u stay those of t
+  /// while others read them. dt must equal this value (fixed step). Needs the compressed list and
+  /// no fast Coulomb part (canAdvanceInForcePass). On a non-finite force or deep overlap nothing is
+  /// advanced (the forces are stored, positions and velocities stay those of t, for the error
+  /// report; image counts may already have moved).
   double advance_dt = 0.0;
   /// >= 0: a bound on every particle's displacement since the list was built, non-decreasing from
   /// pass to pass while the list stays the same (the engine's sum of dt max|u| plus rounding).
@@ -125,22 +126,24 @@ struct ContactStep {
   double displacement_bound = -1.0;
 };
 
-/// Whether computeContactForces can advance the step (ContactStep::advance_dt) with this list and step.
+/// Whether computeContactForces can advance the step (ContactStep::advance_dt) with this list and
+/// step.
 bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step);
 
 /// Contact forces of the current positions into p.force (state as described above),
 /// collisions, and with charging the charge each particle gains at its new contacts.
 template <class Potential>
-ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl, const common::Box& box,
-                                       const typename Potential::Params& params, const ContactStep& step,
-                                       ContactWork& work);
+ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl,
+                                       const common::Box& box,
+                                       const typename Potential::Params& params,
+                                       const ContactStep& step, ContactWork& work);
 
 /// Contact statistics of the current positions (positions only: no velocities needed).
 struct ContactSummary {
   double elastic_energy = 0.0;  ///< sum over pairs in contact
   double overlap_sum = 0.0;     ///< sum of overlaps over pairs in contact (each pair once)
   double max_overlap = 0.0;
-  std::int64_t contacts = 0;    ///< sum over particles of partners in contact (2 x pairs)
+  std::int64_t contacts = 0;  ///< sum over particles of partners in contact (2 x pairs)
 };
 template <class Potential>
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,

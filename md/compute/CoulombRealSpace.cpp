@@ -32,11 +32,13 @@ struct RealForceFunctor {
       const int n = counts[i];
       for (int k = 0; k < n; ++k) {
         const Scalar4 rj = pos[row[k]];
-        const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+        const double rx = box.minimumImageWrapped(ri.x - rj.x),
+                     ry = box.minimumImageWrapped(ri.y - rj.y),
                      rz = box.minimumImageWrapped(ri.z - rj.z);
         const double r2 = rx * rx + ry * ry + rz * rz;
         const double qq = ri.w * rj.w;
-        if (TABLE) {  // branch-free: about half of the list's entries lie beyond r_cut, unpredictably
+        if (TABLE) {  // branch-free: about half of the list's entries lie beyond r_cut,
+                      // unpredictably
           const double fr = K * (r2 < rc2 ? qq : 0.0) * table(r2 < rc2 ? r2 : 0.0);
           f0 += fr * rx;
           f1 += fr * ry;
@@ -74,46 +76,53 @@ struct RealEnergyFunctor {
     const int* row = rows + static_cast<long>(i) * cap;
     for (int k = 0; k < counts[i]; ++k) {
       const Scalar4 rj = pos[row[k]];
-      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+      const double rx = box.minimumImageWrapped(ri.x - rj.x),
+                   ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
-      if (r2 < rc2) e += 0.5 * ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);  // half per partner
+      if (r2 < rc2)
+        e += 0.5 * ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);  // half per partner
     }
     return e;
   }
 };
 
 void checkRange(const NeighborList& nl, const CoulombRealParams& prm) {
-  if (nl.listRange() < prm.r_cut) throw std::logic_error("neighbour list range below the Coulomb real-space cutoff");
+  if (nl.listRange() < prm.r_cut)
+    throw std::logic_error("neighbour list range below the Coulomb real-space cutoff");
 }
 
 }  // namespace
 
-void coulombRealForces(const ParticleData& p, const NeighborList& nl, const common::Box& box, const CoulombRealParams& prm,
-                       DVec<double>& fx, DVec<double>& fy, DVec<double>& fz) {
+void coulombRealForces(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                       const CoulombRealParams& prm, DVec<double>& fx, DVec<double>& fy,
+                       DVec<double>& fz) {
   checkRange(nl, prm);
   const int N = static_cast<int>(p.size());
   for (auto* v : {&fx, &fy, &fz}) v->resize(p.size());
   if (prm.table.data)
     forEachBlocked(N, blockSizeFor(N),
-                   RealForceFunctor<true>{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K, prm.alpha,
-                                          prm.r_cut * prm.r_cut, prm.fast, prm.table, raw(fx), raw(fy), raw(fz)},
+                   RealForceFunctor<true>{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box,
+                                          prm.K, prm.alpha, prm.r_cut * prm.r_cut, prm.fast,
+                                          prm.table, raw(fx), raw(fy), raw(fz)},
                    NoReduction{}, static_cast<int*>(nullptr));
   else
     forEachBlocked(N, blockSizeFor(N),
-                   RealForceFunctor<false>{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K, prm.alpha,
-                                           prm.r_cut * prm.r_cut, prm.fast, prm.table, raw(fx), raw(fy), raw(fz)},
+                   RealForceFunctor<false>{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box,
+                                           prm.K, prm.alpha, prm.r_cut * prm.r_cut, prm.fast,
+                                           prm.table, raw(fx), raw(fy), raw(fz)},
                    NoReduction{}, static_cast<int*>(nullptr));
 }
 
-double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const common::Box& box, const CoulombRealParams& prm) {
+double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                         const CoulombRealParams& prm) {
   checkRange(nl, prm);
   const int N = static_cast<int>(p.size());
   DVec<double> per_slot(p.size());
   thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
                     per_slot.begin(),
-                    RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box,
-                                      prm.K, prm.alpha, prm.r_cut * prm.r_cut});
+                    RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K,
+                                      prm.alpha, prm.r_cut * prm.r_cut});
   return reduceById(per_slot, p.id, 0.0, thrust::plus<double>());  // restart: same bits
 }
 

@@ -15,22 +15,26 @@
 
 namespace granagg::md {
 
-/// Real-space parameters: pair force K q_i q_j [erfc(alpha r)/r^2 + (2 alpha/sqrt pi) exp(-alpha^2 r^2)/r]
-/// along r_ij for r < r_cut.
+/// Real-space parameters: pair force K q_i q_j [erfc(alpha r)/r^2 + (2 alpha/sqrt pi) exp(-alpha^2
+/// r^2)/r] along r_ij for r < r_cut.
 struct CoulombRealParams {
   double K = 0.0, alpha = 0.0, r_cut = 0.0;
-  /// coulombRealForces computes the slow part: the real-space force minus the fast part S(r) K q_i q_j / r^2
+  /// coulombRealForces computes the slow part: the real-space force minus the fast part S(r) K q_i
+  /// q_j / r^2
   RealSpaceSwitch fast{};
   /// The slow force over r tabulated on [0, r_cut^2] (slowPairTableValues), or null: computed
   PairTable table{};
 };
 
-/// Real-space forces (their slow part, see CoulombRealParams::fast) of the current positions and charges into fx, fy, fz (overwritten; resized
-/// to N). The list must reach r_cut (std::logic_error otherwise).
-void coulombRealForces(const ParticleData& p, const NeighborList& nl, const common::Box& box, const CoulombRealParams& prm,
-                       DVec<double>& fx, DVec<double>& fy, DVec<double>& fz);
+/// Real-space forces (their slow part, see CoulombRealParams::fast) of the current positions and
+/// charges into fx, fy, fz (overwritten; resized to N). The list must reach r_cut (std::logic_error
+/// otherwise).
+void coulombRealForces(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                       const CoulombRealParams& prm, DVec<double>& fx, DVec<double>& fy,
+                       DVec<double>& fz);
 
 /// Real-space energy sum over pairs i < j of K q_i q_j erfc(alpha r)/r (exact erfc).
-double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const common::Box& box, const CoulombRealParams& prm);
+double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                         const CoulombRealParams& prm);
 
 }  // namespace granagg::md

@@ -60,12 +60,13 @@ const std::vector<Section>& schema() {
         GRANAGG_KEY(system, temperature), GRANAGG_KEY(system, initial)}},
       {"contact",
        {GRANAGG_KEY(contact, model), GRANAGG_KEY(contact, E), GRANAGG_KEY(contact, D),
-        GRANAGG_KEY(contact, clamp), GRANAGG_KEY(contact, stiffness), GRANAGG_KEY(contact, restitution)}},
+        GRANAGG_KEY(contact, clamp), GRANAGG_KEY(contact, stiffness),
+        GRANAGG_KEY(contact, restitution)}},
       {"integrator",
        {Key{"dt", +[](MdConfig& c) -> double& { return c.integrator.dt; }, true},
         GRANAGG_KEY(integrator, steps_per_contact),
-        Key{"impact_speed_max", +[](MdConfig& c) -> double& { return c.integrator.impact_speed_max; },
-            true}}},
+        Key{"impact_speed_max",
+            +[](MdConfig& c) -> double& { return c.integrator.impact_speed_max; }, true}}},
       {"neighbor", {GRANAGG_KEY(neighbor, skin)}},
       {"charging",
        {GRANAGG_KEY(charging, mode), GRANAGG_KEY(charging, initial), GRANAGG_KEY(charging, q0),
@@ -137,7 +138,8 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
     const std::size_t d = editDistance(word, c);
     if (d < best) best = d, best_name = c;
   }
-  if (best <= 2 && best < std::max<std::size_t>(word.size(), 1)) return "; did you mean '" + best_name + "'?";
+  if (best <= 2 && best < std::max<std::size_t>(word.size(), 1))
+    return "; did you mean '" + best_name + "'?";
   return "";
 }
 
@@ -176,8 +178,8 @@ std::string unknownKeyMessage(const std::string& section, const std::string& key
   for (const auto& k : s->keys) names.push_back(k.name);
   std::string hint = suggestion(key, names);
   if (!hint.empty()) hint = "; did you mean '" + section + "." + hint.substr(hint.find('\'') + 1);
-  return "unknown key '" + section + "." + key + "' (known keys in [" + section + "]: " + keyList(*s) + ")" +
-         hint;
+  return "unknown key '" + section + "." + key + "' (known keys in [" + section +
+         "]: " + keyList(*s) + ")" + hint;
 }
 
 // TOML basic string with escapes (also used to quote strings in messages).
@@ -254,7 +256,8 @@ struct Issue {
   std::string key;
 };
 
-[[noreturn]] void invalid(const std::string& key, const std::string& value, const std::string& rule) {
+[[noreturn]] void invalid(const std::string& key, const std::string& value,
+                          const std::string& rule) {
   throw ConfigError(key + " = " + value + " is invalid: must " + rule, key);
 }
 
@@ -263,7 +266,8 @@ struct Issue {
 
 // Sets the member of `config` named by `key` from `node`; returns "" or an error message (without
 // location). `full` is "section.key".
-std::string assign(const Key& key, const std::string& full, const toml::node& node, MdConfig& config) {
+std::string assign(const Key& key, const std::string& full, const toml::node& node,
+                   MdConfig& config) {
   const std::string got = ", got " + describe(node);
   if (auto r = std::get_if<IntRef>(&key.ref)) {
     if (auto str = node.as_string(); str && key.auto_allowed && str->get() == "auto") {
@@ -271,7 +275,9 @@ std::string assign(const Key& key, const std::string& full, const toml::node& no
       return "";
     }
     auto v = node.as_integer();
-    if (!v) return full + (key.auto_allowed ? " must be an integer or \"auto\"" : " must be an integer") + got;
+    if (!v)
+      return full + (key.auto_allowed ? " must be an integer or \"auto\"" : " must be an integer") +
+             got;
     if (key.auto_allowed && v->get() <= 0)
       return full + " = " + std::to_string(v->get()) + " is invalid: must be > 0 or \"auto\"";
     if (v->get() < std::numeric_limits<int>::min() || v->get() > std::numeric_limits<int>::max())
@@ -291,12 +297,14 @@ std::string assign(const Key& key, const std::string& full, const toml::node& no
       (*r)(config) = static_cast<std::uint64_t>(v->get());
     } else if (auto s = node.as_string()) {
       const std::string& t = s->get();
-      const bool digits = !t.empty() && t.size() <= 20 &&
-                          std::all_of(t.begin(), t.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+      const bool digits =
+          !t.empty() && t.size() <= 20 &&
+          std::all_of(t.begin(), t.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
       errno = 0;
       char* end = nullptr;
       const unsigned long long u = digits ? std::strtoull(t.c_str(), &end, 10) : 0;
-      if (!digits || errno == ERANGE) return full + " must be a non-negative integer (below 2^64)" + got;
+      if (!digits || errno == ERANGE)
+        return full + " must be a non-negative integer (below 2^64)" + got;
       (*r)(config) = static_cast<std::uint64_t>(u);
     } else {
       return full + " must be a non-negative integer" + got;
@@ -311,7 +319,8 @@ std::string assign(const Key& key, const std::string& full, const toml::node& no
       (*r)(config) = 0.0;
       return "";
     } else {
-      return full + (key.auto_allowed ? " must be a number or \"auto\"" : " must be a number") + got;
+      return full + (key.auto_allowed ? " must be a number or \"auto\"" : " must be a number") +
+             got;
     }
     // Zero is how "auto" is stored, so an explicit value must be positive.
     if (key.auto_allowed && !(x > 0.0))
@@ -334,7 +343,8 @@ toml::table parseToml(const std::string& text, const std::string& source_name) {
   try {
     return toml::parse(std::string_view(text), std::string_view(source_name));
   } catch (const toml::parse_error& e) {
-    throw ConfigError(where(e.source(), source_name) + ": invalid TOML: " + std::string(e.description()), "");
+    throw ConfigError(
+        where(e.source(), source_name) + ": invalid TOML: " + std::string(e.description()), "");
   }
 #else
   toml::parse_result res = toml::parse(std::string_view(text), std::string_view(source_name));
@@ -351,20 +361,21 @@ void readTable(const toml::table& root, const std::string& source_name, MdConfig
                std::map<std::string, std::string>& origin) {
   std::vector<Issue> issues;
   auto report = [&](const toml::source_region& r, std::string message, std::string key) {
-    issues.push_back({r.begin.line, r.begin.column, where(r, source_name) + ": " + message, std::move(key)});
+    issues.push_back(
+        {r.begin.line, r.begin.column, where(r, source_name) + ": " + message, std::move(key)});
   };
   for (auto&& [skey, snode] : root) {
     const std::string sname(skey.str());
     const Section* section = findSection(sname);
     if (!section) {
-      report(skey.source(), snode.is_table() ? unknownKeyMessage(sname, "") : unknownKeyMessage("", sname),
-             sname);
+      report(skey.source(),
+             snode.is_table() ? unknownKeyMessage(sname, "") : unknownKeyMessage("", sname), sname);
       continue;
     }
     const toml::table* table = snode.as_table();
     if (!table) {
-      report(skey.source(), "'" + sname + "' must be a table ([" + sname + "]), got " + describe(snode),
-             sname);
+      report(skey.source(),
+             "'" + sname + "' must be a table ([" + sname + "]), got " + describe(snode), sname);
       continue;
     }
     for (auto&& [kkey, knode] : *table) {
@@ -401,7 +412,8 @@ std::string trim(const std::string& s) {
 }
 
 // Applies one "section.key=value" override.
-void applyOverride(const std::string& raw, MdConfig& config, std::map<std::string, std::string>& origin) {
+void applyOverride(const std::string& raw, MdConfig& config,
+                   std::map<std::string, std::string>& origin) {
   const std::string prefix = "--set " + raw + ": ";
   const auto eq = raw.find('=');
   if (eq == std::string::npos) throw ConfigError(prefix + "expected section.key=value", "");
@@ -506,7 +518,8 @@ void validateConfig(const MdConfig& c) {
   using common::formatReal;
   if (c.input_version != CONFIG_VERSION)
     throw ConfigError("input.version = " + std::to_string(c.input_version) +
-                          " is not supported: this granagg reads version " + std::to_string(CONFIG_VERSION),
+                          " is not supported: this granagg reads version " +
+                          std::to_string(CONFIG_VERSION),
                       "input.version");
 
   const SystemConfig& s = c.system;
@@ -514,7 +527,8 @@ void validateConfig(const MdConfig& c) {
   if (!(s.phi > 0.0 && s.phi < 0.6)) invalid("system.phi", formatReal(s.phi), "lie in (0, 0.6)");
   if (!(s.temperature > 0.0 && finite(s.temperature)))
     invalid("system.temperature", formatReal(s.temperature), "be > 0 and finite");
-  if (s.initial.empty()) invalid("system.initial", quote(s.initial), "be \"random\" or a file path");
+  if (s.initial.empty())
+    invalid("system.initial", quote(s.initial), "be \"random\" or a file path");
 
   const ContactConfig& k = c.contact;
   if (k.model != "hertz" && k.model != "spring_dashpot")
@@ -528,7 +542,8 @@ void validateConfig(const MdConfig& c) {
     invalid("contact.restitution", formatReal(k.restitution), "lie in (0, 1]");
 
   const IntegratorConfig& g = c.integrator;
-  if (!(g.dt >= 0.0 && finite(g.dt))) invalid("integrator.dt", formatReal(g.dt), "be > 0 or \"auto\"");
+  if (!(g.dt >= 0.0 && finite(g.dt)))
+    invalid("integrator.dt", formatReal(g.dt), "be > 0 or \"auto\"");
   if (!(g.steps_per_contact >= 5.0 && finite(g.steps_per_contact)))
     invalid("integrator.steps_per_contact", formatReal(g.steps_per_contact), "be >= 5 and finite");
   if (!(g.impact_speed_max >= 0.0 && finite(g.impact_speed_max)))
@@ -540,15 +555,20 @@ void validateConfig(const MdConfig& c) {
   const ChargingConfig& q = c.charging;
   if (q.mode != "exchange" && q.mode != "fixed")
     invalid("charging.mode", quote(q.mode), "be one of \"exchange\", \"fixed\"");
-  if (q.initial != "neutral" && q.initial != "monopolar" && q.initial != "bipolar" && q.initial != "file")
-    invalid("charging.initial", quote(q.initial), "be one of \"neutral\", \"monopolar\", \"bipolar\", \"file\"");
+  if (q.initial != "neutral" && q.initial != "monopolar" && q.initial != "bipolar" &&
+      q.initial != "file")
+    invalid("charging.initial", quote(q.initial),
+            "be one of \"neutral\", \"monopolar\", \"bipolar\", \"file\"");
   if (q.initial == "file" && s.initial == "random")
-    invalid("charging.initial", quote(q.initial), "be used with system.initial = a file that holds charges");
+    invalid("charging.initial", quote(q.initial),
+            "be used with system.initial = a file that holds charges");
   if (!(q.q0 > 0.0 && finite(q.q0))) invalid("charging.q0", formatReal(q.q0), "be > 0 and finite");
   if (!(q.Q >= 0.0 && finite(q.Q))) invalid("charging.Q", formatReal(q.Q), "be >= 0 and finite");
-  if (!(q.kappa > 0.0 && finite(q.kappa))) invalid("charging.kappa", formatReal(q.kappa), "be > 0 and finite");
+  if (!(q.kappa > 0.0 && finite(q.kappa)))
+    invalid("charging.kappa", formatReal(q.kappa), "be > 0 and finite");
   if (!(q.psi1_min > 0.0 && q.psi1_max >= q.psi1_min && finite(q.psi1_max)))
-    invalid("charging.psi1_min", formatReal(q.psi1_min), "be > 0 and <= charging.psi1_max (" + formatReal(q.psi1_max) + ")");
+    invalid("charging.psi1_min", formatReal(q.psi1_min),
+            "be > 0 and <= charging.psi1_max (" + formatReal(q.psi1_max) + ")");
   if (!(q.psi2_fraction >= 0.0 && q.psi2_fraction < 1.0))
     invalid("charging.psi2_fraction", formatReal(q.psi2_fraction), "lie in [0, 1)");
 
@@ -557,20 +577,25 @@ void validateConfig(const MdConfig& c) {
   if (e.method != "pppm" && e.method != "ewald")
     invalid("coulomb.method", quote(e.method), "be one of \"pppm\", \"ewald\"");
   if (!(e.accuracy > 0.0 && e.accuracy < 0.1))
-    invalid("coulomb.accuracy", formatReal(e.accuracy), "lie in (0, 0.1) (relative RMS force error)");
-  if (!(e.r_cut >= 0.0 && finite(e.r_cut))) invalid("coulomb.r_cut", formatReal(e.r_cut), "be > 0 or \"auto\"");
+    invalid("coulomb.accuracy", formatReal(e.accuracy),
+            "lie in (0, 0.1) (relative RMS force error)");
+  if (!(e.r_cut >= 0.0 && finite(e.r_cut)))
+    invalid("coulomb.r_cut", formatReal(e.r_cut), "be > 0 or \"auto\"");
   if (e.mesh < 0) invalid("coulomb.mesh", std::to_string(e.mesh), "be > 0 or \"auto\"");
   if (e.order < 0 || e.order == 1 || e.order > 7)
     invalid("coulomb.order", std::to_string(e.order), "lie in 2..7 or be \"auto\"");
   if (e.every < 0 || e.every > 100)
-    invalid("coulomb.every", std::to_string(e.every), "lie in 1..100 (steps between Coulomb evaluations) or be \"auto\"");
+    invalid("coulomb.every", std::to_string(e.every),
+            "lie in 1..100 (steps between Coulomb evaluations) or be \"auto\"");
   if (e.every_max < 0 || e.every_max > 1000)
     invalid("coulomb.every_max", std::to_string(e.every_max),
             "lie in 1..1000 (the longest slow interval in steps; <= coulomb.every keeps it "
             "fixed) or be \"auto\" (4 x coulomb.every)");
-  if (!(e.skin >= 0.0 && e.skin <= 5.0)) invalid("coulomb.skin", formatReal(e.skin), "lie in (0, 5] or be \"auto\"");
+  if (!(e.skin >= 0.0 && e.skin <= 5.0))
+    invalid("coulomb.skin", formatReal(e.skin), "lie in (0, 5] or be \"auto\"");
   if (!(e.r_fast == 0.0 || (e.r_fast >= 2.0 && finite(e.r_fast))))
-    invalid("coulomb.r_fast", formatReal(e.r_fast), "be >= 2 (the switch [r_fast - 1, r_fast] starts beyond contact) or \"auto\"");
+    invalid("coulomb.r_fast", formatReal(e.r_fast),
+            "be >= 2 (the switch [r_fast - 1, r_fast] starts beyond contact) or \"auto\"");
 
   if (!(c.run.t_end > 0.0 && finite(c.run.t_end)))
     invalid("run.t_end", formatReal(c.run.t_end), "be > 0 and finite");
@@ -588,19 +613,22 @@ void validateConfig(const MdConfig& c) {
   if (o.checkpoint_interval < 0)
     invalid("output.checkpoint_interval", std::to_string(o.checkpoint_interval), "be >= 0");
   if (!(o.checkpoint_wall_seconds >= 0.0 && finite(o.checkpoint_wall_seconds)))
-    invalid("output.checkpoint_wall_seconds", formatReal(o.checkpoint_wall_seconds), "be >= 0 and finite");
+    invalid("output.checkpoint_wall_seconds", formatReal(o.checkpoint_wall_seconds),
+            "be >= 0 and finite");
 }
 
 double boxLength(const SystemConfig& system) {
   if (system.N < 1 || !(system.phi > 0.0))
-    throw std::invalid_argument("boxLength needs system.N >= 1 and system.phi > 0 (got N = " +
-                                std::to_string(system.N) + ", phi = " + common::formatReal(system.phi) + ")");
+    throw std::invalid_argument(
+        "boxLength needs system.N >= 1 and system.phi > 0 (got N = " + std::to_string(system.N) +
+        ", phi = " + common::formatReal(system.phi) + ")");
   return std::cbrt(static_cast<double>(system.N) * M_PI / (6.0 * system.phi));
 }
 
 std::string toToml(const MdConfig& config) {
   std::string out =
-      "# granagg md configuration, every key resolved (docs/config.md); reduced units d = m = T0 = 1\n";
+      "# granagg md configuration, every key resolved (docs/config.md); reduced units d = m = T0 = "
+      "1\n";
   for (const auto& s : schema()) {
     out += "\n[" + s.name + "]\n";
     for (const auto& k : s.keys) out += k.name + " = " + valueText(k, config, true) + "\n";
@@ -611,7 +639,8 @@ std::string toToml(const MdConfig& config) {
 std::vector<std::pair<std::string, std::string>> flatten(const MdConfig& config) {
   std::vector<std::pair<std::string, std::string>> out;
   for (const auto& s : schema())
-    for (const auto& k : s.keys) out.emplace_back(s.name + "." + k.name, valueText(k, config, false));
+    for (const auto& k : s.keys)
+      out.emplace_back(s.name + "." + k.name, valueText(k, config, false));
   return out;
 }
 

@@ -10,11 +10,12 @@
 ///     [input]       version = 1
 ///     [system]      N, phi, seed, temperature, initial ("random" or a CSV/H5MD file path)
 ///     [contact]     model ("hertz" | "spring_dashpot"), E, D, clamp, stiffness, restitution
-///     [integrator]  dt ("auto" or a number), steps_per_contact, impact_speed_max ("auto" or number)
-///     [neighbor]    skin
-///     [charging]    mode ("exchange" | "fixed"), initial ("neutral" | "monopolar" | "bipolar" | "file"),
+///     [integrator]  dt ("auto" or a number), steps_per_contact, impact_speed_max ("auto" or
+///     number) [neighbor]    skin [charging]    mode ("exchange" | "fixed"), initial ("neutral" |
+///     "monopolar" | "bipolar" | "file"),
 ///                   q0, Q, kappa, psi1_min, psi1_max, psi2_fraction
-///     [coulomb]     K, method ("pppm" | "ewald"), accuracy, r_cut, mesh, order ("auto" or numbers),
+///     [coulomb]     K, method ("pppm" | "ewald"), accuracy, r_cut, mesh, order ("auto" or
+///     numbers),
 ///                   every, every_max, skin, r_fast
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
@@ -25,10 +26,10 @@
 namespace granagg::md {
 
 struct SystemConfig {
-  int N = 1000;                 ///< number of particles (>= 2)
-  double phi = 0.076;           ///< filling fraction N pi / (6 L^3), in (0, 0.6)
-  std::uint64_t seed = 1;       ///< seeds positions, velocities (and charging, issue 4)
-  double temperature = 1.0;     ///< initial granular temperature T_g(0) (= T0 = 1 in reduced units)
+  int N = 1000;              ///< number of particles (>= 2)
+  double phi = 0.076;        ///< filling fraction N pi / (6 L^3), in (0, 0.6)
+  std::uint64_t seed = 1;    ///< seeds positions, velocities (and charging, issue 4)
+  double temperature = 1.0;  ///< initial granular temperature T_g(0) (= T0 = 1 in reduced units)
   std::string initial = "random";  ///< "random", or a CSV / H5MD file with positions, velocities
 };
 
@@ -42,7 +43,7 @@ struct ContactConfig {
 };
 
 struct IntegratorConfig {
-  double dt = 0.0;              ///< time step; 0 means "auto" (from the contact time)
+  double dt = 0.0;                  ///< time step; 0 means "auto" (from the contact time)
   double steps_per_contact = 50.0;  ///< auto dt = contact time of the fastest impact / this
   /// fastest expected impact speed for auto dt; 0 means "auto": the normal relative speed exceeded
   /// by a fraction 1e-6 of collisions in a Maxwellian gas at the initial temperature,
@@ -51,33 +52,37 @@ struct IntegratorConfig {
 };
 
 struct NeighborConfig {
-  double skin = 0.3;            ///< Verlet skin; lists rebuilt when a particle moved skin/2
+  double skin = 0.3;  ///< Verlet skin; lists rebuilt when a particle moved skin/2
 };
 
 /// Collisional charging (design.md section 2): at the first step of a contact, |dq| =
 /// Q [Psi1 m_eff xi'^2]^(kappa + Psi2) moves from one partner to the other (sign + or - with
-/// probability 1/2), Psi1 ~ U[psi1_min, psi1_max], Psi2 ~ U[-psi2_fraction kappa, +psi2_fraction kappa].
+/// probability 1/2), Psi1 ~ U[psi1_min, psi1_max], Psi2 ~ U[-psi2_fraction kappa, +psi2_fraction
+/// kappa].
 struct ChargingConfig {
-  std::string mode = "exchange";   ///< "exchange" (the paper's model) or "fixed" (charges never change)
+  std::string mode =
+      "exchange";  ///< "exchange" (the paper's model) or "fixed" (charges never change)
   /// initial charges: "neutral" (all 0), "monopolar" (all +q0), "bipolar" (+q0 or -q0 at random,
   /// zero net charge for even N), "file" (from system.initial)
   std::string initial = "neutral";
-  double q0 = 1.0;                 ///< charge magnitude of monopolar / bipolar initial states
-  double Q = 1.0;                  ///< charge scale of the exchange rule
-  double kappa = 0.83;             ///< exponent (Poppe et al. 2000, silica)
-  double psi1_min = 0.1;           ///< Psi1 range: U[0.1, 3.1623], mean 1.63
+  double q0 = 1.0;        ///< charge magnitude of monopolar / bipolar initial states
+  double Q = 1.0;         ///< charge scale of the exchange rule
+  double kappa = 0.83;    ///< exponent (Poppe et al. 2000, silica)
+  double psi1_min = 0.1;  ///< Psi1 range: U[0.1, 3.1623], mean 1.63
   double psi1_max = 3.1623;
-  double psi2_fraction = 0.05;     ///< Psi2 ~ U[-0.05 kappa, +0.05 kappa] (mean 0; the paper's typo, design.md)
+  double psi2_fraction =
+      0.05;  ///< Psi2 ~ U[-0.05 kappa, +0.05 kappa] (mean 0; the paper's typo, design.md)
 };
 
 /// Coulomb interaction K q_i q_k / r^2 with all periodic images (Ewald, tinfoil boundary).
 struct CoulombConfig {
-  double K = 0.0;                  ///< Coulomb constant l_B / d (paper: 0, 0.25, 1, 5); 0 switches Coulomb off
-  std::string method = "pppm";     ///< "pppm" (particle-mesh Ewald, production) or "ewald" (plain, reference)
-  double accuracy = 1e-4;          ///< requested relative RMS force accuracy (docs/coulomb.md)
-  double r_cut = 0.0;              ///< real-space cutoff; 0 = "auto"
-  int mesh = 0;                    ///< mesh points per side (pppm); 0 = "auto"
-  int order = 0;                   ///< charge-assignment order 2..7 (pppm); 0 = "auto"
+  double K = 0.0;  ///< Coulomb constant l_B / d (paper: 0, 0.25, 1, 5); 0 switches Coulomb off
+  std::string method =
+      "pppm";  ///< "pppm" (particle-mesh Ewald, production) or "ewald" (plain, reference)
+  double accuracy = 1e-4;  ///< requested relative RMS force accuracy (docs/coulomb.md)
+  double r_cut = 0.0;      ///< real-space cutoff; 0 = "auto"
+  int mesh = 0;            ///< mesh points per side (pppm); 0 = "auto"
+  int order = 0;           ///< charge-assignment order 2..7 (pppm); 0 = "auto"
   /// Multiple time stepping (Engine.h): the slow Coulomb force is evaluated every this many steps
   /// and applied as an impulse; 1 = every step (plain velocity Verlet with the total force);
   /// 0 = "auto": every 0.016 time units (Engine::coulombEvery; 8 steps at dt = 0.002)
@@ -85,26 +90,29 @@ struct CoulombConfig {
   /// The slow interval follows the gas, from every up to this many steps (Engine.h, "multiple
   /// time stepping"); <= every: fixed; 0 = "auto": 4 x every (docs/benchmarks-coulomb.md)
   int every_max = 0;
-  double skin = 0.0;               ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or neighbor.skin when every = 1)
-  double r_fast = 0.0;             ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (3.5)
+  double skin = 0.0;  ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or
+                      ///< neighbor.skin when every = 1)
+  double r_fast =
+      0.0;  ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (3.5)
 };
 
 struct RunConfig {
-  double t_end = 100.0;         ///< simulated time to reach
+  double t_end = 100.0;  ///< simulated time to reach
   /// stop (keeping the last checkpoint) if an overlap exceeds this. The paper's soft contacts
-  /// overlap a lot: an elastic Hertz impact at speed v reaches xi_max = (5 m_eff v^2 / (4 E))^{2/5},
-  /// 0.13 at v = 1.6 and 0.41 at v = 7.4 (the 1e-6 tail of impacts at T = 1).
+  /// overlap a lot: an elastic Hertz impact at speed v reaches xi_max = (5 m_eff v^2 / (4
+  /// E))^{2/5}, 0.13 at v = 1.6 and 0.41 at v = 7.4 (the 1e-6 tail of impacts at T = 1).
   double max_overlap = 0.6;
 };
 
 struct OutputConfig {
-  int frames_per_decade = 10;       ///< log-spaced frames in time (0: none)
-  double frame_interval = 0.0;      ///< linear frame spacing in time (0: none)
-  int observable_interval = 100;    ///< steps between observable samples
-  long checkpoint_interval = 0;     ///< steps between checkpoints (0: only at the end)
+  int frames_per_decade = 10;              ///< log-spaced frames in time (0: none)
+  double frame_interval = 0.0;             ///< linear frame spacing in time (0: none)
+  int observable_interval = 100;           ///< steps between observable samples
+  long checkpoint_interval = 0;            ///< steps between checkpoints (0: only at the end)
   double checkpoint_wall_seconds = 600.0;  ///< wall-clock seconds between checkpoints (0: off)
   bool write_velocities = true;
-  bool write_forces = false;        ///< per-particle total forces in every frame (/particles/all/force), for checks
+  bool write_forces =
+      false;  ///< per-particle total forces in every frame (/particles/all/force), for checks
 };
 
 struct MdConfig {

@@ -16,25 +16,35 @@ constexpr double PI = 3.14159265358979323846;
 double minimumImage(double d, double L) { return d - L * std::nearbyint(d / L); }
 }  // namespace
 
-EwaldReference::EwaldReference(const EwaldParams& params, double L, double K) : m_params(params), m_L(L), m_K(K) {
+EwaldReference::EwaldReference(const EwaldParams& params, double L, double K)
+    : m_params(params), m_L(L), m_K(K) {
   std::ostringstream msg;
-  if (!(L > 0.0) || !std::isfinite(L)) msg << "EwaldReference requires a positive box length L (got " << L << ").";
-  else if (!(K >= 0.0) || !std::isfinite(K)) msg << "EwaldReference requires a coupling K >= 0 (got " << K << ").";
-  else if (!(params.alpha > 0.0)) msg << "EwaldReference requires alpha > 0 (got " << params.alpha << ").";
-  else if (!(params.r_cut > 0.0)) msg << "EwaldReference requires r_cut > 0 (got " << params.r_cut << ").";
-  else if (params.k_max < 1) msg << "EwaldReference requires k_max >= 1 (got " << params.k_max << ").";
+  if (!(L > 0.0) || !std::isfinite(L))
+    msg << "EwaldReference requires a positive box length L (got " << L << ").";
+  else if (!(K >= 0.0) || !std::isfinite(K))
+    msg << "EwaldReference requires a coupling K >= 0 (got " << K << ").";
+  else if (!(params.alpha > 0.0))
+    msg << "EwaldReference requires alpha > 0 (got " << params.alpha << ").";
+  else if (!(params.r_cut > 0.0))
+    msg << "EwaldReference requires r_cut > 0 (got " << params.r_cut << ").";
+  else if (params.k_max < 1)
+    msg << "EwaldReference requires k_max >= 1 (got " << params.k_max << ").";
   if (!msg.str().empty()) throw std::invalid_argument(msg.str());
 }
 
-double EwaldReference::selfEnergy(double alpha, double K, double sum_q2) { return -K * alpha / std::sqrt(PI) * sum_q2; }
+double EwaldReference::selfEnergy(double alpha, double K, double sum_q2) {
+  return -K * alpha / std::sqrt(PI) * sum_q2;
+}
 
 double EwaldReference::backgroundEnergy(double alpha, double K, double L, double q_total) {
   return -K * PI * q_total * q_total / (2.0 * alpha * alpha * L * L * L);
 }
 
-double EwaldReference::realSpace(const double* x, const double* y, const double* z, const double* q, std::size_t n,
-                                 double L, double K, double alpha, double r_cut, double* fx, double* fy, double* fz) {
-  // images n L with |d0 + n L| < r_cut for a minimum-image d0 in [-L/2, L/2] need |n| < r_cut/L + 1/2
+double EwaldReference::realSpace(const double* x, const double* y, const double* z, const double* q,
+                                 std::size_t n, double L, double K, double alpha, double r_cut,
+                                 double* fx, double* fy, double* fz) {
+  // images n L with |d0 + n L| < r_cut for a minimum-image d0 in [-L/2, L/2] need |n| < r_cut/L +
+  // 1/2
   const int s = static_cast<int>(std::ceil(r_cut / L - 0.5));
   const double rc2 = r_cut * r_cut;
   std::vector<double> e(n, 0.0);
@@ -59,7 +69,8 @@ double EwaldReference::realSpace(const double* x, const double* y, const double*
             f0 += fr * dx;
             f1 += fr * dy;
             f2 += fr * dz;
-            ei += 0.5 * ewaldRealEnergy(qq, r, alpha, K);  // each pair (and image) seen from both ends
+            ei += 0.5 *
+                  ewaldRealEnergy(qq, r, alpha, K);  // each pair (and image) seen from both ends
           }
     }
     fx[i] += f0;
@@ -73,7 +84,8 @@ double EwaldReference::realSpace(const double* x, const double* y, const double*
 }
 
 CoulombResult EwaldReference::compute(const std::vector<double>& x, const std::vector<double>& y,
-                                      const std::vector<double>& z, const std::vector<double>& q) const {
+                                      const std::vector<double>& z,
+                                      const std::vector<double>& q) const {
   const std::size_t n = x.size();
   if (y.size() != n || z.size() != n || q.size() != n)
     throw std::invalid_argument("EwaldReference::compute requires x, y, z and q of equal length.");
@@ -83,9 +95,8 @@ CoulombResult EwaldReference::compute(const std::vector<double>& x, const std::v
   res.fx.assign(n, 0.0);
   res.fy.assign(n, 0.0);
   res.fz.assign(n, 0.0);
-  res.energy_real =
-      realSpace(x.data(), y.data(), z.data(), q.data(), n, L, K, alpha, m_params.r_cut, res.fx.data(), res.fy.data(),
-                res.fz.data());
+  res.energy_real = realSpace(x.data(), y.data(), z.data(), q.data(), n, L, K, alpha,
+                              m_params.r_cut, res.fx.data(), res.fy.data(), res.fz.data());
 
   double sum_q = 0.0, sum_q2 = 0.0;
   for (double v : q) {
@@ -105,7 +116,8 @@ CoulombResult EwaldReference::compute(const std::vector<double>& x, const std::v
     const double t[3] = {2.0 * PI * x[i] / L, 2.0 * PI * y[i] / L, 2.0 * PI * z[i] / L};
     C* tab[3] = {&ex[i * W], &ey[i * W], &ez[i * W]};
     for (int d = 0; d < 3; ++d)
-      for (int m = 0; m < W; ++m) tab[d][m] = std::polar(1.0, m * t[d]);  // direct, no recursion drift
+      for (int m = 0; m < W; ++m)
+        tab[d][m] = std::polar(1.0, m * t[d]);  // direct, no recursion drift
   }
   struct KVec {
     int a, b, c;

@@ -8,8 +8,9 @@
 /// (conducting) boundary conditions, the energy (Frenkel & Smit, sec. 12.1; Kolafa & Perram 1992)
 ///
 ///     E = E_real + E_recip + E_self + E_background
-///     E_real  = (K/2) sum_{i,j} sum_{n: |r_ij + nL| < r_cut}' q_i q_j erfc(alpha r) / r   (' : no i = j, n = 0)
-///     E_recip = (K / 2V) sum_{k != 0, |k| <= k_max 2pi/L} (4 pi / k^2) exp(-k^2 / 4 alpha^2) |S(k)|^2,
+///     E_real  = (K/2) sum_{i,j} sum_{n: |r_ij + nL| < r_cut}' q_i q_j erfc(alpha r) / r   (' : no
+///     i = j, n = 0) E_recip = (K / 2V) sum_{k != 0, |k| <= k_max 2pi/L} (4 pi / k^2) exp(-k^2 / 4
+///     alpha^2) |S(k)|^2,
 ///               S(k) = sum_j q_j exp(i k.r_j)
 ///     E_self  = -K alpha / sqrt(pi) sum_i q_i^2
 ///     E_background = -K pi Q^2 / (2 alpha^2 V),  Q = sum_i q_i   (uniform neutralising background;
@@ -43,14 +44,15 @@ class EwaldReference {
 
   /// Energy and forces of charges q at positions (x, y, z) (any real coordinates; periodic).
   /// Throws std::invalid_argument if the arrays differ in length.
-  CoulombResult compute(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z,
-                        const std::vector<double>& q) const;
+  CoulombResult compute(const std::vector<double>& x, const std::vector<double>& y,
+                        const std::vector<double>& z, const std::vector<double>& q) const;
 
   /// Real-space part alone, O(n^2) over all images within r_cut (the minimum image only when
   /// r_cut <= L/2): adds the forces to fx, fy, fz and returns E_real. Used by the tests to add the
   /// real-space part to Pppm's mesh part with the same RealSpace.h functions the engine uses.
-  static double realSpace(const double* x, const double* y, const double* z, const double* q, std::size_t n, double L,
-                          double K, double alpha, double r_cut, double* fx, double* fy, double* fz);
+  static double realSpace(const double* x, const double* y, const double* z, const double* q,
+                          std::size_t n, double L, double K, double alpha, double r_cut, double* fx,
+                          double* fy, double* fz);
 
   /// Self energy -K alpha / sqrt(pi) sum_q2.
   static double selfEnergy(double alpha, double K, double sum_q2);

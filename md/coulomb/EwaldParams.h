@@ -24,9 +24,9 @@ namespace granagg::md {
 
 /// Plain Ewald parameters (EwaldReference).
 struct EwaldParams {
-  double alpha = 0.0;                   ///< splitting parameter, in 1/d
-  double r_cut = 0.0;                   ///< real-space cutoff, in d (may exceed L/2: images are summed)
-  int k_max = 0;                        ///< reciprocal cutoff: k = 2 pi n / L for integer n, 0 < |n| <= k_max
+  double alpha = 0.0;  ///< splitting parameter, in 1/d
+  double r_cut = 0.0;  ///< real-space cutoff, in d (may exceed L/2: images are summed)
+  int k_max = 0;       ///< reciprocal cutoff: k = 2 pi n / L for integer n, 0 < |n| <= k_max
   double estimated_error_real = 0.0;    ///< Kolafa-Perram real-space RMS force error / K
   double estimated_error_kspace = 0.0;  ///< Kolafa-Perram reciprocal RMS force error / K
   /// sqrt(e_r^2 + e_k^2): estimated relative RMS force error.
@@ -35,11 +35,11 @@ struct EwaldParams {
 
 /// Particle-particle particle-mesh (P3M / PPPM) parameters for a cubic box (Pppm).
 struct PppmParams {
-  double alpha = 0.0;                   ///< splitting parameter, in 1/d
-  double r_cut = 0.0;                   ///< real-space cutoff, in d (<= L/2, minimum image)
-  int mesh = 0;                         ///< mesh points per box edge (product of 2, 3 and 5)
-  int order = 5;                        ///< charge-assignment order P (2..7): P points per dimension
-  double estimated_error_real = 0.0;    ///< Kolafa-Perram real-space RMS force error / K
+  double alpha = 0.0;                 ///< splitting parameter, in 1/d
+  double r_cut = 0.0;                 ///< real-space cutoff, in d (<= L/2, minimum image)
+  int mesh = 0;                       ///< mesh points per box edge (product of 2, 3 and 5)
+  int order = 5;                      ///< charge-assignment order P (2..7): P points per dimension
+  double estimated_error_real = 0.0;  ///< Kolafa-Perram real-space RMS force error / K
   double estimated_error_kspace = 0.0;  ///< Deserno-Holm / LAMMPS ik mesh RMS force error / K
   /// sqrt(e_r^2 + e_k^2): estimated relative RMS force error.
   double estimatedError() const;
@@ -72,15 +72,16 @@ int fftFriendlySize(int n_min);
 /// values are allowed and sum explicit images), alpha from the real-space estimate at
 /// accuracy / sqrt(2), then the smallest k_max whose reciprocal estimate is <= accuracy / sqrt(2).
 /// Throws std::invalid_argument for accuracy <= 0, n == 0, L <= 0, sum_q2 <= 0 or r_cut < 0.
-EwaldParams chooseEwaldParams(double accuracy, std::size_t n, double L, double sum_q2, double r_cut = 0.0);
+EwaldParams chooseEwaldParams(double accuracy, std::size_t n, double L, double sum_q2,
+                              double r_cut = 0.0);
 
 /// PPPM parameters for relative accuracy `accuracy` at a given real-space cutoff r_cut (0 < r_cut
 /// <= L/2) and assignment order (2..7, default 5): alpha from the real-space estimate at
 /// accuracy / sqrt(2), then the smallest FFT-friendly mesh whose estimate is <= accuracy / sqrt(2).
 /// Throws std::invalid_argument for unphysical inputs (naming the parameter), or when the mesh
 /// would exceed max_mesh points per edge.
-PppmParams choosePppmParams(double accuracy, std::size_t n, double L, double sum_q2, double r_cut, int order = 5,
-                            int max_mesh = 1024);
+PppmParams choosePppmParams(double accuracy, std::size_t n, double L, double sum_q2, double r_cut,
+                            int order = 5, int max_mesh = 1024);
 
 /// Cost model for one PPPM force evaluation, in nanoseconds per elementary operation. The
 /// defaults were measured on one core of the 2-core development VM (Release, N = 1e5, mesh 108,
@@ -102,7 +103,8 @@ double pppmCost(const PppmParams& p, std::size_t n, double L, const PppmCostMode
 
 /// PPPM parameters minimising pppmCost over r_cut in [r_cut_min, r_cut_max] (steps of 0.25 d;
 /// r_cut_max = 0 means L/2) and order 2..7, each meeting `accuracy` (choosePppmParams).
-PppmParams optimizePppmParams(double accuracy, std::size_t n, double L, double sum_q2, double r_cut_min,
-                              double r_cut_max = 0.0, const PppmCostModel& model = {});
+PppmParams optimizePppmParams(double accuracy, std::size_t n, double L, double sum_q2,
+                              double r_cut_min, double r_cut_max = 0.0,
+                              const PppmCostModel& model = {});
 
 }  // namespace granagg::md

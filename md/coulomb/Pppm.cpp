@@ -47,9 +47,9 @@ HD inline double meshCoordinate(double x, double inv_h, int M) {
 /// Charge-assignment weights of order P (Hockney & Eastwood's W^(P), the cardinal B-spline M_P
 /// centred on the mesh point) for a particle at mesh coordinate u: the P mesh points
 /// j_max - p (p = 0..P-1) with j_max = floor(u + P/2) receive a[p] = M_P(w + p), where
-/// w = u + P/2 - j_max in [0, 1). Cox-de Boor recursion M_n(t) = [t M_{n-1}(t) + (n - t) M_{n-1}(t-1)]
-/// / (n - 1), starting from M_2(w) = w, M_2(w + 1) = 1 - w; the weights sum to 1. Returns j_max
-/// (not wrapped).
+/// w = u + P/2 - j_max in [0, 1). Cox-de Boor recursion M_n(t) = [t M_{n-1}(t) + (n - t)
+/// M_{n-1}(t-1)] / (n - 1), starting from M_2(w) = w, M_2(w + 1) = 1 - w; the weights sum to 1.
+/// Returns j_max (not wrapped).
 HD inline int assignmentWeights(double u, int P, double* a) {
   const double s = u + 0.5 * P;
   const double jf = floor(s);
@@ -58,15 +58,18 @@ HD inline int assignmentWeights(double u, int P, double* a) {
   a[0] = w;
   a[1] = 1.0 - w;
   for (int n = 3; n <= P; ++n)
-    for (int p = n - 1; p >= 0; --p) a[p] = ((w + p) * a[p] + (n - w - p) * (p > 0 ? a[p - 1] : 0.0)) / (n - 1);
+    for (int p = n - 1; p >= 0; --p)
+      a[p] = ((w + p) * a[p] + (n - w - p) * (p > 0 ? a[p - 1] : 0.0)) / (n - 1);
   return static_cast<int>(jf);
 }
 
 constexpr int N_ALIAS = 2 * ALIAS_RANGE + 1;
 
 /// Hockney-Eastwood optimal influence function for ik-differentiation (Deserno & Holm 1998 I,
-/// eq. 31 with D(k) = i k and the Ewald reference force R(k) = -i k (4 pi / k^2) exp(-k^2/4alpha^2)):
-///     G_opt(k) = (4 pi / k^2) sum_m (k.k_m / k_m^2) exp(-k_m^2 / 4 alpha^2) U^2(k_m) / [sum_m U^2(k_m)]^2,
+/// eq. 31 with D(k) = i k and the Ewald reference force R(k) = -i k (4 pi / k^2)
+/// exp(-k^2/4alpha^2)):
+///     G_opt(k) = (4 pi / k^2) sum_m (k.k_m / k_m^2) exp(-k_m^2 / 4 alpha^2) U^2(k_m) / [sum_m
+///     U^2(k_m)]^2,
 /// k_m = k + 2 pi m / h, U(k) = prod_d sinc(k_d h / 2)^P. The numerator's alias sum runs over
 /// |m_d| <= ALIAS_RANGE; the denominator factorises into 1-D sums, precomputed (den1d) to
 /// convergence. The exponential and U^2 factorise too: 1-D tables per FFT index i and alias m
@@ -140,7 +143,8 @@ struct CellKey {
   }
 };
 
-/// For sorted particle k: weights (P per dimension), stencil top j_max per dimension, charge and cell.
+/// For sorted particle k: weights (P per dimension), stencil top j_max per dimension, charge and
+/// cell.
 struct SortedSetup {
   const double *x, *y, *z, *q;
   long stride;
@@ -242,18 +246,22 @@ struct FieldSpectrum {
   HD void operator()(long idx) const {
     const int Mz = M / 2 + 1;
     int i;
-    if (dim == 2) i = static_cast<int>(idx % Mz);
-    else if (dim == 1) i = static_cast<int>((idx / Mz) % M);
-    else i = static_cast<int>(idx / (long(Mz) * M));
+    if (dim == 2)
+      i = static_cast<int>(idx % Mz);
+    else if (dim == 1)
+      i = static_cast<int>((idx / Mz) % M);
+    else
+      i = static_cast<int>(idx / (long(Mz) * M));
     const int w = (M % 2 == 0 && i == M / 2) ? 0 : waveIndex(i, M);
     const double f = unit_over_V * w * G[idx];
     const double re = c[2 * idx], im = c[2 * idx + 1];
-    out[2 * idx] = f * im;       // -i f (re + i im) = f im - i f re
+    out[2 * idx] = f * im;  // -i f (re + i im) = f im - i f re
     out[2 * idx + 1] = -f * re;
   }
 };
 
-/// Mesh force on sorted particle k, added to its slot: F = K q sum_stencil W E (per-particle gather).
+/// Mesh force on sorted particle k, added to its slot: F = K q sum_stencil W E (per-particle
+/// gather).
 struct Interpolate {
   const double *wx, *wy, *wz, *qs, *ex, *ey, *ez;
   const int *jx, *jy, *jz, *order;
@@ -309,26 +317,33 @@ struct Pppm::Impl {
   double L, K, h, V;
   int M, P;
   Fft3d fft;
-  DVec<double> G;                    // influence function, r2c layout
-  DVec<double> mesh;                 // assigned charges (M^3)
-  DVec<double> spectrum, work;       // 2 * complexSize doubles
-  DVec<double> ex, ey, ez;           // field components on the mesh
-  DVec<long long> key, cell;         // sort keys, cell of each sorted particle
+  DVec<double> G;               // influence function, r2c layout
+  DVec<double> mesh;            // assigned charges (M^3)
+  DVec<double> spectrum, work;  // 2 * complexSize doubles
+  DVec<double> ex, ey, ez;      // field components on the mesh
+  DVec<long long> key, cell;    // sort keys, cell of each sorted particle
   DVec<int> order, start, jx, jy, jz;
   DVec<double> wx, wy, wz, qs;
   DVec<double> terms, blocks;
-  int tiles = 1;                     // tiles per dimension of the charge assignment (ScatterTile)
-  double self_correction = 0.0;      // mean P3M self-energy error per unit q^2 (SelfEnergyTerm)
+  int tiles = 1;                 // tiles per dimension of the charge assignment (ScatterTile)
+  double self_correction = 0.0;  // mean P3M self-energy error per unit q^2 (SelfEnergyTerm)
   PppmEnergies energies;
   bool computed = false;
-  PhaseTimer* timer = nullptr;       // setPhaseTimer
+  PhaseTimer* timer = nullptr;  // setPhaseTimer
 
   /// compute() for particle data with `stride` doubles between consecutive particles.
-  double run(const double* x, const double* y, const double* z, const double* q, long stride, std::size_t n,
-             double* fx, double* fy, double* fz, const int* id);
+  double run(const double* x, const double* y, const double* z, const double* q, long stride,
+             std::size_t n, double* fx, double* fy, double* fz, const int* id);
 
   Impl(const PppmParams& p, double L_, double K_)
-      : params(p), L(L_), K(K_), h(L_ / p.mesh), V(L_ * L_ * L_), M(p.mesh), P(p.order), fft(p.mesh, p.mesh, p.mesh) {}
+      : params(p),
+        L(L_),
+        K(K_),
+        h(L_ / p.mesh),
+        V(L_ * L_ * L_),
+        M(p.mesh),
+        P(p.order),
+        fft(p.mesh, p.mesh, p.mesh) {}
 
   /// Deterministic sum of n device values (squares if `square`): fixed blocks, then the block sums
   /// in order on the host.
@@ -347,12 +362,16 @@ struct Pppm::Impl {
 
 Pppm::Pppm(const PppmParams& params, double L, double K) {
   std::ostringstream msg;
-  if (!(L > 0.0) || !std::isfinite(L)) msg << "Pppm requires a positive box length L (got " << L << ").";
-  else if (!(K >= 0.0) || !std::isfinite(K)) msg << "Pppm requires a coupling K >= 0 (got " << K << ").";
-  else if (!(params.alpha > 0.0)) msg << "Pppm requires alpha > 0 (got " << params.alpha << ").";
+  if (!(L > 0.0) || !std::isfinite(L))
+    msg << "Pppm requires a positive box length L (got " << L << ").";
+  else if (!(K >= 0.0) || !std::isfinite(K))
+    msg << "Pppm requires a coupling K >= 0 (got " << K << ").";
+  else if (!(params.alpha > 0.0))
+    msg << "Pppm requires alpha > 0 (got " << params.alpha << ").";
   else if (params.order < 2 || params.order > MAX_ORDER)
     msg << "Pppm requires order in 2..7 (got " << params.order << ").";
-  else if (params.mesh < params.order) msg << "Pppm requires mesh >= order (got mesh " << params.mesh << ").";
+  else if (params.mesh < params.order)
+    msg << "Pppm requires mesh >= order (got mesh " << params.mesh << ").";
   if (!msg.str().empty()) throw std::invalid_argument(msg.str());
   m_impl.reset(new Impl(params, L, K));
   Impl& s = *m_impl;
@@ -374,13 +393,14 @@ Pppm::Pppm(const PppmParams& params, double L, double K) {
       tu[i * N_ALIAS + m + ALIAS_RANGE] = std::pow(sinc(0.5 * q * s.h), 2 * s.P);
     }
   }
-  const DVec<double> d_den(den.begin(), den.end()), d_tq(tq.begin(), tq.end()), d_te(te.begin(), te.end()),
-      d_tu(tu.begin(), tu.end());
+  const DVec<double> d_den(den.begin(), den.end()), d_tq(tq.begin(), tq.end()),
+      d_te(te.begin(), te.end()), d_tu(tu.begin(), tu.end());
   const long nc = static_cast<long>(s.fft.complexSize());
   s.G.resize(nc);
   s.terms.resize(nc);
-  thrust::for_each(thrust::counting_iterator<long>(0), thrust::counting_iterator<long>(nc),
-                   InfluenceFunction{M, raw(d_den), raw(d_tq), raw(d_te), raw(d_tu), raw(s.G), raw(s.terms)});
+  thrust::for_each(
+      thrust::counting_iterator<long>(0), thrust::counting_iterator<long>(nc),
+      InfluenceFunction{M, raw(d_den), raw(d_tq), raw(d_te), raw(d_tu), raw(s.G), raw(s.terms)});
   s.self_correction = K / (2.0 * s.V) * s.sum(raw(s.terms), nc, false);
   const long nr = static_cast<long>(s.fft.realSize());
   s.mesh.resize(nr);
@@ -397,17 +417,19 @@ Pppm::Pppm(const PppmParams& params, double L, double K) {
 
 Pppm::~Pppm() = default;
 
-double Pppm::compute(const double* x, const double* y, const double* z, const double* q, std::size_t n, double* fx,
-                     double* fy, double* fz, const int* id) {
+double Pppm::compute(const double* x, const double* y, const double* z, const double* q,
+                     std::size_t n, double* fx, double* fy, double* fz, const int* id) {
   return m_impl->run(x, y, z, q, 1, n, fx, fy, fz, id);
 }
 
-double Pppm::compute(const double* pos4, std::size_t n, double* fx, double* fy, double* fz, const int* id) {
+double Pppm::compute(const double* pos4, std::size_t n, double* fx, double* fy, double* fz,
+                     const int* id) {
   return m_impl->run(pos4, pos4 + 1, pos4 + 2, pos4 + 3, 4, n, fx, fy, fz, id);
 }
 
-double Pppm::Impl::run(const double* x, const double* y, const double* z, const double* q, long stride, std::size_t n,
-                       double* fx, double* fy, double* fz, const int* id) {
+double Pppm::Impl::run(const double* x, const double* y, const double* z, const double* q,
+                       long stride, std::size_t n, double* fx, double* fy, double* fz,
+                       const int* id) {
   Impl& s = *this;
   const int N = static_cast<int>(n);
   const int M = s.M, P = s.P;
@@ -422,15 +444,17 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   s.key.resize(n);
   s.order.resize(n);
   thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(N),
-                   CellKey{x, y, z, stride, id, inv_h, M, P, static_cast<long long>(n), raw(s.key), raw(s.order)});
+                   CellKey{x, y, z, stride, id, inv_h, M, P, static_cast<long long>(n), raw(s.key),
+                           raw(s.order)});
   thrust::sort_by_key(s.key.begin(), s.key.end(), s.order.begin());
   for (auto* v : {&s.wx, &s.wy, &s.wz}) v->resize(n * P);
   for (auto* v : {&s.jx, &s.jy, &s.jz}) v->resize(n);
   s.qs.resize(n);
   s.cell.resize(n);
   thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(N),
-                   SortedSetup{x, y, z, q, stride, raw(s.key), raw(s.order), inv_h, M, P, static_cast<long long>(n),
-                               raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx), raw(s.jy), raw(s.jz), raw(s.cell)});
+                   SortedSetup{x, y, z, q, stride, raw(s.key), raw(s.order), inv_h, M, P,
+                               static_cast<long long>(n), raw(s.wx), raw(s.wy), raw(s.wz),
+                               raw(s.qs), raw(s.jx), raw(s.jy), raw(s.jz), raw(s.cell)});
   thrust::for_each(counting_iterator<long>(0), counting_iterator<long>(static_cast<long>(n) + 1),
                    CellStart{raw(s.cell), static_cast<long>(n), nr, raw(s.start)});
   // self and background energies from sum q, sum q^2, summed in the sorted order (cell, id):
@@ -448,9 +472,10 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   for (int cx = 0; cx < colours; ++cx)
     for (int cy = 0; cy < colours; ++cy)
       for (int cz = 0; cz < colours; ++cz)
-        thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(tiles_per_pass),
-                         ScatterTile{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx), raw(s.jy), raw(s.jz),
-                                     raw(s.start), M, P, T, cx, cy, cz, raw(s.mesh)});
+        thrust::for_each(
+            counting_iterator<int>(0), counting_iterator<int>(tiles_per_pass),
+            ScatterTile{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx), raw(s.jy), raw(s.jz),
+                        raw(s.start), M, P, T, cx, cy, cz, raw(s.mesh)});
   phase.emplace(s.timer, PhaseTimer::PppmFft);
   s.fft.forward(raw(s.mesh), raw(s.spectrum));
   phase.emplace(s.timer, PhaseTimer::PppmKspace);
@@ -458,23 +483,26 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   // 3. energy (K / 2V) sum_k G |Q|^2
   thrust::for_each(counting_iterator<long>(0), counting_iterator<long>(nc),
                    EnergyTerm{raw(s.G), raw(s.spectrum), M, raw(s.terms)});
-  s.energies.kspace = s.K / (2.0 * s.V) * s.sum(raw(s.terms), nc, false) + s.self_correction * sum_q2;
+  s.energies.kspace =
+      s.K / (2.0 * s.V) * s.sum(raw(s.terms), nc, false) + s.self_correction * sum_q2;
 
   // 4. field by ik-differentiation: one inverse FFT per component (backward overwrites `work`)
   DVec<double>* field[3] = {&s.ex, &s.ey, &s.ez};
   for (int d = 0; d < 3; ++d) {
     phase.emplace(s.timer, PhaseTimer::PppmKspace);
-    thrust::for_each(counting_iterator<long>(0), counting_iterator<long>(nc),
-                     FieldSpectrum{raw(s.G), raw(s.spectrum), M, d, 2.0 * PI / s.L / s.V, raw(s.work)});
+    thrust::for_each(
+        counting_iterator<long>(0), counting_iterator<long>(nc),
+        FieldSpectrum{raw(s.G), raw(s.spectrum), M, d, 2.0 * PI / s.L / s.V, raw(s.work)});
     phase.emplace(s.timer, PhaseTimer::PppmFft);
     s.fft.backward(raw(s.work), raw(*field[d]));
   }
   phase.emplace(s.timer, PhaseTimer::PppmInterpolate);
 
   // 5. interpolation back to the particles
-  thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(N),
-                   Interpolate{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.ex), raw(s.ey), raw(s.ez), raw(s.jx),
-                               raw(s.jy), raw(s.jz), raw(s.order), M, P, s.K, fx, fy, fz});
+  thrust::for_each(
+      counting_iterator<int>(0), counting_iterator<int>(N),
+      Interpolate{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.ex), raw(s.ey), raw(s.ez),
+                  raw(s.jx), raw(s.jy), raw(s.jz), raw(s.order), M, P, s.K, fx, fy, fz});
   s.computed = true;
   return s.energies.total();
 }
@@ -484,7 +512,8 @@ CoulombResult Pppm::computeHost(const std::vector<double>& x, const std::vector<
   const std::size_t n = x.size();
   if (y.size() != n || z.size() != n || q.size() != n)
     throw std::invalid_argument("Pppm::computeHost requires x, y, z and q of equal length.");
-  DVec<double> dx(x.begin(), x.end()), dy(y.begin(), y.end()), dz(z.begin(), z.end()), dq(q.begin(), q.end());
+  DVec<double> dx(x.begin(), x.end()), dy(y.begin(), y.end()), dz(z.begin(), z.end()),
+      dq(q.begin(), q.end());
   DVec<double> fx(n, 0.0), fy(n, 0.0), fz(n, 0.0);
   compute(raw(dx), raw(dy), raw(dz), raw(dq), n, raw(fx), raw(fy), raw(fz));
   CoulombResult r;
@@ -502,7 +531,8 @@ CoulombResult Pppm::computeHost(const std::vector<double>& x, const std::vector<
 }
 
 const PppmEnergies& Pppm::lastEnergies() const {
-  if (!m_impl->computed) throw std::logic_error("Pppm::lastEnergies: nothing has been computed yet.");
+  if (!m_impl->computed)
+    throw std::logic_error("Pppm::lastEnergies: nothing has been computed yet.");
   return m_impl->energies;
 }
 const PppmParams& Pppm::params() const { return m_impl->params; }

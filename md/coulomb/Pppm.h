@@ -20,7 +20,8 @@
 /// self-energy correction (Ballenegger, Cerda & Holm 2012), so that a lone charge's energy
 /// averages to the exact Ewald value.
 ///
-/// This header has no Thrust in it (pimpl), so host-only code (tests, CLI) can use it in a CUDA build.
+/// This header has no Thrust in it (pimpl), so host-only code (tests, CLI) can use it in a CUDA
+/// build.
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -32,8 +33,8 @@ namespace granagg::md {
 
 /// Energies of the last Pppm evaluation, in T0.
 struct PppmEnergies {
-  double kspace = 0.0;      ///< mesh sum (K / 2V) sum_k G_opt |Q(k)|^2 + mean self-energy correction
-  double self = 0.0;        ///< -K alpha / sqrt(pi) sum q^2
+  double kspace = 0.0;  ///< mesh sum (K / 2V) sum_k G_opt |Q(k)|^2 + mean self-energy correction
+  double self = 0.0;    ///< -K alpha / sqrt(pi) sum q^2
   double background = 0.0;  ///< -K pi Q^2 / (2 alpha^2 V) (zero for a neutral system)
   double total() const { return kspace + self + background; }
 };
@@ -55,17 +56,18 @@ class Pppm {
   /// may lie anywhere (they are wrapped into the box). `id` (optional, values 0..n-1, a
   /// permutation) orders the charges within a mesh cell, so that results do not depend on the
   /// storage order; without it the slot index is used.
-  double compute(const double* x, const double* y, const double* z, const double* q, std::size_t n, double* fx,
-                 double* fy, double* fz, const int* id = nullptr);
+  double compute(const double* x, const double* y, const double* z, const double* q, std::size_t n,
+                 double* fx, double* fy, double* fz, const int* id = nullptr);
 
   /// The same for the engine's packed layout: pos4 holds n records of 4 doubles (x, y, z, q), the
   /// Scalar4 of md/engine/ParticleData.h (device pointer).
-  double compute(const double* pos4, std::size_t n, double* fx, double* fy, double* fz, const int* id = nullptr);
+  double compute(const double* pos4, std::size_t n, double* fx, double* fy, double* fz,
+                 const int* id = nullptr);
 
   /// Host convenience (copies in and out): the mesh forces alone (fx, fy, fz) and energies
   /// (energy_kspace, energy_self, energy_background; energy_real = 0; energy = their sum).
-  CoulombResult computeHost(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z,
-                            const std::vector<double>& q);
+  CoulombResult computeHost(const std::vector<double>& x, const std::vector<double>& y,
+                            const std::vector<double>& z, const std::vector<double>& q);
 
   /// Energies of the last compute(); throws std::logic_error before the first one.
   const PppmEnergies& lastEnergies() const;

@@ -34,7 +34,8 @@ HD inline double ewaldRealEnergy(double qiqj, double r, double alpha, double K) 
 HD inline double ewaldRealForceOverR(double qiqj, double r, double alpha, double K) {
   const double ar = alpha * r;
   const double inv_r = 1.0 / r;
-  return K * qiqj * (::erfc(ar) * inv_r + TWO_OVER_SQRT_PI * alpha * ::exp(-ar * ar)) * inv_r * inv_r;
+  return K * qiqj * (::erfc(ar) * inv_r + TWO_OVER_SQRT_PI * alpha * ::exp(-ar * ar)) * inv_r *
+         inv_r;
 }
 
 /// The same force factor for the MD hot loop, with erfc from Abramowitz & Stegun 7.1.26 (absolute
@@ -43,8 +44,8 @@ HD inline double ewaldRealForceOverR(double qiqj, double r, double alpha, double
 /// is below 1.5e-7 K |q_i q_j| / r^2, far under the requested Ewald accuracies (>= 1e-6 relative to
 /// K); the references (EwaldReference, the tests) keep the exact ewaldRealForceOverR.
 HD inline double ewaldRealForceOverRFast(double qiqj, double r, double alpha, double K) {
-  constexpr double P = 0.3275911, A1 = 0.254829592, A2 = -0.284496736, A3 = 1.421413741, A4 = -1.453152027,
-                   A5 = 1.061405429;
+  constexpr double P = 0.3275911, A1 = 0.254829592, A2 = -0.284496736, A3 = 1.421413741,
+                   A4 = -1.453152027, A5 = 1.061405429;
   const double ar = alpha * r;
   const double e = ::exp(-ar * ar);
   const double t = 1.0 / (1.0 + P * ar);
@@ -74,16 +75,18 @@ struct RealSpaceSwitch {
 
 /// The slow pair force of a split with r1 >= 1 (every contact entirely fast), divided by K q_i q_j
 /// and by r: g(r) = [erfc(alpha r)/r + (2 alpha/sqrt pi) exp(-alpha^2 r^2)] / r^2 - S(r) / r^3.
-/// Where S = 1 this is minus the pair's smooth erf part, finite at r = 0 (-4 alpha^3 / (3 sqrt pi)),
-/// so it is evaluated in that form there (no cancellation of two large terms).
+/// Where S = 1 this is minus the pair's smooth erf part, finite at r = 0 (-4 alpha^3 / (3 sqrt
+/// pi)), so it is evaluated in that form there (no cancellation of two large terms).
 inline double slowPairForceOverR(double r, double alpha, const RealSpaceSwitch& sw) {
   const double ar = alpha * r;
   if (r <= sw.r1) {
-    if (ar < 1e-3)  // series: erf(x)/x - 2/sqrt(pi) exp(-x^2) = (2/sqrt(pi)) (2 x^2/3 - 4 x^4/5 + ...)
+    if (ar <
+        1e-3)  // series: erf(x)/x - 2/sqrt(pi) exp(-x^2) = (2/sqrt(pi)) (2 x^2/3 - 4 x^4/5 + ...)
       return -TWO_OVER_SQRT_PI * alpha * alpha * alpha * (2.0 / 3.0 - 0.8 * ar * ar);
     return -(std::erf(ar) / r - TWO_OVER_SQRT_PI * alpha * std::exp(-ar * ar)) / (r * r);
   }
-  return (std::erfc(ar) / r + TWO_OVER_SQRT_PI * alpha * std::exp(-ar * ar)) / (r * r) - sw.fastFraction(r) / (r * r * r);
+  return (std::erfc(ar) / r + TWO_OVER_SQRT_PI * alpha * std::exp(-ar * ar)) / (r * r) -
+         sw.fastFraction(r) / (r * r * r);
 }
 
 /// Piecewise-cubic interpolation in r^2 of a smooth function g (the slow or fast pair force over
@@ -149,8 +152,8 @@ inline std::vector<double> fastPairTableValues(const RealSpaceSwitch& sw,
 /// Table of slowPairForceOverR on [0, r2_max].
 inline std::vector<double> slowPairTableValues(double alpha, const RealSpaceSwitch& sw,
                                                double r2_max, int n = SLOW_PAIR_TABLE_INTERVALS) {
-  return pairTableValues(
-      [&](double r2) { return slowPairForceOverR(std::sqrt(r2), alpha, sw); }, r2_max, n);
+  return pairTableValues([&](double r2) { return slowPairForceOverR(std::sqrt(r2), alpha, sw); },
+                         r2_max, n);
 }
 
 }  // namespace granagg::md

@@ -12,10 +12,10 @@
 #include <thrust/fill.h>
 #include <thrust/functional.h>
 #include <thrust/gather.h>
-#include <thrust/scatter.h>
-#include <thrust/sequence.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/reduce.h>
+#include <thrust/scatter.h>
+#include <thrust/sequence.h>
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
@@ -101,7 +101,8 @@ struct ChargeOf {
 };
 struct CombineCharges {
   HD ChargeSums operator()(const ChargeSums& a, const ChargeSums& b) const {
-    return ChargeSums{a.total + b.total, a.abs_sum + b.abs_sum, a.abs_max > b.abs_max ? a.abs_max : b.abs_max};
+    return ChargeSums{a.total + b.total, a.abs_sum + b.abs_sum,
+                      a.abs_max > b.abs_max ? a.abs_max : b.abs_max};
   }
 };
 struct Axpy {  // v + a f
@@ -150,16 +151,17 @@ struct Engine::Impl {
   std::int64_t step = 0;
   double time = 0.0;
   std::int64_t collisions = 0;
-  bool close_pending = false;      // v holds u = v(t - dt/2): the closing kick is still to apply
-  double drift_since_build = 0.0;  // sum over steps of dt * max |u| (+ rounding): bounds every displacement
-  bool exchange = false;           // collisional charging on (charging.mode = "exchange")
+  bool close_pending = false;  // v holds u = v(t - dt/2): the closing kick is still to apply
+  double drift_since_build =
+      0.0;                // sum over steps of dt * max |u| (+ rounding): bounds every displacement
+  bool exchange = false;  // collisional charging on (charging.mode = "exchange")
   ChargeExchange::Params charging{};
-  DVec<double> dq;                 // charge gained at the last force pass, per slot (exchange only)
+  DVec<double> dq;  // charge gained at the last force pass, per slot (exchange only)
   // Coulomb (coulomb.K > 0): the slow force of the impulse multiple-time-step integrator
   // (Engine.h), evaluated every coulomb.every steps into ext_f*: PPPM's real space over its own
   // neighbour list nl_coul plus its mesh part, or a whole plain-Ewald evaluation
   bool coulomb = false;
-  int every = 1;                            // steps from the last evaluation to the next
+  int every = 1;  // steps from the last evaluation to the next
   // the slow interval that follows the gas (coulomb.every_max > every): between every_base and
   // every_cap steps, chosen at each evaluation (chooseEvery); fixed: every_cap = every_base
   int every_base = 1, every_cap = 1;
@@ -168,20 +170,22 @@ struct Engine::Impl {
   CoulombSetup csetup;
   std::unique_ptr<Pppm> pppm;
   std::unique_ptr<EwaldReference> ewald;
-  std::unique_ptr<NeighborList> nl_coul;    // pppm: reaches r_cut + coulomb.skin
-  RealSpaceSwitch fast_switch{};            // pppm with every > 1: the real space within r_fast is fast
-  DVec<double> slow_table, fast_table;      // ... and the slow and fast pair forces tabulated (PairTable)
-  double drift_since_coul_build = 0.0;      // as drift_since_build, for nl_coul
-  DVec<double> ext_fx, ext_fy, ext_fz;      // the Coulomb force at the last evaluation, per slot
-  double coulomb_ext_energy = 0.0;          // pppm: mesh + self + background; ewald: everything
-  std::int64_t kspace_step = -1;            // step of the last Coulomb evaluation (-1: none yet)
+  std::unique_ptr<NeighborList> nl_coul;  // pppm: reaches r_cut + coulomb.skin
+  RealSpaceSwitch fast_switch{};  // pppm with every > 1: the real space within r_fast is fast
+  DVec<double> slow_table,
+      fast_table;  // ... and the slow and fast pair forces tabulated (PairTable)
+  double drift_since_coul_build = 0.0;  // as drift_since_build, for nl_coul
+  DVec<double> ext_fx, ext_fy, ext_fz;  // the Coulomb force at the last evaluation, per slot
+  double coulomb_ext_energy = 0.0;      // pppm: mesh + self + background; ewald: everything
+  std::int64_t kspace_step = -1;        // step of the last Coulomb evaluation (-1: none yet)
   bool hertz = true;
   HertzViscoelastic::Params hertz_params{};
   SpringDashpot::Params sd_params{};
-  PhaseTimer timer;                         // Engine::enableProfile
+  PhaseTimer timer;  // Engine::enableProfile
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
-    nl.keepPairs(true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
+    nl.keepPairs(
+        true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
     exchange = c.charging.mode == "exchange";
     charging.seed = c.system.seed;
     charging.Q = c.charging.Q;
@@ -208,8 +212,8 @@ struct Engine::Impl {
 
   /// Stores particles in cell order (memory locality for the neighbour gathers: a particle's
   /// neighbours then sit within a few hundred slots of it). Rows are sorted by particle id, so
-  /// forces, and hence trajectories, do not depend on the storage order. The caller rebuilds the list.
-  /// Returns false if nothing was sorted (boxes too small for cells).
+  /// forces, and hence trajectories, do not depend on the storage order. The caller rebuilds the
+  /// list. Returns false if nothing was sorted (boxes too small for cells).
   bool sortByCell() {
     const DVec<int>& order = nl.computeCellOrder(p, box);
     if (order.size() != p.size()) return false;  // all-pairs builds: nothing to sort
@@ -278,24 +282,31 @@ struct Engine::Impl {
     nl.keepPairs(true);
     if (cc.method == "pppm") {
       // "auto": a longer skin than the contact list's when the list is used every k-th step only
-      // (fewer builds of a long list; measured optimum at N = 1e4, K = 5: docs/benchmarks-coulomb.md)
+      // (fewer builds of a long list; measured optimum at N = 1e4, K = 5:
+      // docs/benchmarks-coulomb.md)
       const double coul_skin = cc.skin > 0.0 ? cc.skin : (every_base > 1 ? 0.8 : skin);
       const double rc_max = 0.5 * L - coul_skin;  // the list must reach r_cut + skin within L/2
       if (cc.r_cut > rc_max)
-        throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) + " exceeds L/2 - coulomb.skin = " +
-                                    common::formatReal(rc_max) + " for this box (L = " + common::formatReal(L) + ")");
+        throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) +
+                                    " exceeds L/2 - coulomb.skin = " + common::formatReal(rc_max) +
+                                    " for this box (L = " + common::formatReal(L) + ")");
       PppmParams prm;
       if (cc.r_cut > 0.0) {
-        prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut, cc.order > 0 ? cc.order : 5);
+        prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut,
+                               cc.order > 0 ? cc.order : 5);
       } else {
-        if (!(rc_max >= 1.0)) throw std::invalid_argument("box too small for PPPM with this coulomb.skin (L/2 - skin < 1)");
+        if (!(rc_max >= 1.0))
+          throw std::invalid_argument(
+              "box too small for PPPM with this coulomb.skin (L/2 - skin < 1)");
         prm = optimizePppmParams(cc.accuracy, N, L, sum_q2_design, 1.0, rc_max);
         if (cc.order > 0 && cc.order != prm.order)
           prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, prm.r_cut, cc.order);
       }
-      if (cc.mesh > 0) {  // a mesh given explicitly overrides the chosen one (its error is reported)
+      if (cc.mesh >
+          0) {  // a mesh given explicitly overrides the chosen one (its error is reported)
         prm.mesh = cc.mesh;
-        prm.estimated_error_kspace = pppmKspaceError(prm.alpha, prm.mesh, prm.order, N, L, sum_q2_design);
+        prm.estimated_error_kspace =
+            pppmKspaceError(prm.alpha, prm.mesh, prm.order, N, L, sum_q2_design);
       }
       pppm = std::make_unique<Pppm>(prm, L, cc.K);
       pppm->setPhaseTimer(&timer);
@@ -311,8 +322,9 @@ struct Engine::Impl {
       if (every_base > 1) {
         const double r2 = std::min(cc.r_fast > 0.0 ? cc.r_fast : 3.5, prm.r_cut);
         if (r2 < 2.0)
-          throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(prm.r_cut) + " leaves coulomb.r_fast = " +
-                                      common::formatReal(r2) + " < 2 for the multiple time stepping (coulomb.every > 1): "
+          throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(prm.r_cut) +
+                                      " leaves coulomb.r_fast = " + common::formatReal(r2) +
+                                      " < 2 for the multiple time stepping (coulomb.every > 1): "
                                       "use a larger r_cut or coulomb.every = 1");
         fast_switch = RealSpaceSwitch{std::max(0.0, r2 - 1.0), r2};
         csetup.r_fast = r2;
@@ -324,7 +336,8 @@ struct Engine::Impl {
         fast_table.assign(f.begin(), f.end());
       }
       nl = NeighborList(std::max(1.0, fast_switch.r2), skin);
-      nl.keepPairs(fast_switch.r2 == 0.0);  // with a fast Coulomb part every entry has work: per-row loops
+      nl.keepPairs(fast_switch.r2 ==
+                   0.0);  // with a fast Coulomb part every entry has work: per-row loops
     } else {
       const EwaldParams prm = chooseEwaldParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut);
       ewald = std::make_unique<EwaldReference>(prm, L, cc.K);
@@ -349,7 +362,8 @@ struct Engine::Impl {
   CoulombResult ewaldOnHost() const {
     const auto pos = toHost(p.pos);
     std::vector<double> x(pos.size()), y(pos.size()), z(pos.size()), q(pos.size());
-    for (std::size_t i = 0; i < pos.size(); ++i) x[i] = pos[i].x, y[i] = pos[i].y, z[i] = pos[i].z, q[i] = pos[i].w;
+    for (std::size_t i = 0; i < pos.size(); ++i)
+      x[i] = pos[i].x, y[i] = pos[i].y, z[i] = pos[i].z, q[i] = pos[i].w;
     return ewald->compute(x, y, z, q);
   }
 
@@ -369,8 +383,8 @@ struct Engine::Impl {
         PhaseTimer::Scope phase(&timer, PhaseTimer::CoulombReal);
         coulombRealForces(p, *nl_coul, box, realParams(), ext_fx, ext_fy, ext_fz);
       }
-      coulomb_ext_energy = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), N, raw(ext_fx), raw(ext_fy),
-                                         raw(ext_fz), raw(p.id));
+      coulomb_ext_energy = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), N,
+                                         raw(ext_fx), raw(ext_fy), raw(ext_fz), raw(p.id));
       return;
     }
     // the plain-Ewald reference: all of its evaluation counts as the slow real space
@@ -426,8 +440,8 @@ struct Engine::Impl {
       st.fast = fast_switch;
       st.coulomb_K = cfg.coulomb.K;
       if (!fast_table.empty())
-        st.fast_table = pairTable(raw(fast_table), fast_switch.r2 * fast_switch.r2,
-                                  FAST_PAIR_TABLE_INTERVALS);
+        st.fast_table =
+            pairTable(raw(fast_table), fast_switch.r2 * fast_switch.r2, FAST_PAIR_TABLE_INTERVALS);
     }
     return st;
   }
@@ -443,7 +457,8 @@ struct Engine::Impl {
     // rigorous bound that needs no stored reference positions).
     const bool slow = coulomb && (kspace_step < 0 || step - kspace_step >= every);
     const double prev_weight = coulomb ? slowWeight(step - 1) : 0.0;
-    if (slow && nl_coul && nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build))
+    if (slow && nl_coul &&
+        nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build))
       rebuildList(true);
     else if (nl.needsRebuild(p, drift_since_build * drift_since_build))
       rebuildContactList();
@@ -453,8 +468,9 @@ struct Engine::Impl {
     st.displacement_bound = drift_since_build;
     if (advance) st.advance_dt = dt;
     PhaseTimer::Scope phase(&timer, PhaseTimer::ContactPass);
-    const ContactStepResult r = hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
-                                      : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
+    const ContactStepResult r =
+        hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
+              : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
     if (r.worst != 0) abort(r.worst);
     collisions += r.collisions;
     if (advance) driftTaken(r.max_u2);
@@ -525,7 +541,8 @@ struct Engine::Impl {
       double ext = coulomb_ext_energy;
       if (kspace_step != step) {
         DVec<double> gx(p.size(), 0.0), gy(p.size(), 0.0), gz(p.size(), 0.0);
-        ext = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), p.size(), raw(gx), raw(gy), raw(gz), raw(p.id));
+        ext = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), p.size(), raw(gx), raw(gy),
+                            raw(gz), raw(p.id));
       }
       return coulombRealEnergy(p, *nl_coul, box, realParams()) + ext;
     }
@@ -552,7 +569,8 @@ struct Engine::Impl {
     }
     std::ostringstream msg;
     msg << "step " << step << " (t = " << time << "): ";
-    msg << (worst == 1 ? "non-finite force or position (NaN/inf)" : "overlap beyond run.max_overlap = ");
+    msg << (worst == 1 ? "non-finite force or position (NaN/inf)"
+                       : "overlap beyond run.max_overlap = ");
     if (worst != 1) msg << cfg.run.max_overlap;
     msg << " for particle(s)";
     int shown = 0;
@@ -570,7 +588,8 @@ struct Engine::Impl {
       double worst_qq = 0.0;
       for (std::size_t i = 0; i < bad.size(); ++i)
         if (bad[i] == 2) worst_qq = std::max(worst_qq, pos[i].w * pos[i].w);
-      msg << ", or an attractive Coulomb pair beyond what the Hertz contact can hold (K |q_i q_j| > 0.0916 E = "
+      msg << ", or an attractive Coulomb pair beyond what the Hertz contact can hold (K |q_i q_j| "
+             "> 0.0916 E = "
           << hold << " has no equilibrium overlap; here K q^2 = " << cfg.coulomb.K * worst_qq
           << " for the largest flagged charge): lower coulomb.K or charging.Q";
     }
@@ -582,7 +601,8 @@ struct Engine::Impl {
   /// of L each per component: 2 ulp(L) per step bounds that for the vector, so that the bounds
   /// hold to the last bit, also for a gas so cold that dt |u| is itself of the order of an ulp.
   void driftTaken(double max_u2) {
-    const double moved = dt * std::sqrt(max_u2) + 2.0 * (std::nextafter(box.L, 2.0 * box.L) - box.L);
+    const double moved =
+        dt * std::sqrt(max_u2) + 2.0 * (std::nextafter(box.L, 2.0 * box.L) - box.L);
     drift_since_build += moved;
     drift_since_coul_build += moved;
     ++step;
@@ -628,13 +648,16 @@ double Engine::chooseTimeStep(const MdConfig& c, std::string* reason) {
   std::ostringstream why;
   double tc;
   if (c.contact.model == "spring_dashpot") {
-    const auto sp = SpringDashpot::makeParams(c.contact.stiffness, c.contact.restitution, c.contact.clamp, M_EFF);
+    const auto sp = SpringDashpot::makeParams(c.contact.stiffness, c.contact.restitution,
+                                              c.contact.clamp, M_EFF);
     tc = SpringDashpot::contactTime(sp, M_EFF);
     why << "spring-dashpot contact time " << tc;
   } else {
     const double v = impactSpeedMax(c);
     if (!(c.contact.E > 0.0))
-      throw std::invalid_argument("integrator.dt = \"auto\" needs contact.E > 0 (the Hertz contact time is infinite for E = 0); give integrator.dt explicitly.");
+      throw std::invalid_argument(
+          "integrator.dt = \"auto\" needs contact.E > 0 (the Hertz contact time is infinite for E "
+          "= 0); give integrator.dt explicitly.");
     tc = HertzViscoelastic::contactTime(v, {c.contact.E, c.contact.D, c.contact.clamp}, M_EFF);
     why << "elastic Hertz contact time " << tc << " at impact speed " << v;
   }
@@ -653,18 +676,24 @@ int Engine::coulombEvery(const MdConfig& c, double dt) {
   return std::max(1, static_cast<int>(std::floor(SLOW_INTERVAL / dt + 1e-9)));
 }
 
-Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) : m_impl(std::make_unique<Impl>(config)) {
+Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
+    : m_impl(std::make_unique<Impl>(config)) {
   Impl& d = *m_impl;
   const std::size_t N = init.size();
-  if (N < 2) throw std::invalid_argument("the initial state needs at least 2 particles (got " + std::to_string(N) + ").");
+  if (N < 2)
+    throw std::invalid_argument("the initial state needs at least 2 particles (got " +
+                                std::to_string(N) + ").");
   for (const auto* v : {&init.y, &init.z, &init.vx, &init.vy, &init.vz})
-    if (v->size() != N) throw std::invalid_argument("initial state: position and velocity arrays differ in length.");
-  if (!(init.box > 0.0) || !std::isfinite(init.box)) throw std::invalid_argument("initial state: box edge must be positive.");
+    if (v->size() != N)
+      throw std::invalid_argument("initial state: position and velocity arrays differ in length.");
+  if (!(init.box > 0.0) || !std::isfinite(init.box))
+    throw std::invalid_argument("initial state: box edge must be positive.");
   d.box.L = init.box;
   d.hertz = config.contact.model != "spring_dashpot";
   d.hertz_params = {config.contact.E, config.contact.D, config.contact.clamp};
   if (!d.hertz)
-    d.sd_params = SpringDashpot::makeParams(config.contact.stiffness, config.contact.restitution, config.contact.clamp, M_EFF);
+    d.sd_params = SpringDashpot::makeParams(config.contact.stiffness, config.contact.restitution,
+                                            config.contact.clamp, M_EFF);
   d.dt = chooseTimeStep(config);
   d.every = d.every_prev = d.every_base = d.every_cap = coulombEvery(config, d.dt);
   if (d.every_base > 1) {
@@ -679,7 +708,9 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
     if (v->size() != N) v->assign(N, 0);
   for (std::size_t i = 0; i < N; ++i) {
     for (double v : {f.x[i], f.y[i], f.z[i], f.vx[i], f.vy[i], f.vz[i], f.charge[i]})
-      if (!std::isfinite(v)) throw std::invalid_argument("initial state: non-finite value for particle " + std::to_string(i) + ".");
+      if (!std::isfinite(v))
+        throw std::invalid_argument("initial state: non-finite value for particle " +
+                                    std::to_string(i) + ".");
     f.ix[i] += d.box.wrap(f.x[i]);
     f.iy[i] += d.box.wrap(f.y[i]);
     f.iz[i] += d.box.wrap(f.z[i]);
@@ -702,18 +733,21 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts) :
     d.computeInitialForces();
     return;
   }
-  const auto rows = toHost(DVec<int>(d.nl.rows(), d.nl.rows() + N * static_cast<std::size_t>(d.nl.capacity())));
+  const auto rows =
+      toHost(DVec<int>(d.nl.rows(), d.nl.rows() + N * static_cast<std::size_t>(d.nl.capacity())));
   const auto counts = toHost(DVec<int>(d.nl.counts(), d.nl.counts() + N));
   for (std::size_t i = 0; i < N; ++i)
     for (int k = 0; k < counts[i]; ++k) {
       const std::size_t j = rows[i * d.nl.capacity() + k];
       if (j <= i) continue;
-      const double rx = d.box.minimumImage(f.x[i] - f.x[j]), ry = d.box.minimumImage(f.y[i] - f.y[j]),
+      const double rx = d.box.minimumImage(f.x[i] - f.x[j]),
+                   ry = d.box.minimumImage(f.y[i] - f.y[j]),
                    rz = d.box.minimumImage(f.z[i] - f.z[j]);
       const double r = std::sqrt(rx * rx + ry * ry + rz * rz);
       if (r < 1.0)
-        throw std::invalid_argument("initial state: particles " + std::to_string(i) + " and " + std::to_string(j) +
-                                    " overlap (distance " + common::formatReal(r) + " < diameter 1).");
+        throw std::invalid_argument("initial state: particles " + std::to_string(i) + " and " +
+                                    std::to_string(j) + " overlap (distance " +
+                                    common::formatReal(r) + " < diameter 1).");
     }
   d.computeInitialForces();
 }
@@ -807,7 +841,8 @@ std::vector<double> Engine::forces(StateKind kind) const {
   unpackVec3(d.p.force, comp[0], comp[1], comp[2]);
   const DVec<double>* f[3] = {&comp[0], &comp[1], &comp[2]};
   DVec<double> g[3];
-  const double w = d.coulomb ? 1.0 - d.slowWeight(d.step) : 0.0;  // physical: contact + Coulomb once
+  const double w =
+      d.coulomb ? 1.0 - d.slowWeight(d.step) : 0.0;  // physical: contact + Coulomb once
   if (kind == StateKind::Physical && w != 0.0) {
     const DVec<double>* ext[3] = {&d.ext_fx, &d.ext_fy, &d.ext_fz};
     for (int a = 0; a < 3; ++a) {
@@ -837,11 +872,13 @@ EngineExtra Engine::extraState() const {
   return e;
 }
 
-void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions, const EngineExtra& extra) {
+void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions,
+                     const EngineExtra& extra) {
   Impl& d = *m_impl;
   const std::size_t N = d.p.size();
   if (s.size() != N || forces.size() != 3 * N || s.charge.size() != N || s.ix.size() != N)
-    throw std::invalid_argument("checkpoint has " + std::to_string(s.size()) + " particles, the run " + std::to_string(N));
+    throw std::invalid_argument("checkpoint has " + std::to_string(s.size()) +
+                                " particles, the run " + std::to_string(N));
   d.upload(s);  // storage in id order again
   packVec3(std::vector<double>(forces.begin(), forces.begin() + N),
            std::vector<double>(forces.begin() + N, forces.begin() + 2 * N),
@@ -856,11 +893,12 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
                fz = extra.arrays.find("coulomb_fz");
     const auto at = extra.ints.find("coulomb_eval_step");
     const auto en = extra.reals.find("coulomb_energy_ext");
-    const bool have = fx != extra.arrays.end() && fy != extra.arrays.end() && fz != extra.arrays.end() &&
-                      at != extra.ints.end() && en != extra.reals.end();
+    const bool have = fx != extra.arrays.end() && fy != extra.arrays.end() &&
+                      fz != extra.arrays.end() && at != extra.ints.end() && en != extra.reals.end();
     if (have) {
       for (const auto* a : {&fx->second, &fy->second, &fz->second})
-        if (a->size() != N) throw std::invalid_argument("checkpoint: Coulomb force arrays have the wrong length");
+        if (a->size() != N)
+          throw std::invalid_argument("checkpoint: Coulomb force arrays have the wrong length");
       toDevice(fx->second, d.ext_fx);
       toDevice(fy->second, d.ext_fy);
       toDevice(fz->second, d.ext_fz);
@@ -869,18 +907,20 @@ void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int
       const auto k = extra.ints.find("coulomb_every"), kp = extra.ints.find("coulomb_every_prev");
       if (k != extra.ints.end() && kp != extra.ints.end()) {
         if (k->second < d.every_base || k->second > d.every_cap || kp->second < 1)
-          throw std::invalid_argument(
-              "checkpoint: slow Coulomb interval " + std::to_string(k->second) +
-              " outside this run's " + std::to_string(d.every_base) + ".." +
-              std::to_string(d.every_cap));
+          throw std::invalid_argument("checkpoint: slow Coulomb interval " +
+                                      std::to_string(k->second) + " outside this run's " +
+                                      std::to_string(d.every_base) + ".." +
+                                      std::to_string(d.every_cap));
         d.every = static_cast<int>(k->second);
         d.every_prev = static_cast<int>(kp->second);
       }  // (older checkpoints: a fixed interval, as configured)
     } else if (d.every == 1) {
       d.kspace_step = -1;  // evaluated afresh at the next step, as every step
     } else {
-      throw std::invalid_argument("checkpoint lacks the Coulomb forces of the multiple-time-step integrator "
-                                  "(coulomb.every > 1): it was written by an older granagg; restart with coulomb.every = 1");
+      throw std::invalid_argument(
+          "checkpoint lacks the Coulomb forces of the multiple-time-step integrator "
+          "(coulomb.every > 1): it was written by an older granagg; restart with coulomb.every = "
+          "1");
     }
   }
   d.rebuildList(true);  // storage in cell order from the first step on, as after any build
@@ -915,8 +955,8 @@ Observables Engine::observables() const {
   for (int c = 0; c < 3; ++c) o.momentum[c] = vs.p[c];
   const double sum2 = vs.v2;
   o.kinetic_energy = 0.5 * sum2;
-  const double p2 = o.momentum[0] * o.momentum[0] + o.momentum[1] * o.momentum[1] +
-                    o.momentum[2] * o.momentum[2];
+  const double p2 =
+      o.momentum[0] * o.momentum[0] + o.momentum[1] * o.momentum[1] + o.momentum[2] * o.momentum[2];
   o.temperature = (sum2 - p2 / N) / (3.0 * N);  // (1/3N) sum (v - <v>)^2, unit mass
   o.momentum_abs_sum = vs.abs;
   const ContactSummary c = d.summary();
@@ -943,7 +983,9 @@ double Engine::box() const { return m_impl->box.L; }
 std::size_t Engine::size() const { return m_impl->p.size(); }
 std::int64_t Engine::neighborBuilds() const { return m_impl->nl.builds(); }
 
-const CoulombSetup* Engine::coulombSetup() const { return m_impl->coulomb ? &m_impl->csetup : nullptr; }
+const CoulombSetup* Engine::coulombSetup() const {
+  return m_impl->coulomb ? &m_impl->csetup : nullptr;
+}
 int Engine::slowInterval() const { return m_impl->coulomb ? m_impl->every : 0; }
 std::int64_t Engine::slowEvaluations() const { return m_impl->slow_evaluations; }
 
@@ -955,7 +997,9 @@ void Engine::useCoulombDesign(double sum_q2_design) {
 }
 
 void Engine::setThreads(int n) {
-  if (n < 1) throw std::invalid_argument("the number of threads must be >= 1 (got " + std::to_string(n) + ")");
+  if (n < 1)
+    throw std::invalid_argument("the number of threads must be >= 1 (got " + std::to_string(n) +
+                                ")");
 #if !defined(__CUDACC__)
   omp_set_num_threads(n);
 #endif
@@ -989,14 +1033,18 @@ Frame Engine::randomInitialState(const MdConfig& c) {
   std::unordered_multimap<long, int> grid;
   grid.reserve(2 * N);
   common::Box box{L};
-  auto key = [nc](int a, int b, int cc) { return (static_cast<long>((a + nc) % nc) * nc + (b + nc) % nc) * nc + (cc + nc) % nc; };
+  auto key = [nc](int a, int b, int cc) {
+    return (static_cast<long>((a + nc) % nc) * nc + (b + nc) % nc) * nc + (cc + nc) % nc;
+  };
   const std::uint32_t max_attempts = 100000;
   for (int i = 0; i < N; ++i) {
     bool placed = false;
     for (std::uint32_t k = 0; k < max_attempts && !placed; ++k) {
-      const auto r = philoxDraw(c.system.seed, RNG_INIT_POSITION, static_cast<std::uint32_t>(i), k, 0);
+      const auto r =
+          philoxDraw(c.system.seed, RNG_INIT_POSITION, static_cast<std::uint32_t>(i), k, 0);
       const double px = uniform01(r[0]) * L, py = uniform01(r[1]) * L, pz = uniform01(r[2]) * L;
-      const int cx = std::min(nc - 1, static_cast<int>(px / cell)), cy = std::min(nc - 1, static_cast<int>(py / cell)),
+      const int cx = std::min(nc - 1, static_cast<int>(px / cell)),
+                cy = std::min(nc - 1, static_cast<int>(py / cell)),
                 cz = std::min(nc - 1, static_cast<int>(pz / cell));
       bool ok = true;
       for (int a = -1; a <= 1 && ok; ++a)
@@ -1019,17 +1067,22 @@ Frame Engine::randomInitialState(const MdConfig& c) {
       }
     }
     if (!placed)
-      throw std::invalid_argument("random insertion failed after " + std::to_string(max_attempts) + " attempts for particle " +
-                                  std::to_string(i) + ": system.phi = " + common::formatReal(c.system.phi) +
-                                  " is too dense for random sequential insertion (use phi < 0.3 or give an initial file).");
+      throw std::invalid_argument(
+          "random insertion failed after " + std::to_string(max_attempts) +
+          " attempts for particle " + std::to_string(i) +
+          ": system.phi = " + common::formatReal(c.system.phi) +
+          " is too dense for random sequential insertion (use phi < 0.3 or give an initial file).");
   }
-  // Maxwell velocities (Box-Muller on Philox words), then zero momentum and T_g = temperature exactly
+  // Maxwell velocities (Box-Muller on Philox words), then zero momentum and T_g = temperature
+  // exactly
   f.vx.resize(N);
   f.vy.resize(N);
   f.vz.resize(N);
   for (int i = 0; i < N; ++i) {
-    const auto r = philoxDraw(c.system.seed, RNG_INIT_VELOCITY, static_cast<std::uint32_t>(i), 0, 0);
-    const double u1 = uniform01(r[0]), u2 = uniform01(r[1]), u3 = uniform01(r[2]), u4 = uniform01(r[3]);
+    const auto r =
+        philoxDraw(c.system.seed, RNG_INIT_VELOCITY, static_cast<std::uint32_t>(i), 0, 0);
+    const double u1 = uniform01(r[0]), u2 = uniform01(r[1]), u3 = uniform01(r[2]),
+                 u4 = uniform01(r[3]);
     const double a = std::sqrt(-2.0 * std::log(u1)), b = std::sqrt(-2.0 * std::log(u3));
     f.vx[i] = a * std::cos(2.0 * M_PI * u2);
     f.vy[i] = a * std::sin(2.0 * M_PI * u2);
@@ -1070,7 +1123,9 @@ void Engine::assignInitialCharges(const MdConfig& c, Frame& f) {
   const std::size_t N = f.size();
   const std::string& how = c.charging.initial;
   if (how == "file") {
-    if (f.charge.size() != N) throw std::invalid_argument("charging.initial = \"file\" but the initial state holds no charges");
+    if (f.charge.size() != N)
+      throw std::invalid_argument(
+          "charging.initial = \"file\" but the initial state holds no charges");
     return;
   }
   f.charge.assign(N, 0.0);
@@ -1079,14 +1134,18 @@ void Engine::assignInitialCharges(const MdConfig& c, Frame& f) {
     f.charge.assign(N, c.charging.q0);
     return;
   }
-  if (how != "bipolar") throw std::invalid_argument("charging.initial = \"" + how + "\" is not one of neutral, monopolar, bipolar, file");
+  if (how != "bipolar")
+    throw std::invalid_argument("charging.initial = \"" + how +
+                                "\" is not one of neutral, monopolar, bipolar, file");
   // bipolar: a random half +q0, the other half -q0 (exactly zero net; for odd N one particle stays
   // neutral). The halves come from ordering particles by a Philox key per particle.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> key(N);
   for (std::size_t i = 0; i < N; ++i)
-    key[i] = {philoxDraw(c.system.seed, RNG_INIT_CHARGE, static_cast<std::uint32_t>(i), 0, 0)[0], static_cast<std::uint32_t>(i)};
+    key[i] = {philoxDraw(c.system.seed, RNG_INIT_CHARGE, static_cast<std::uint32_t>(i), 0, 0)[0],
+              static_cast<std::uint32_t>(i)};
   std::sort(key.begin(), key.end());
-  for (std::size_t k = 0; k < 2 * (N / 2); ++k) f.charge[key[k].second] = k < N / 2 ? c.charging.q0 : -c.charging.q0;
+  for (std::size_t k = 0; k < 2 * (N / 2); ++k)
+    f.charge[key[k].second] = k < N / 2 ? c.charging.q0 : -c.charging.q0;
 }
 
 }  // namespace granagg::md

@@ -8,12 +8,12 @@
 /// md/potentials/. This header has no Thrust in it (pimpl), so host-only code (CLI, I/O) can use it
 /// in a CUDA build too.
 ///
-/// Storage: particles are kept sorted by cell (re-sorted every few neighbour-list builds) for memory
-/// locality; ParticleData::id maps slots back to particle ids, and frame(), forces() and error
-/// messages use ids. Determinism: forces are gathered per particle over a neighbour row sorted by
-/// particle id, so every sum runs in the same order whatever the thread count, the storage order,
-/// the neighbour-list rebuild schedule, or a restart from a checkpoint: the same build gives
-/// bit-identical trajectories.
+/// Storage: particles are kept sorted by cell (re-sorted every few neighbour-list builds) for
+/// memory locality; ParticleData::id maps slots back to particle ids, and frame(), forces() and
+/// error messages use ids. Determinism: forces are gathered per particle over a neighbour row
+/// sorted by particle id, so every sum runs in the same order whatever the thread count, the
+/// storage order, the neighbour-list rebuild schedule, or a restart from a checkpoint: the same
+/// build gives bit-identical trajectories.
 ///
 /// Coulomb forces (coulomb.K > 0) are the slow force of an impulse multiple-time-step integrator
 /// (r-RESPA; Tuckerman, Berne & Martyna, J. Chem. Phys. 97, 1990 (1992); Grubmueller et al., Mol.
@@ -51,36 +51,39 @@
 
 namespace granagg::md {
 
-/// Observables at one step (design.md section 3, "Per frame"). Energies are totals (not per particle).
+/// Observables at one step (design.md section 3, "Per frame"). Energies are totals (not per
+/// particle).
 struct Observables {
   std::int64_t step = 0;
   double time = 0.0;
-  double temperature = 0.0;          ///< T_g = (1/3N) sum (v - <v>)^2
-  double kinetic_energy = 0.0;       ///< (1/2) sum v^2
-  double elastic_energy = 0.0;       ///< sum over contacts of the elastic energy
-  double momentum[3] = {0, 0, 0};    ///< sum v
-  double momentum_abs_sum = 0.0;     ///< sum |v| (scale for momentum conservation)
+  double temperature = 0.0;        ///< T_g = (1/3N) sum (v - <v>)^2
+  double kinetic_energy = 0.0;     ///< (1/2) sum v^2
+  double elastic_energy = 0.0;     ///< sum over contacts of the elastic energy
+  double momentum[3] = {0, 0, 0};  ///< sum v
+  double momentum_abs_sum = 0.0;   ///< sum |v| (scale for momentum conservation)
   double contacts_per_particle = 0.0;
-  std::int64_t collisions = 0;       ///< new contacts since the start of the run
-  double mean_overlap = 0.0;         ///< over pairs in contact (0 if none)
+  std::int64_t collisions = 0;  ///< new contacts since the start of the run
+  double mean_overlap = 0.0;    ///< over pairs in contact (0 if none)
   double max_overlap = 0.0;
-  double total_charge = 0.0;         ///< sum q (conserved by the exchange rule)
-  double mean_abs_charge = 0.0;      ///< (1/N) sum |q|, the paper's q-bar
+  double total_charge = 0.0;     ///< sum q (conserved by the exchange rule)
+  double mean_abs_charge = 0.0;  ///< (1/N) sum |q|, the paper's q-bar
   double max_abs_charge = 0.0;
-  double coulomb_energy = 0.0;       ///< Ewald total (real + mesh/reciprocal + self + background); 0 without Coulomb
+  double coulomb_energy =
+      0.0;  ///< Ewald total (real + mesh/reciprocal + self + background); 0 without Coulomb
 };
 
 /// The Coulomb method's parameters as chosen for a run (docs/coulomb.md), logged and stored.
 struct CoulombSetup {
-  std::string method;              ///< "pppm" or "ewald"
-  double alpha = 0.0;              ///< Ewald splitting parameter (1/d)
-  double r_cut = 0.0;              ///< real-space cutoff (d)
-  int mesh = 0, order = 0;         ///< PPPM mesh points per side, assignment order
-  int k_max = 0;                   ///< plain Ewald reciprocal cutoff
-  double estimated_error = 0.0;    ///< estimated relative RMS force error at sum_q2_design
-  double sum_q2_design = 0.0;      ///< sum q^2 the parameters were chosen for
-  double r_fast = 0.0;             ///< multiple time stepping: real space within this is fast (switched over 1 d); 0: none
-  int every = 1;                   ///< multiple time stepping: steps between evaluations of the slow part
+  std::string method;            ///< "pppm" or "ewald"
+  double alpha = 0.0;            ///< Ewald splitting parameter (1/d)
+  double r_cut = 0.0;            ///< real-space cutoff (d)
+  int mesh = 0, order = 0;       ///< PPPM mesh points per side, assignment order
+  int k_max = 0;                 ///< plain Ewald reciprocal cutoff
+  double estimated_error = 0.0;  ///< estimated relative RMS force error at sum_q2_design
+  double sum_q2_design = 0.0;    ///< sum q^2 the parameters were chosen for
+  double r_fast =
+      0.0;  ///< multiple time stepping: real space within this is fast (switched over 1 d); 0: none
+  int every = 1;  ///< multiple time stepping: steps between evaluations of the slow part
   /// > every: the interval follows the gas up to this many steps (coulomb.every_max);
   /// = every: fixed
   int every_max = 1;

@@ -81,7 +81,8 @@ struct BlockRangeLoop {
 
 template <class Body>
 void forEachBlockRange(int n, int block, const Body& body, typename Body::value_type* out) {
-  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(blockCount(n, block)),
+  thrust::for_each(thrust::counting_iterator<int>(0),
+                   thrust::counting_iterator<int>(blockCount(n, block)),
                    BlockRangeLoop<Body>{body, out, n, block});
 }
 
@@ -104,8 +105,8 @@ T reduceBlocks(const thrust::device_vector<T>& blocks, T init, Op op) {
 /// count or the backend. For observables (sampled every so many steps), not for per-step work:
 /// it copies the values to the host.
 template <class T, class Op>
-T reduceById(const thrust::device_vector<T>& per_slot, const thrust::device_vector<int>& id,
-             T init, Op op) {
+T reduceById(const thrust::device_vector<T>& per_slot, const thrust::device_vector<int>& id, T init,
+             Op op) {
   thrust::device_vector<T> by_id(per_slot.size());
   thrust::scatter(per_slot.begin(), per_slot.end(), id.begin(), by_id.begin());
   const thrust::host_vector<T> h = by_id;
@@ -114,8 +115,10 @@ T reduceById(const thrust::device_vector<T>& per_slot, const thrust::device_vect
 }
 
 template <class Body, class Reduction>
-void forEachBlocked(int n, int block, const Body& body, const Reduction& reduce, typename Reduction::value_type* out) {
-  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(blockCount(n, block)),
+void forEachBlocked(int n, int block, const Body& body, const Reduction& reduce,
+                    typename Reduction::value_type* out) {
+  thrust::for_each(thrust::counting_iterator<int>(0),
+                   thrust::counting_iterator<int>(blockCount(n, block)),
                    BlockedLoop<Body, Reduction>{body, reduce, out, n, block});
 }
 

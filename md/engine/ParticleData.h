@@ -43,9 +43,9 @@ struct Vec3 {
 };
 
 struct ParticleData {
-  DVec<Scalar4> pos;  ///< wrapped positions in [0, L) (x, y, z) and charge (w)
-  DVec<Vec3> vel;     ///< velocities
-  DVec<Vec3> force;   ///< forces of the current positions
+  DVec<Scalar4> pos;     ///< wrapped positions in [0, L) (x, y, z) and charge (w)
+  DVec<Vec3> vel;        ///< velocities
+  DVec<Vec3> force;      ///< forces of the current positions
   DVec<int> ix, iy, iz;  ///< image counts
   /// Particle id (index in the user's order) of each slot: the engine stores particles sorted by
   /// cell for memory locality and maps back to ids for output.
@@ -60,17 +60,18 @@ struct ParticleData {
   }
   std::size_t size() const { return pos.size(); }
   /// Sets positions and charges from host arrays (slot order).
-  void setPositions(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z,
-                    const std::vector<double>& q) {
+  void setPositions(const std::vector<double>& x, const std::vector<double>& y,
+                    const std::vector<double>& z, const std::vector<double>& q) {
     std::vector<Scalar4> h(x.size());
-    for (std::size_t i = 0; i < h.size(); ++i) h[i] = Scalar4{x[i], y[i], z[i], q.empty() ? 0.0 : q[i]};
+    for (std::size_t i = 0; i < h.size(); ++i)
+      h[i] = Scalar4{x[i], y[i], z[i], q.empty() ? 0.0 : q[i]};
     pos.assign(h.begin(), h.end());
   }
 };
 
 /// Packs host component arrays (slot order) into v.
-inline void packVec3(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z,
-                     DVec<Vec3>& v) {
+inline void packVec3(const std::vector<double>& x, const std::vector<double>& y,
+                     const std::vector<double>& z, DVec<Vec3>& v) {
   std::vector<Vec3> h(x.size());
   for (std::size_t i = 0; i < h.size(); ++i) h[i] = Vec3{x[i], y[i], z[i]};
   v.assign(h.begin(), h.end());

@@ -8,7 +8,8 @@
 /// nx * ny * (nz/2 + 1) values c[(ix * ny + iy) * (nz/2 + 1) + iz], stored as interleaved
 /// (re, im) doubles. Both directions are unnormalised:
 ///     forward:  c(k) = sum_r r(x) exp(-i k.x)
-///     backward: r(x) = sum_k c(k) exp(+i k.x)   (over the full spectrum, Hermitian symmetry implied)
+///     backward: r(x) = sum_k c(k) exp(+i k.x)   (over the full spectrum, Hermitian symmetry
+///     implied)
 /// so backward(forward(r)) = nx ny nz r.
 ///
 /// Plans are made once in the constructor (FFTW's planner is not thread-safe; a global lock
@@ -28,9 +29,11 @@ class Fft3d {
   Fft3d(const Fft3d&) = delete;
   Fft3d& operator=(const Fft3d&) = delete;
 
-  /// Real -> complex (in: nx ny nz doubles, preserved; out: 2 complexSize() doubles), device pointers.
+  /// Real -> complex (in: nx ny nz doubles, preserved; out: 2 complexSize() doubles), device
+  /// pointers.
   void forward(const double* in, double* out);
-  /// Complex -> real (in: 2 complexSize() doubles, overwritten; out: nx ny nz doubles), device pointers.
+  /// Complex -> real (in: 2 complexSize() doubles, overwritten; out: nx ny nz doubles), device
+  /// pointers.
   void backward(double* in, double* out);
 
   std::size_t realSize() const;     ///< nx ny nz

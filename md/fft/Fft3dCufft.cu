@@ -45,7 +45,8 @@ Fft3d::~Fft3d() {
 }
 
 void Fft3d::forward(const double* in, double* out) {
-  check(cufftExecD2Z(m_impl->r2c, const_cast<cufftDoubleReal*>(in), reinterpret_cast<cufftDoubleComplex*>(out)),
+  check(cufftExecD2Z(m_impl->r2c, const_cast<cufftDoubleReal*>(in),
+                     reinterpret_cast<cufftDoubleComplex*>(out)),
         "cufftExecD2Z");
 }
 
@@ -54,7 +55,9 @@ void Fft3d::backward(double* in, double* out) {
 }
 
 std::size_t Fft3d::realSize() const { return std::size_t(m_impl->nx) * m_impl->ny * m_impl->nz; }
-std::size_t Fft3d::complexSize() const { return std::size_t(m_impl->nx) * m_impl->ny * (m_impl->nz / 2 + 1); }
+std::size_t Fft3d::complexSize() const {
+  return std::size_t(m_impl->nx) * m_impl->ny * (m_impl->nz / 2 + 1);
+}
 const char* Fft3d::backendName() { return "cuFFT"; }
 
 }  // namespace granagg::md

@@ -48,7 +48,8 @@ Fft3d::Fft3d(int nx, int ny, int nz) : m_impl(new Impl{nx, ny, nz}) {
   m_impl->c2r = fftw_plan_dft_c2r_3d(nx, ny, nz, c, r, flags);
   fftw_free(r);
   fftw_free(c);
-  if (!m_impl->r2c || !m_impl->c2r) throw std::runtime_error("Fft3d: FFTW could not create a plan.");
+  if (!m_impl->r2c || !m_impl->c2r)
+    throw std::runtime_error("Fft3d: FFTW could not create a plan.");
 }
 
 Fft3d::~Fft3d() {
@@ -67,7 +68,9 @@ void Fft3d::backward(double* in, double* out) {
 }
 
 std::size_t Fft3d::realSize() const { return std::size_t(m_impl->nx) * m_impl->ny * m_impl->nz; }
-std::size_t Fft3d::complexSize() const { return std::size_t(m_impl->nx) * m_impl->ny * (m_impl->nz / 2 + 1); }
+std::size_t Fft3d::complexSize() const {
+  return std::size_t(m_impl->nx) * m_impl->ny * (m_impl->nz / 2 + 1);
+}
 const char* Fft3d::backendName() { return "FFTW3 (OpenMP threads)"; }
 
 }  // namespace granagg::md

@@ -27,8 +27,8 @@ struct KickDrift {
   common::Box box;
   /// returns |u|^2 of the drift velocity
   HD double operator()(int i) const {
-    return kickDriftParticle(box, h, dt, close_pending, force[i], vel[i], pos[i], dq ? dq + i : nullptr, ix[i], iy[i],
-                             iz[i], vel[i], pos[i]);
+    return kickDriftParticle(box, h, dt, close_pending, force[i], vel[i], pos[i],
+                             dq ? dq + i : nullptr, ix[i], iy[i], iz[i], vel[i], pos[i]);
   }
 };
 
@@ -53,20 +53,21 @@ struct CloseKick {
 };
 }  // namespace
 
-double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending, double* dq,
-                 DVec<double>& block_max) {
+double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box,
+                 bool close_pending, double* dq, DVec<double>& block_max) {
   const int n = static_cast<int>(p.size());
   const int block = blockSizeFor(n);
   block_max.resize(blockCount(n, block));
   forEachBlocked(n, block,
-                 KickDrift{raw(p.pos), raw(p.vel), raw(p.force), raw(p.ix),
-                           raw(p.iy), raw(p.iz), dq, half_dt, dt, close_pending, box},
+                 KickDrift{raw(p.pos), raw(p.vel), raw(p.force), raw(p.ix), raw(p.iy), raw(p.iz),
+                           dq, half_dt, dt, close_pending, box},
                  MaxReduction{}, raw(block_max));
   return reduceBlocks(block_max, 0.0, MaxReduction{});
 }
 
 void closeKick(ParticleData& p, double half_dt, double* dq) {
-  thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(static_cast<int>(p.size())),
+  thrust::for_each(thrust::counting_iterator<int>(0),
+                   thrust::counting_iterator<int>(static_cast<int>(p.size())),
                    CloseKick{raw(p.vel), raw(p.force), raw(p.pos), dq, half_dt});
 }
 

@@ -25,9 +25,9 @@ namespace granagg::md {
 /// with dq (the charge exchanged at the last force pass, non-null) q' = q + *dq, clearing *dq.
 /// Writes u' and x' (with q') and returns |u'|^2. kickDrift() and the fused force pass
 /// (ContactStep::advance_dt) both call it: one arithmetic, so the two give identical trajectories.
-HD_INLINE double kickDriftParticle(const common::Box& box, double h, double dt, bool close, const Vec3& f, const Vec3& v,
-                                   const Scalar4& r, double* dq, int& ix, int& iy, int& iz, Vec3& u_out,
-                                   Scalar4& r_out) {
+HD_INLINE double kickDriftParticle(const common::Box& box, double h, double dt, bool close,
+                                   const Vec3& f, const Vec3& v, const Scalar4& r, double* dq,
+                                   int& ix, int& iy, int& iz, Vec3& u_out, Scalar4& r_out) {
   double u0 = v.x, u1 = v.y, u2 = v.z;
   if (close) {  // v(t) = u(t - dt/2) + (dt/2) f(t)
     u0 += h * f.x;
@@ -59,8 +59,8 @@ HD_INLINE double kickDriftParticle(const common::Box& box, double h, double dt, 
 /// q += dq and dq = 0, the charges exchanged at the previous force pass.
 /// Returns the largest |v|^2 of the drift velocities (a bound on this step's displacements for the
 /// neighbour-list check). \param block_max scratch for the per-block maxima.
-double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box, bool close_pending, double* dq,
-                 DVec<double>& block_max);
+double kickDrift(ParticleData& p, double half_dt, double dt, const common::Box& box,
+                 bool close_pending, double* dq, DVec<double>& block_max);
 
 /// The closing kick alone: v += half_dt f; with dq, q += dq and dq = 0.
 void closeKick(ParticleData& p, double half_dt, double* dq);

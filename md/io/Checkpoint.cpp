@@ -1,14 +1,14 @@
 #include "md/io/Checkpoint.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <exception>
-#include <fcntl.h>
 #include <stdexcept>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "common/Csv.h"
 #include "common/Version.h"
@@ -39,16 +39,17 @@ std::string parentDir(const std::string& path) {
 }
 
 /// 1D array dataset of n elements, chunked with the Fletcher-32 checksum filter.
-void writeArray(hid_t loc, const std::string& name, hid_t file_type, hid_t mem_type, const void* data,
-                std::size_t n, const std::string& ctx) {
+void writeArray(hid_t loc, const std::string& name, hid_t file_type, hid_t mem_type,
+                const void* data, std::size_t n, const std::string& ctx) {
   const hsize_t dims[1] = {n};
   h5::Handle space(H5Screate_simple(1, dims, nullptr));
   h5::Handle dcpl = h5::check(H5Pcreate(H5P_DATASET_CREATE), ctx);
   const hsize_t chunk[1] = {std::max<hsize_t>(1, std::min<hsize_t>(n, CHUNK_MAX))};
   h5::checkStatus(H5Pset_chunk(dcpl.get(), 1, chunk), ctx);
   h5::checkStatus(H5Pset_fletcher32(dcpl.get()), ctx);
-  h5::Handle d = h5::check(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
-                           ctx + ": cannot create dataset '" + name + "'");
+  h5::Handle d = h5::check(
+      H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
+      ctx + ": cannot create dataset '" + name + "'");
   h5::checkStatus(H5Dwrite(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
                   ctx + ": cannot write dataset '" + name + "'");
 }
@@ -73,11 +74,14 @@ void writeFile(const std::string& file_path, const Frame& s, const CheckpointExt
     h5::writeAttribute(g.get(), "box", s.box, c);
     h5::writeAttribute(g.get(), "N", static_cast<std::int64_t>(n), c);
     const std::pair<const char*, const std::vector<double>*> reals[] = {
-        {"x", &s.x},   {"y", &s.y},   {"z", &s.z},   {"vx", &s.vx}, {"vy", &s.vy},
+        {"x", &s.x},   {"y", &s.y},           {"z", &s.z},   {"vx", &s.vx}, {"vy", &s.vy},
         {"vz", &s.vz}, {"charge", &s.charge}, {"fx", &e.fx}, {"fy", &e.fy}, {"fz", &e.fz}};
-    for (const auto& [name, v] : reals) writeArray(g.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v->data(), n, c);
-    const std::pair<const char*, const std::vector<std::int32_t>*> ints[] = {{"ix", &s.ix}, {"iy", &s.iy}, {"iz", &s.iz}};
-    for (const auto& [name, v] : ints) writeArray(g.get(), name, H5T_STD_I32LE, H5T_NATIVE_INT32, v->data(), n, c);
+    for (const auto& [name, v] : reals)
+      writeArray(g.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v->data(), n, c);
+    const std::pair<const char*, const std::vector<std::int32_t>*> ints[] = {
+        {"ix", &s.ix}, {"iy", &s.iy}, {"iz", &s.iz}};
+    for (const auto& [name, v] : ints)
+      writeArray(g.get(), name, H5T_STD_I32LE, H5T_NATIVE_INT32, v->data(), n, c);
   }
   {
     h5::Handle g = h5::createGroup(f, "integrator", c);
@@ -92,13 +96,16 @@ void writeFile(const std::string& file_path, const Frame& s, const CheckpointExt
   }
   {
     h5::Handle gi = h5::createGroup(f, "scalars/int", c);
-    for (const auto& [k, v] : e.int_scalars) h5::writeAttribute(gi.get(), k, static_cast<std::int64_t>(v), c + " /scalars/int");
+    for (const auto& [k, v] : e.int_scalars)
+      h5::writeAttribute(gi.get(), k, static_cast<std::int64_t>(v), c + " /scalars/int");
     h5::Handle gr = h5::createGroup(f, "scalars/real", c);
-    for (const auto& [k, v] : e.real_scalars) h5::writeAttribute(gr.get(), k, v, c + " /scalars/real");
+    for (const auto& [k, v] : e.real_scalars)
+      h5::writeAttribute(gr.get(), k, v, c + " /scalars/real");
   }
   if (!e.arrays.empty()) {
     h5::Handle g = h5::createGroup(f, "arrays", c);
-    for (const auto& [k, v] : e.arrays) writeArray(g.get(), k, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v.data(), n, c);
+    for (const auto& [k, v] : e.arrays)
+      writeArray(g.get(), k, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v.data(), n, c);
   }
   if (!file.reset()) h5::fail("cannot close " + c + " (disk full?)");
 }
@@ -108,7 +115,8 @@ void validate(const Frame& s, const CheckpointExtra& e) {
   if (n == 0) throw std::invalid_argument("writeCheckpoint: the state has no particles.");
   auto need = [&](std::size_t size, const char* name) {
     if (size != n)
-      throw std::invalid_argument(std::string("writeCheckpoint: array ") + name + " has " + std::to_string(size) +
+      throw std::invalid_argument(std::string("writeCheckpoint: array ") + name + " has " +
+                                  std::to_string(size) +
                                   " entries, expected N = " + std::to_string(n) + ".");
   };
   need(s.y.size(), "y");
@@ -124,13 +132,17 @@ void validate(const Frame& s, const CheckpointExtra& e) {
   need(e.fy.size(), "fy");
   need(e.fz.size(), "fz");
   if (!(s.box > 0.0) || !std::isfinite(s.box))
-    throw std::invalid_argument("writeCheckpoint: the box edge must be positive and finite, got " + common::formatReal(s.box) + ".");
+    throw std::invalid_argument("writeCheckpoint: the box edge must be positive and finite, got " +
+                                common::formatReal(s.box) + ".");
   if (!(e.dt > 0.0) || !std::isfinite(e.dt))
-    throw std::invalid_argument("writeCheckpoint: dt must be positive and finite, got " + common::formatReal(e.dt) + ".");
+    throw std::invalid_argument("writeCheckpoint: dt must be positive and finite, got " +
+                                common::formatReal(e.dt) + ".");
   for (const auto& kv : e.int_scalars)
-    if (kv.first.empty()) throw std::invalid_argument("writeCheckpoint: an integer scalar has an empty name.");
+    if (kv.first.empty())
+      throw std::invalid_argument("writeCheckpoint: an integer scalar has an empty name.");
   for (const auto& kv : e.real_scalars)
-    if (kv.first.empty()) throw std::invalid_argument("writeCheckpoint: a real scalar has an empty name.");
+    if (kv.first.empty())
+      throw std::invalid_argument("writeCheckpoint: a real scalar has an empty name.");
   for (const auto& kv : e.arrays) {
     if (kv.first.empty() || kv.first.find('/') != std::string::npos)
       throw std::invalid_argument("writeCheckpoint: an array name is empty or contains '/'.");
@@ -147,9 +159,11 @@ void writeCheckpoint(const std::string& path, const Frame& state, const Checkpoi
   const std::string tmp = path + ".tmp";
   try {
     writeFile(tmp, state, extra);
-    if (!syncPath(tmp, false)) throw std::runtime_error("cannot fsync checkpoint '" + tmp + "': " + std::strerror(errno));
+    if (!syncPath(tmp, false))
+      throw std::runtime_error("cannot fsync checkpoint '" + tmp + "': " + std::strerror(errno));
     if (std::rename(tmp.c_str(), path.c_str()) != 0)
-      throw std::runtime_error("cannot rename checkpoint '" + tmp + "' to '" + path + "': " + std::strerror(errno));
+      throw std::runtime_error("cannot rename checkpoint '" + tmp + "' to '" + path +
+                               "': " + std::strerror(errno));
   } catch (...) {
     // Remove a partial temporary file (never a directory or anything else someone put there).
     struct stat st;
@@ -174,25 +188,31 @@ Checkpoint readCheckpoint(const std::string& path) {
   {
     h5::Handle a = h5::openAttribute(f, "format");
     if (!a || h5::readString(a.get(), true, c + " format") != FORMAT_NAME)
-      throw std::runtime_error(c + " is not a granagg checkpoint (no format = \"" + std::string(FORMAT_NAME) + "\")");
+      throw std::runtime_error(c + " is not a granagg checkpoint (no format = \"" +
+                               std::string(FORMAT_NAME) + "\")");
     h5::Handle v = h5::openAttribute(f, "format_version");
     if (!v) throw std::runtime_error(c + " has no format_version");
-    const auto ver = h5::readNumericAttribute<std::int64_t>(v.get(), H5T_NATIVE_INT64, c + " format_version");
+    const auto ver =
+        h5::readNumericAttribute<std::int64_t>(v.get(), H5T_NATIVE_INT64, c + " format_version");
     if (ver.size() != 1 || ver[0] != FORMAT_VERSION)
-      throw std::runtime_error(c + " has format_version " + (ver.empty() ? std::string("?") : std::to_string(ver[0])) +
+      throw std::runtime_error(c + " has format_version " +
+                               (ver.empty() ? std::string("?") : std::to_string(ver[0])) +
                                ", this granagg reads version " + std::to_string(FORMAT_VERSION));
   }
   auto group = [&](const char* name) {
-    if (h5::objectType(f, name) != H5I_GROUP) throw std::runtime_error(c + " is missing group '/" + std::string(name) + "'");
+    if (h5::objectType(f, name) != H5I_GROUP)
+      throw std::runtime_error(c + " is missing group '/" + std::string(name) + "'");
     return h5::check(H5Gopen2(f, name, H5P_DEFAULT), c + ": cannot open /" + name);
   };
-  auto scalar = [&](hid_t g, const std::string& gname, const char* name, hid_t mem_type, void* out) {
+  auto scalar = [&](hid_t g, const std::string& gname, const char* name, hid_t mem_type,
+                    void* out) {
     h5::Handle a = h5::openAttribute(g, name);
     if (!a) throw std::runtime_error(c + " is missing attribute '" + gname + "/" + name + "'");
     h5::Handle space = h5::check(H5Aget_space(a.get()), c);
     if (H5Sget_simple_extent_npoints(space.get()) != 1)
       throw std::runtime_error(c + ": attribute '" + gname + "/" + name + "' is not a scalar");
-    h5::checkStatus(H5Aread(a.get(), mem_type, out), c + ": cannot read '" + gname + "/" + name + "'");
+    h5::checkStatus(H5Aread(a.get(), mem_type, out),
+                    c + ": cannot read '" + gname + "/" + name + "'");
   };
 
   Checkpoint cp;
@@ -207,15 +227,19 @@ Checkpoint readCheckpoint(const std::string& path) {
     scalar(g.get(), "/state", "time", H5T_NATIVE_DOUBLE, &s.time);
     scalar(g.get(), "/state", "box", H5T_NATIVE_DOUBLE, &s.box);
     scalar(g.get(), "/state", "N", H5T_NATIVE_INT64, &n);
-    if (n <= 0) throw std::runtime_error(c + ": /state N = " + std::to_string(n) + " is not positive");
+    if (n <= 0)
+      throw std::runtime_error(c + ": /state N = " + std::to_string(n) + " is not positive");
     auto array = [&](const char* name, hid_t mem_type, auto& out) {
       const std::string dc = c + ": dataset '/state/" + name + "'";
-      if (h5::objectType(g.get(), name) != H5I_DATASET) throw std::runtime_error(c + " is missing dataset '/state/" + name + "'");
+      if (h5::objectType(g.get(), name) != H5I_DATASET)
+        throw std::runtime_error(c + " is missing dataset '/state/" + name + "'");
       h5::Handle d = h5::check(H5Dopen2(g.get(), name, H5P_DEFAULT), dc + ": cannot open");
       const auto dims = h5::datasetDims(d.get(), dc);
       if (dims.size() != 1 || dims[0] != static_cast<hsize_t>(n))
-        throw std::runtime_error(dc + " has " + (dims.size() == 1 ? std::to_string(dims[0]) : std::string("a wrong shape")) +
-                                 " entries, expected N = " + std::to_string(n));
+        throw std::runtime_error(
+            dc + " has " +
+            (dims.size() == 1 ? std::to_string(dims[0]) : std::string("a wrong shape")) +
+            " entries, expected N = " + std::to_string(n));
       out.resize(static_cast<std::size_t>(n));
       h5::checkStatus(H5Dread(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
                       dc + ": cannot read (corrupt: checksum mismatch?)");
@@ -245,7 +269,8 @@ Checkpoint readCheckpoint(const std::string& path) {
     scalar(g.get(), "/run", "next_frame_index", H5T_NATIVE_UINT64, &e.next_frame_index);
     if (h5::objectType(g.get(), "config_toml") != H5I_DATASET)
       throw std::runtime_error(c + " is missing dataset '/run/config_toml'");
-    h5::Handle d = h5::check(H5Dopen2(g.get(), "config_toml", H5P_DEFAULT), c + ": /run/config_toml");
+    h5::Handle d =
+        h5::check(H5Dopen2(g.get(), "config_toml", H5P_DEFAULT), c + ": /run/config_toml");
     e.config_toml = h5::readString(d.get(), false, c + ": /run/config_toml");
   }
   {
@@ -281,8 +306,9 @@ Checkpoint readCheckpoint(const std::string& path) {
         throw std::runtime_error(dc + " does not hold N = " + std::to_string(n) + " entries");
       std::vector<double>& out = e.arrays[name];
       out.resize(static_cast<std::size_t>(n));
-      h5::checkStatus(H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
-                      dc + ": cannot read (corrupt: checksum mismatch?)");
+      h5::checkStatus(
+          H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
+          dc + ": cannot read (corrupt: checksum mismatch?)");
     }
   }
   return cp;

@@ -43,13 +43,14 @@ struct CheckpointExtra {
   std::uint64_t frames_written = 0;    ///< frames already in the trajectory file
   std::uint64_t next_frame_index = 0;  ///< index of the next scheduled frame in the output schedule
   std::map<std::string, std::int64_t> int_scalars;  ///< engine-defined counters (e.g. rebuilds)
-  std::map<std::string, double> real_scalars;       ///< engine-defined reals (e.g. wall-clock timers)
-  std::map<std::string, std::vector<double>> arrays;  ///< engine-defined per-particle arrays (N each)
+  std::map<std::string, double> real_scalars;  ///< engine-defined reals (e.g. wall-clock timers)
+  std::map<std::string, std::vector<double>>
+      arrays;  ///< engine-defined per-particle arrays (N each)
 };
 
 /// What readCheckpoint returns.
 struct Checkpoint {
-  Frame state;            ///< full-precision particle state (positions wrapped, with images)
+  Frame state;  ///< full-precision particle state (positions wrapped, with images)
   CheckpointExtra extra;
 };
 

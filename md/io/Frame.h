@@ -11,10 +11,10 @@ namespace granagg::md {
 struct Frame {
   std::int64_t step = 0;
   double time = 0.0;
-  double box = 0.0;  ///< cubic box edge L
-  std::vector<double> x, y, z;      ///< wrapped positions
-  std::vector<double> vx, vy, vz;   ///< velocities
-  std::vector<double> charge;       ///< charges (zero for a neutral gas)
+  double box = 0.0;                      ///< cubic box edge L
+  std::vector<double> x, y, z;           ///< wrapped positions
+  std::vector<double> vx, vy, vz;        ///< velocities
+  std::vector<double> charge;            ///< charges (zero for a neutral gas)
   std::vector<std::int32_t> ix, iy, iz;  ///< image counts
   /// per-particle forces (optional: filled for output with output.write_forces, else empty)
   std::vector<double> fx, fy, fz;

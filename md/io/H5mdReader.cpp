@@ -1,9 +1,9 @@
 #include "md/io/H5mdReader.h"
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <sys/stat.h>
 
 #include "common/Csv.h"
 #include "md/io/H5mdWriter.h"
@@ -23,7 +23,7 @@ std::string shapeText(const std::vector<hsize_t>& d) {
 /// One H5MD element of the particle group: a time-dependent group {value, step, time} or a
 /// fixed dataset.
 struct Element {
-  std::string name;      // path below the particle group, e.g. "velocity"
+  std::string name;  // path below the particle group, e.g. "velocity"
   bool present = false;
   bool time_dependent = false;
   h5::Handle value;
@@ -43,7 +43,9 @@ struct H5mdReader::Impl {
   std::string ctx() const { return "H5MD file '" + path + "'"; }
   std::string where(const Element& e) const { return "particles/" + group + "/" + e.name; }
 
-  [[noreturn]] void error(const std::string& what) const { throw std::runtime_error(ctx() + ": " + what); }
+  [[noreturn]] void error(const std::string& what) const {
+    throw std::runtime_error(ctx() + ": " + what);
+  }
 
   /// Reads a step or time dataset of `rows` samples, either an array or the H5MD fixed-increment
   /// form (scalar increment with an optional `offset` attribute).
@@ -66,7 +68,9 @@ struct H5mdReader::Impl {
       for (std::size_t k = 0; k < rows; ++k) out[k] = offset + static_cast<T>(k) * inc.at(0);
       return out;
     }
-    if (dims.size() != 1) error(elem + "/" + name + " has shape " + shapeText(dims) + ", expected one value per sample");
+    if (dims.size() != 1)
+      error(elem + "/" + name + " has shape " + shapeText(dims) +
+            ", expected one value per sample");
     return h5::readAll<T>(d.get(), mem_type, c);
   }
 
@@ -89,7 +93,8 @@ struct H5mdReader::Impl {
     if (t != H5I_GROUP) error(where(e) + " is neither a group nor a dataset");
     e.time_dependent = true;
     h5::Handle g = h5::check(H5Gopen2(part, name.c_str(), H5P_DEFAULT), c + ": cannot open");
-    if (h5::objectType(g.get(), "value") != H5I_DATASET) error("missing dataset " + where(e) + "/value");
+    if (h5::objectType(g.get(), "value") != H5I_DATASET)
+      error("missing dataset " + where(e) + "/value");
     e.value = h5::check(H5Dopen2(g.get(), "value", H5P_DEFAULT), c + "/value: cannot open");
     e.dims = h5::datasetDims(e.value.get(), c + "/value");
     if (e.dims.empty()) error(where(e) + "/value is a scalar, expected a time series");
@@ -102,7 +107,8 @@ struct H5mdReader::Impl {
   }
 
   /// Checks value dims: time-dependent [rows][inner...] or fixed [inner...].
-  void checkShape(const Element& e, const std::vector<hsize_t>& inner, const std::string& expected) const {
+  void checkShape(const Element& e, const std::vector<hsize_t>& inner,
+                  const std::string& expected) const {
     if (!e.present) return;
     std::vector<hsize_t> got = e.dims;
     std::string suffix = e.time_dependent ? "/value" : "";
@@ -120,22 +126,27 @@ struct H5mdReader::Impl {
     const std::int64_t s = pos.steps[i];
     const std::size_t rows = std::min<std::size_t>(e.dims[0], e.steps.size());
     if (i < rows && e.steps[i] == s) return i;
-    auto it = std::lower_bound(e.steps.begin(), e.steps.begin() + static_cast<std::ptrdiff_t>(rows), s);
+    auto it =
+        std::lower_bound(e.steps.begin(), e.steps.begin() + static_cast<std::ptrdiff_t>(rows), s);
     if (it == e.steps.begin() + static_cast<std::ptrdiff_t>(rows) || *it != s) {
-      it = std::find(e.steps.begin(), e.steps.begin() + static_cast<std::ptrdiff_t>(rows), s);  // unsorted steps
+      it = std::find(e.steps.begin(), e.steps.begin() + static_cast<std::ptrdiff_t>(rows),
+                     s);  // unsorted steps
       if (it == e.steps.begin() + static_cast<std::ptrdiff_t>(rows))
-        error(where(e) + " has no sample at step " + std::to_string(s) + " (frame " + std::to_string(i) + ")");
+        error(where(e) + " has no sample at step " + std::to_string(s) + " (frame " +
+              std::to_string(i) + ")");
     }
     return static_cast<hsize_t>(it - e.steps.begin());
   }
 
   /// Reads the data of element e for frame i into out (count values of mem_type).
   void readElement(const Element& e, std::size_t i, hid_t mem_type, void* out) const {
-    const std::string c = ctx() + " frame " + std::to_string(i) + ": " + where(e) + (e.time_dependent ? "/value" : "");
+    const std::string c = ctx() + " frame " + std::to_string(i) + ": " + where(e) +
+                          (e.time_dependent ? "/value" : "");
     if (e.time_dependent) {
       h5::readRows(e.value.get(), rowFor(e, i), 1, mem_type, out, c);
     } else {
-      h5::checkStatus(H5Dread(e.value.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out), c + ": cannot read");
+      h5::checkStatus(H5Dread(e.value.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out),
+                      c + ": cannot read");
     }
   }
 
@@ -156,18 +167,20 @@ struct H5mdReader::Impl {
     }
     for (double l : L)
       if (!(l > 0.0) || !std::isfinite(l))
-        error("frame " + std::to_string(i) + ": box edge " + common::formatReal(l) + " in " + where(edges) +
-              " is not positive and finite");
+        error("frame " + std::to_string(i) + ": box edge " + common::formatReal(l) + " in " +
+              where(edges) + " is not positive and finite");
     // Cubic up to the rounding of single-precision writers.
     if (std::fabs(L[1] - L[0]) > 1e-6 * L[0] || std::fabs(L[2] - L[0]) > 1e-6 * L[0])
-      error("frame " + std::to_string(i) + ": the box is not cubic (" + common::formatReal(L[0]) + ", " +
-            common::formatReal(L[1]) + ", " + common::formatReal(L[2]) + "); only cubic boxes are supported");
+      error("frame " + std::to_string(i) + ": the box is not cubic (" + common::formatReal(L[0]) +
+            ", " + common::formatReal(L[1]) + ", " + common::formatReal(L[2]) +
+            "); only cubic boxes are supported");
     return L[0];
   }
 
   void requireFrame(std::size_t i) const {
     if (i >= frames)
-      error("frame " + std::to_string(i) + " requested, the file has " + std::to_string(frames) + " complete frames");
+      error("frame " + std::to_string(i) + " requested, the file has " + std::to_string(frames) +
+            " complete frames");
   }
 };
 
@@ -177,7 +190,8 @@ H5mdReader::H5mdReader(const std::string& path, const std::string& particle_grou
   m.path = path;
   h5::silenceErrors();
   struct stat st;
-  if (::stat(path.c_str(), &st) != 0) throw std::runtime_error("H5MD file '" + path + "' does not exist");
+  if (::stat(path.c_str(), &st) != 0)
+    throw std::runtime_error("H5MD file '" + path + "' does not exist");
   const htri_t is_h5 = H5Fis_hdf5(path.c_str());
   if (is_h5 <= 0) {
     h5::lastError();
@@ -191,13 +205,16 @@ H5mdReader::H5mdReader(const std::string& path, const std::string& particle_grou
     h5::Handle g = h5::check(H5Gopen2(f, "/h5md", H5P_DEFAULT), m.ctx() + ": /h5md");
     h5::Handle a = h5::openAttribute(g.get(), "version");
     if (!a) m.error("/h5md has no 'version' attribute");
-    const auto v = h5::readNumericAttribute<std::int64_t>(a.get(), H5T_NATIVE_INT64, m.ctx() + ": /h5md version");
+    const auto v = h5::readNumericAttribute<std::int64_t>(a.get(), H5T_NATIVE_INT64,
+                                                          m.ctx() + ": /h5md version");
     if (v.size() != 2 || v[0] != 1)
-      m.error("unsupported H5MD version (expected 1.x, /h5md version has " + std::to_string(v.size()) +
-              " entries, first " + (v.empty() ? std::string("?") : std::to_string(v[0])) + ")");
+      m.error("unsupported H5MD version (expected 1.x, /h5md version has " +
+              std::to_string(v.size()) + " entries, first " +
+              (v.empty() ? std::string("?") : std::to_string(v[0])) + ")");
   }
   if (h5::objectType(f, "/particles") != H5I_GROUP) m.error("no /particles group");
-  h5::Handle particles = h5::check(H5Gopen2(f, "/particles", H5P_DEFAULT), m.ctx() + ": /particles");
+  h5::Handle particles =
+      h5::check(H5Gopen2(f, "/particles", H5P_DEFAULT), m.ctx() + ": /particles");
   const auto groups = h5::children(particles.get());
   if (particle_group.empty()) {
     if (groups.empty()) m.error("/particles holds no particle group");
@@ -207,7 +224,8 @@ H5mdReader::H5mdReader(const std::string& path, const std::string& particle_grou
     if (std::find(groups.begin(), groups.end(), particle_group) == groups.end()) {
       std::string list;
       for (const auto& g : groups) list += (list.empty() ? "" : ", ") + g;
-      m.error("no particle group '/particles/" + particle_group + "' (available: " + (list.empty() ? "none" : list) + ")");
+      m.error("no particle group '/particles/" + particle_group +
+              "' (available: " + (list.empty() ? "none" : list) + ")");
     }
   }
   h5::Handle part = h5::check(H5Gopen2(particles.get(), m.group.c_str(), H5P_DEFAULT),
@@ -215,36 +233,46 @@ H5mdReader::H5mdReader(const std::string& path, const std::string& particle_grou
   const hid_t p = part.get();
 
   m.pos = m.openElement(p, "position", true);
-  if (!m.pos.time_dependent) m.error(m.where(m.pos) + " must be a time-dependent group {value, step, time}");
+  if (!m.pos.time_dependent)
+    m.error(m.where(m.pos) + " must be a time-dependent group {value, step, time}");
   if (m.pos.dims.size() != 3 || m.pos.dims[2] != 3)
-    m.error(m.where(m.pos) + "/value has shape " + shapeText(m.pos.dims) + ", expected [frames,N,3]");
+    m.error(m.where(m.pos) + "/value has shape " + shapeText(m.pos.dims) +
+            ", expected [frames,N,3]");
   m.n = m.pos.dims[1];
-  m.frames = std::min<std::size_t>({static_cast<std::size_t>(m.pos.dims[0]), m.pos.steps.size(), m.pos.times.size()});
+  m.frames = std::min<std::size_t>(
+      {static_cast<std::size_t>(m.pos.dims[0]), m.pos.steps.size(), m.pos.times.size()});
 
   // box: attributes dimension and boundary, element edges
-  if (h5::objectType(p, "box") != H5I_GROUP) m.error("missing group particles/" + m.group + "/box (required by H5MD)");
+  if (h5::objectType(p, "box") != H5I_GROUP)
+    m.error("missing group particles/" + m.group + "/box (required by H5MD)");
   {
     h5::Handle box = h5::check(H5Gopen2(p, "box", H5P_DEFAULT), m.ctx() + ": box");
     const std::string bc = m.ctx() + ": particles/" + m.group + "/box";
     h5::Handle dim = h5::openAttribute(box.get(), "dimension");
     if (!dim) m.error("particles/" + m.group + "/box has no 'dimension' attribute");
-    const auto d = h5::readNumericAttribute<std::int64_t>(dim.get(), H5T_NATIVE_INT64, bc + " dimension");
+    const auto d =
+        h5::readNumericAttribute<std::int64_t>(dim.get(), H5T_NATIVE_INT64, bc + " dimension");
     if (d.size() != 1 || d[0] != 3)
-      m.error("particles/" + m.group + "/box dimension is " + (d.empty() ? std::string("empty") : std::to_string(d[0])) +
-              ", only 3 is supported");
+      m.error("particles/" + m.group + "/box dimension is " +
+              (d.empty() ? std::string("empty") : std::to_string(d[0])) + ", only 3 is supported");
     h5::Handle bnd = h5::openAttribute(box.get(), "boundary");
     if (!bnd) m.error("particles/" + m.group + "/box has no 'boundary' attribute");
     const auto b = h5::readStringArrayAttribute(bnd.get(), bc + " boundary");
-    if (b.size() != 3) m.error("particles/" + m.group + "/box boundary has " + std::to_string(b.size()) + " entries, expected 3");
+    if (b.size() != 3)
+      m.error("particles/" + m.group + "/box boundary has " + std::to_string(b.size()) +
+              " entries, expected 3");
     for (const auto& s : b)
       if (s != "periodic")
-        m.error("particles/" + m.group + "/box boundary is '" + s + "'; only periodic boxes are supported");
+        m.error("particles/" + m.group + "/box boundary is '" + s +
+                "'; only periodic boxes are supported");
     m.edges = m.openElement(box.get(), "edges", true);
     m.edges.name = "box/edges";
     const std::size_t rank = m.edges.dims.size() - (m.edges.time_dependent ? 1 : 0);
-    const std::vector<hsize_t> inner(m.edges.dims.end() - static_cast<std::ptrdiff_t>(rank), m.edges.dims.end());
+    const std::vector<hsize_t> inner(m.edges.dims.end() - static_cast<std::ptrdiff_t>(rank),
+                                     m.edges.dims.end());
     if (!(inner == std::vector<hsize_t>{3} || inner == std::vector<hsize_t>{3, 3}))
-      m.error(m.where(m.edges) + " has shape " + shapeText(m.edges.dims) + ", expected [3] or [3,3] per frame");
+      m.error(m.where(m.edges) + " has shape " + shapeText(m.edges.dims) +
+              ", expected [3] or [3,3] per frame");
   }
 
   const hsize_t N = m.n;
@@ -334,7 +362,8 @@ std::vector<std::pair<std::string, std::string>> H5mdReader::parameters() const 
   const Impl& m = *m_impl;
   std::vector<std::pair<std::string, std::string>> out;
   if (h5::objectType(m.file.get(), "/parameters") != H5I_GROUP) return out;
-  h5::Handle g = h5::check(H5Gopen2(m.file.get(), "/parameters", H5P_DEFAULT), m.ctx() + ": /parameters");
+  h5::Handle g =
+      h5::check(H5Gopen2(m.file.get(), "/parameters", H5P_DEFAULT), m.ctx() + ": /parameters");
   const std::vector<std::string> names = h5::attributeNames(g.get(), m.ctx() + ": /parameters");
   for (const auto& name : names) {
     const std::string c = m.ctx() + ": /parameters attribute '" + name + "'";
@@ -371,8 +400,10 @@ std::pair<std::string, std::string> H5mdReader::creator() const {
   const Impl& m = *m_impl;
   std::pair<std::string, std::string> out;
   if (h5::objectType(m.file.get(), "/h5md/creator") != H5I_GROUP) return out;
-  h5::Handle g = h5::check(H5Gopen2(m.file.get(), "/h5md/creator", H5P_DEFAULT), m.ctx() + ": /h5md/creator");
-  if (h5::Handle a = h5::openAttribute(g.get(), "name")) out.first = h5::readString(a.get(), true, m.ctx() + ": creator name");
+  h5::Handle g =
+      h5::check(H5Gopen2(m.file.get(), "/h5md/creator", H5P_DEFAULT), m.ctx() + ": /h5md/creator");
+  if (h5::Handle a = h5::openAttribute(g.get(), "name"))
+    out.first = h5::readString(a.get(), true, m.ctx() + ": creator name");
   if (h5::Handle a = h5::openAttribute(g.get(), "version"))
     out.second = h5::readString(a.get(), true, m.ctx() + ": creator version");
   return out;
@@ -401,11 +432,14 @@ ObservableSeries H5mdReader::readObservable(const std::string& name) const {
   for (const char* root : OBSERVABLE_ROOTS) {
     const std::string base = std::string(root) + "/" + name;
     if (name.empty() || h5::objectType(m.file.get(), base + "/value") != H5I_DATASET) continue;
-    h5::Handle g = h5::check(H5Gopen2(m.file.get(), base.c_str(), H5P_DEFAULT), m.ctx() + ": " + base);
-    h5::Handle v = h5::check(H5Dopen2(g.get(), "value", H5P_DEFAULT), m.ctx() + ": " + base + "/value");
+    h5::Handle g =
+        h5::check(H5Gopen2(m.file.get(), base.c_str(), H5P_DEFAULT), m.ctx() + ": " + base);
+    h5::Handle v =
+        h5::check(H5Dopen2(g.get(), "value", H5P_DEFAULT), m.ctx() + ": " + base + "/value");
     const auto dims = h5::datasetDims(v.get(), m.ctx() + ": " + base + "/value");
     if (dims.size() != 1)
-      m.error(base + "/value has shape " + shapeText(dims) + ", expected a scalar time series [samples]");
+      m.error(base + "/value has shape " + shapeText(dims) +
+              ", expected a scalar time series [samples]");
     ObservableSeries s;
     s.name = name;
     s.value = h5::readAll<double>(v.get(), H5T_NATIVE_DOUBLE, m.ctx() + ": " + base + "/value");

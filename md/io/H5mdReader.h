@@ -74,7 +74,8 @@ class H5mdReader {
   std::vector<std::pair<std::string, std::string>> parameters() const;
   /// Text of /parameters/config_toml ("" if absent).
   std::string configToml() const;
-  /// /h5md/creator name and version, e.g. {"granagg", "granagg 0.1.0 (abc123)"} ({"", ""} if absent).
+  /// /h5md/creator name and version, e.g. {"granagg", "granagg 0.1.0 (abc123)"} ({"", ""} if
+  /// absent).
   std::pair<std::string, std::string> creator() const;
 
   /// Names of the scalar time series: /granagg/observables first, then H5MD /observables.

@@ -18,10 +18,11 @@ namespace granagg::md {
 
 namespace {
 
-constexpr hsize_t STEP_CHUNK = 256;         // rows per chunk of step/time (one row per frame)
-constexpr hsize_t OBS_CHUNK = 1024;         // rows per chunk of observable series
+constexpr hsize_t STEP_CHUNK = 256;           // rows per chunk of step/time (one row per frame)
+constexpr hsize_t OBS_CHUNK = 1024;           // rows per chunk of observable series
 constexpr std::size_t OBS_BUFFER_MAX = 4096;  // buffered observable samples before a write
-constexpr std::size_t XDMF_EVERY_FRAME_UP_TO = 1000;  // then every XDMF_STRIDE frames (and at flush)
+constexpr std::size_t XDMF_EVERY_FRAME_UP_TO =
+    1000;  // then every XDMF_STRIDE frames (and at flush)
 constexpr std::size_t XDMF_STRIDE = 100;
 
 std::string particlePath() { return std::string("/particles/") + H5MD_PARTICLE_GROUP; }
@@ -43,11 +44,20 @@ std::string xmlEscape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -68,7 +78,7 @@ struct H5mdWriter::Impl {
   std::size_t frames = 0;
   bool have_last_step = false;
   std::int64_t last_step = 0;
-  std::vector<double> frame_times;  // for the XDMF sidecar
+  std::vector<double> frame_times;                         // for the XDMF sidecar
   std::size_t xdmf_frames = static_cast<std::size_t>(-1);  // frames described by the sidecar
 
   // observables
@@ -94,12 +104,14 @@ struct H5mdWriter::Impl {
     {
       h5::Handle g = h5::createGroup(file.get(), "h5md", c);
       const int version[2] = {1, 1};
-      h5::writeAttribute(g.get(), "version", H5T_STD_I32LE, H5T_NATIVE_INT, version, {2}, c + " /h5md");
+      h5::writeAttribute(g.get(), "version", H5T_STD_I32LE, H5T_NATIVE_INT, version, {2},
+                         c + " /h5md");
       h5::Handle author = h5::createGroup(g.get(), "author", c);
       h5::writeFixedStringAttribute(author.get(), "name", authorName(), c + " /h5md/author");
       h5::Handle creator = h5::createGroup(g.get(), "creator", c);
       h5::writeFixedStringAttribute(creator.get(), "name", "granagg", c + " /h5md/creator");
-      h5::writeFixedStringAttribute(creator.get(), "version", common::versionString(), c + " /h5md/creator");
+      h5::writeFixedStringAttribute(creator.get(), "version", common::versionString(),
+                                    c + " /h5md/creator");
     }
     const std::string pg = particlePath();
     h5::Handle part = h5::createGroup(file.get(), pg, c);
@@ -113,7 +125,8 @@ struct H5mdWriter::Impl {
       h5::Handle g = h5::createGroup(part.get(), name, c);
       std::vector<hsize_t> chunk_inner = inner;
       chunk_inner[0] = nchunk;
-      return h5::createExtendible(g.get(), "value", type, inner, 1, c + " " + pg + "/" + name, chunk_inner);
+      return h5::createExtendible(g.get(), "value", type, inner, 1, c + " " + pg + "/" + name,
+                                  chunk_inner);
     };
     pos = series("position", H5T_IEEE_F64LE, {N, 3});
     if (velocities) vel = series("velocity", H5T_IEEE_F64LE, {N, 3});
@@ -123,8 +136,10 @@ struct H5mdWriter::Impl {
     {
       h5::Handle box = h5::createGroup(part.get(), "box", c);
       const int dim = 3;
-      h5::writeAttribute(box.get(), "dimension", H5T_STD_I32LE, H5T_NATIVE_INT, &dim, {}, c + " box");
-      h5::writeFixedStringArrayAttribute(box.get(), "boundary", {"periodic", "periodic", "periodic"}, c + " box");
+      h5::writeAttribute(box.get(), "dimension", H5T_STD_I32LE, H5T_NATIVE_INT, &dim, {},
+                         c + " box");
+      h5::writeFixedStringArrayAttribute(box.get(), "boundary",
+                                         {"periodic", "periodic", "periodic"}, c + " box");
       h5::Handle eg = h5::createGroup(box.get(), "edges", c);
       edges = h5::createExtendible(eg.get(), "value", H5T_IEEE_F64LE, {3, 3}, 16, c + " box/edges");
     }
@@ -139,14 +154,16 @@ struct H5mdWriter::Impl {
       for (const auto& o : others) {
         for (const char* what : {"step", "time"}) {
           const std::string src = pg + "/position/" + what, dst = pg + "/" + o + "/" + what;
-          h5::checkStatus(H5Lcreate_hard(file.get(), src.c_str(), file.get(), dst.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+          h5::checkStatus(H5Lcreate_hard(file.get(), src.c_str(), file.get(), dst.c_str(),
+                                         H5P_DEFAULT, H5P_DEFAULT),
                           c + ": cannot link " + dst);
         }
       }
     }
     {
       h5::Handle par = h5::createGroup(file.get(), "parameters", c);
-      for (const auto& [k, v] : parameters) h5::writeStringAttribute(par.get(), k, v, c + " /parameters");
+      for (const auto& [k, v] : parameters)
+        h5::writeStringAttribute(par.get(), k, v, c + " /parameters");
       h5::writeStringDataset(par.get(), H5MD_CONFIG_DATASET, config_toml, c + " /parameters");
     }
   }
@@ -155,7 +172,8 @@ struct H5mdWriter::Impl {
     const std::string c = ctx(), pg = particlePath();
     auto open = [&](const std::string& p) {
       if (h5::objectType(file.get(), p) != H5I_DATASET)
-        throw std::invalid_argument(c + " has no dataset '" + p + "' (not written by granagg's H5mdWriter?)");
+        throw std::invalid_argument(c + " has no dataset '" + p +
+                                    "' (not written by granagg's H5mdWriter?)");
       return h5::check(H5Dopen2(file.get(), p.c_str(), H5P_DEFAULT), c + ": cannot open " + p);
     };
     pos = open(pg + "/position/value");
@@ -166,17 +184,19 @@ struct H5mdWriter::Impl {
     time = open(pg + "/position/time");
     const bool has_vel = h5::exists(file.get(), pg + "/velocity/value");
     if (has_vel != velocities)
-      throw std::invalid_argument(c + (has_vel ? " has" : " has no") +
-                                  " velocities but write_velocities = " + (velocities ? "true" : "false"));
+      throw std::invalid_argument(
+          c + (has_vel ? " has" : " has no") +
+          " velocities but write_velocities = " + (velocities ? "true" : "false"));
     if (velocities) vel = open(pg + "/velocity/value");
     const bool has_force = h5::exists(file.get(), pg + "/force/value");
     if (has_force != forces)
-      throw std::invalid_argument(c + (has_force ? " has" : " has no") + " forces but write_forces = " +
-                                  (forces ? "true" : "false"));
+      throw std::invalid_argument(c + (has_force ? " has" : " has no") +
+                                  " forces but write_forces = " + (forces ? "true" : "false"));
     if (forces) force = open(pg + "/force/value");
     const auto d = h5::datasetDims(pos.get(), c);
     if (d.size() != 3 || d[1] != n || d[2] != 3)
-      throw std::invalid_argument(c + " holds " + (d.size() == 3 ? std::to_string(d[1]) : std::string("?")) +
+      throw std::invalid_argument(c + " holds " +
+                                  (d.size() == 3 ? std::to_string(d[1]) : std::string("?")) +
                                   " particles, expected N = " + std::to_string(n));
     if (h5::exists(file.get(), H5MD_OBSERVABLES_GROUP)) {
       h5::Handle og = h5::check(H5Gopen2(file.get(), H5MD_OBSERVABLES_GROUP, H5P_DEFAULT), c);
@@ -211,9 +231,11 @@ struct H5mdWriter::Impl {
     };
     // Frames are complete only when their step/time rows exist (written last); value rows past
     // them are leftovers of a killed run and are cut as well.
-    const std::size_t nt = std::min<std::size_t>(h5::datasetDims(step.get(), c)[0], h5::datasetDims(time.get(), c)[0]);
+    const std::size_t nt =
+        std::min<std::size_t>(h5::datasetDims(step.get(), c)[0], h5::datasetDims(time.get(), c)[0]);
     frames = std::min<std::size_t>(keepRows(step.get()), nt);
-    for (hid_t d : {pos.get(), vel.get(), force.get(), charge.get(), image.get(), edges.get(), step.get(), time.get()})
+    for (hid_t d : {pos.get(), vel.get(), force.get(), charge.get(), image.get(), edges.get(),
+                    step.get(), time.get()})
       if (d >= 0) shrink(d, frames);
     frame_times = h5::readAll<double>(time.get(), H5T_NATIVE_DOUBLE, c + " time");
     if (frames > 0) {
@@ -222,8 +244,10 @@ struct H5mdWriter::Impl {
       last_step = steps.back();
     }
     if (obs_step) {
-      std::size_t rows = std::min<std::size_t>(keepRows(obs_step.get()), h5::datasetDims(obs_time.get(), c)[0]);
-      for (const auto& v : obs_value) rows = std::min<std::size_t>(rows, h5::datasetDims(v.get(), c)[0]);
+      std::size_t rows =
+          std::min<std::size_t>(keepRows(obs_step.get()), h5::datasetDims(obs_time.get(), c)[0]);
+      for (const auto& v : obs_value)
+        rows = std::min<std::size_t>(rows, h5::datasetDims(v.get(), c)[0]);
       for (const auto& v : obs_value) shrink(v.get(), rows);
       shrink(obs_step.get(), rows);
       shrink(obs_time.get(), rows);
@@ -242,26 +266,32 @@ struct H5mdWriter::Impl {
     for (const auto& kv : values) {
       const std::string& name = kv.first;
       if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-        throw std::invalid_argument("H5mdWriter: observable name '" + name + "' is not allowed (empty, '.', or contains '/')");
+        throw std::invalid_argument("H5mdWriter: observable name '" + name +
+                                    "' is not allowed (empty, '.', or contains '/')");
       if (!seen.insert(name).second)
         throw std::invalid_argument("H5mdWriter: observable '" + name + "' given twice");
     }
-    if (values.empty()) throw std::invalid_argument("H5mdWriter: writeObservables needs at least one value");
+    if (values.empty())
+      throw std::invalid_argument("H5mdWriter: writeObservables needs at least one value");
     h5::Handle og = h5::createGroup(file.get(), H5MD_OBSERVABLES_GROUP, c);
     const std::string first = std::string(H5MD_OBSERVABLES_GROUP) + "/" + values[0].first;
     for (std::size_t k = 0; k < values.size(); ++k) {
       const std::string& name = values[k].first;
       h5::Handle g = h5::createGroup(og.get(), name, c);
       obs_names.push_back(name);
-      obs_value.push_back(h5::createExtendible(g.get(), "value", H5T_IEEE_F64LE, {}, OBS_CHUNK, c + " observable " + name));
+      obs_value.push_back(h5::createExtendible(g.get(), "value", H5T_IEEE_F64LE, {}, OBS_CHUNK,
+                                               c + " observable " + name));
       if (k == 0) {
-        obs_step = h5::createExtendible(g.get(), "step", H5T_STD_I64LE, {}, OBS_CHUNK, c + " observable " + name);
-        obs_time = h5::createExtendible(g.get(), "time", H5T_IEEE_F64LE, {}, OBS_CHUNK, c + " observable " + name);
+        obs_step = h5::createExtendible(g.get(), "step", H5T_STD_I64LE, {}, OBS_CHUNK,
+                                        c + " observable " + name);
+        obs_time = h5::createExtendible(g.get(), "time", H5T_IEEE_F64LE, {}, OBS_CHUNK,
+                                        c + " observable " + name);
       } else {
         for (const char* what : {"step", "time"}) {
           const std::string src = first + "/" + what;
-          h5::checkStatus(H5Lcreate_hard(file.get(), src.c_str(), g.get(), what, H5P_DEFAULT, H5P_DEFAULT),
-                          c + ": cannot link observable " + name + "/" + what);
+          h5::checkStatus(
+              H5Lcreate_hard(file.get(), src.c_str(), g.get(), what, H5P_DEFAULT, H5P_DEFAULT),
+              c + ": cannot link observable " + name + "/" + what);
         }
       }
     }
@@ -273,10 +303,13 @@ struct H5mdWriter::Impl {
     const std::string c = ctx() + " observables";
     const hsize_t rows = buf_step.size();
     for (std::size_t k = 0; k < obs_names.size(); ++k)
-      h5::writeRows(obs_value[k].get(), obs_written, rows, H5T_NATIVE_DOUBLE, buf_values[k].data(), c + " " + obs_names[k]);
+      h5::writeRows(obs_value[k].get(), obs_written, rows, H5T_NATIVE_DOUBLE, buf_values[k].data(),
+                    c + " " + obs_names[k]);
     // step/time last: a sample exists once they are written (as for frames)
-    h5::writeRows(obs_step.get(), obs_written, rows, H5T_NATIVE_INT64, buf_step.data(), c + " step");
-    h5::writeRows(obs_time.get(), obs_written, rows, H5T_NATIVE_DOUBLE, buf_time.data(), c + " time");
+    h5::writeRows(obs_step.get(), obs_written, rows, H5T_NATIVE_INT64, buf_step.data(),
+                  c + " step");
+    h5::writeRows(obs_time.get(), obs_written, rows, H5T_NATIVE_DOUBLE, buf_time.data(),
+                  c + " time");
     obs_written += rows;
     buf_step.clear();
     buf_time.clear();
@@ -300,11 +333,14 @@ struct H5mdWriter::Impl {
     auto slab = [&](std::size_t f, const std::string& dset, bool vec, const char* num, int prec) {
       std::ostringstream s;
       const std::string inner = vec ? " 3" : "";
-      s << "      <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 " << N << inner << "\" Type=\"HyperSlab\">\n"
-        << "       <DataItem Dimensions=\"3 " << (vec ? 3 : 2) << "\" Format=\"XML\">" << f << " 0" << (vec ? " 0" : "")
-        << "  1 1" << (vec ? " 1" : "") << "  1 " << N << inner << "</DataItem>\n"
-        << "       <DataItem Dimensions=\"" << F << " " << N << inner << "\" NumberType=\"" << num << "\" Precision=\""
-        << prec << "\" Format=\"HDF\">" << h5 << ":" << pg << "/" << dset << "/value</DataItem>\n"
+      s << "      <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 " << N << inner
+        << "\" Type=\"HyperSlab\">\n"
+        << "       <DataItem Dimensions=\"3 " << (vec ? 3 : 2) << "\" Format=\"XML\">" << f << " 0"
+        << (vec ? " 0" : "") << "  1 1" << (vec ? " 1" : "") << "  1 " << N << inner
+        << "</DataItem>\n"
+        << "       <DataItem Dimensions=\"" << F << " " << N << inner << "\" NumberType=\"" << num
+        << "\" Precision=\"" << prec << "\" Format=\"HDF\">" << h5 << ":" << pg << "/" << dset
+        << "/value</DataItem>\n"
         << "      </DataItem>\n";
       return s.str();
     };
@@ -313,7 +349,8 @@ struct H5mdWriter::Impl {
       std::snprintf(tbuf, sizeof tbuf, "%.17g", frame_times[f]);
       x << "   <Grid Name=\"frame" << f << "\" GridType=\"Uniform\">\n"
         << "    <Time Value=\"" << tbuf << "\"/>\n"
-        << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << N << "\" NodesPerElement=\"1\"/>\n"
+        << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << N
+        << "\" NodesPerElement=\"1\"/>\n"
         << "    <Geometry GeometryType=\"XYZ\">\n"
         << slab(f, "position", true, "Float", 8) << "    </Geometry>\n";
       if (velocities)
@@ -352,7 +389,8 @@ H5mdWriter::H5mdWriter(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
 
 H5mdWriter::H5mdWriter(const std::string& path, std::size_t N,
                        const std::vector<std::pair<std::string, std::string>>& parameters,
-                       const std::string& config_toml, bool overwrite, bool write_velocities, bool write_forces)
+                       const std::string& config_toml, bool overwrite, bool write_velocities,
+                       bool write_forces)
     : m_impl(std::make_unique<Impl>()) {
   if (path.empty()) throw std::invalid_argument("H5mdWriter requires a file name.");
   if (N == 0) throw std::invalid_argument("H5mdWriter requires N >= 1 particles, got N = 0.");
@@ -370,8 +408,9 @@ H5mdWriter::H5mdWriter(const std::string& path, std::size_t N,
   m.n = N;
   m.velocities = write_velocities;
   m.forces = write_forces;
-  m.file = h5::check(H5Fcreate(path.c_str(), overwrite ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT),
-                     "cannot create H5MD file '" + path + "'");
+  m.file = h5::check(
+      H5Fcreate(path.c_str(), overwrite ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT),
+      "cannot create H5MD file '" + path + "'");
   try {
     m.createLayout(parameters, config_toml);
     m.flushFile();
@@ -398,7 +437,8 @@ H5mdWriter H5mdWriter::reopen(const std::string& path, std::size_t N, std::int64
     h5::lastError();
     throw std::invalid_argument("cannot reopen '" + path + "': no such HDF5 file");
   }
-  m.file = h5::check(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), "cannot reopen H5MD file '" + path + "'");
+  m.file = h5::check(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT),
+                     "cannot reopen H5MD file '" + path + "'");
   m.openLayout();
   m.truncateAfter(restart_step);
   m.flushFile();
@@ -434,10 +474,13 @@ void H5mdWriter::writeFrame(const Frame& f) {
   m.requireOpen();
   const std::size_t N = m.n;
   const std::string where = "H5mdWriter ('" + m.path + "', step " + std::to_string(f.step) + "): ";
-  if (f.size() != N) throw std::invalid_argument(where + "frame has " + std::to_string(f.size()) + " particles, expected " + std::to_string(N));
+  if (f.size() != N)
+    throw std::invalid_argument(where + "frame has " + std::to_string(f.size()) +
+                                " particles, expected " + std::to_string(N));
   auto need = [&](std::size_t size, const char* name) {
     if (size != N)
-      throw std::invalid_argument(where + "array " + name + " has " + std::to_string(size) + " entries, expected " + std::to_string(N));
+      throw std::invalid_argument(where + "array " + name + " has " + std::to_string(size) +
+                                  " entries, expected " + std::to_string(N));
   };
   need(f.y.size(), "y");
   need(f.z.size(), "z");
@@ -456,10 +499,12 @@ void H5mdWriter::writeFrame(const Frame& f) {
     need(f.fz.size(), "fz");
   }
   if (!(f.box > 0.0) || !std::isfinite(f.box))
-    throw std::invalid_argument(where + "box edge must be positive and finite, got " + common::formatReal(f.box));
+    throw std::invalid_argument(where + "box edge must be positive and finite, got " +
+                                common::formatReal(f.box));
   if (!std::isfinite(f.time)) throw std::invalid_argument(where + "time is not finite");
   if (m.have_last_step && f.step <= m.last_step)
-    throw std::invalid_argument(where + "steps must increase, previous frame was at step " + std::to_string(m.last_step));
+    throw std::invalid_argument(where + "steps must increase, previous frame was at step " +
+                                std::to_string(m.last_step));
 
   std::vector<double> xyz(3 * N);
   std::vector<std::int32_t> img(3 * N);
@@ -470,8 +515,9 @@ void H5mdWriter::writeFrame(const Frame& f) {
       double x = (*coords[d])[i];
       std::int32_t im = (*images[d])[i];
       if (!wrapCoordinate(x, im, f.box))
-        throw std::invalid_argument(where + "particle " + std::to_string(i) + " has position " + "xyz"[d] +
-                                    " = " + common::formatReal((*coords[d])[i]) + " (not finite, or too many box lengths away)");
+        throw std::invalid_argument(where + "particle " + std::to_string(i) + " has position " +
+                                    "xyz"[d] + " = " + common::formatReal((*coords[d])[i]) +
+                                    " (not finite, or too many box lengths away)");
       xyz[3 * i + d] = x;
       img[3 * i + d] = im;
     }
@@ -522,18 +568,21 @@ void H5mdWriter::writeObservables(std::int64_t step, double time,
   m.requireOpen();
   if (m.obs_names.empty()) m.createObservables(values);
   if (values.size() != m.obs_names.size())
-    throw std::invalid_argument("H5mdWriter: writeObservables got " + std::to_string(values.size()) +
-                                " values, the first call fixed " + std::to_string(m.obs_names.size()));
+    throw std::invalid_argument("H5mdWriter: writeObservables got " +
+                                std::to_string(values.size()) + " values, the first call fixed " +
+                                std::to_string(m.obs_names.size()));
   if (m.have_last_obs_step && step <= m.last_obs_step)
-    throw std::invalid_argument("H5mdWriter: observable steps must increase (step " + std::to_string(step) +
-                                " after " + std::to_string(m.last_obs_step) + ")");
+    throw std::invalid_argument("H5mdWriter: observable steps must increase (step " +
+                                std::to_string(step) + " after " + std::to_string(m.last_obs_step) +
+                                ")");
   std::vector<double> row(m.obs_names.size());
   std::vector<bool> filled(m.obs_names.size(), false);
   for (const auto& [name, v] : values) {
     std::size_t k = 0;
     while (k < m.obs_names.size() && m.obs_names[k] != name) ++k;
     if (k == m.obs_names.size())
-      throw std::invalid_argument("H5mdWriter: unknown observable '" + name + "' (the first call fixes the names)");
+      throw std::invalid_argument("H5mdWriter: unknown observable '" + name +
+                                  "' (the first call fixes the names)");
     if (filled[k]) throw std::invalid_argument("H5mdWriter: observable '" + name + "' given twice");
     filled[k] = true;
     row[k] = v;
@@ -568,7 +617,8 @@ void H5mdWriter::close() {
   } catch (...) {
     pending = std::current_exception();  // still close the file below
   }
-  for (h5::Handle* h : {&m.pos, &m.vel, &m.force, &m.charge, &m.image, &m.edges, &m.step, &m.time, &m.obs_step, &m.obs_time})
+  for (h5::Handle* h : {&m.pos, &m.vel, &m.force, &m.charge, &m.image, &m.edges, &m.step, &m.time,
+                        &m.obs_step, &m.obs_time})
     h->reset();
   m.obs_value.clear();
   const bool closed_ok = m.file.reset();
@@ -577,7 +627,9 @@ void H5mdWriter::close() {
 }
 
 std::size_t H5mdWriter::frames() const { return m_impl->frames; }
-std::size_t H5mdWriter::observableSamples() const { return m_impl->obs_written + m_impl->buf_step.size(); }
+std::size_t H5mdWriter::observableSamples() const {
+  return m_impl->obs_written + m_impl->buf_step.size();
+}
 std::size_t H5mdWriter::size() const { return m_impl->n; }
 const std::string& H5mdWriter::path() const { return m_impl->path; }
 const std::string& H5mdWriter::xdmfPath() const { return m_impl->xdmf_path; }

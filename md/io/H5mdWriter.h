@@ -74,7 +74,8 @@ class H5mdWriter {
   /// Throws std::invalid_argument for bad arguments, std::runtime_error if HDF5 fails.
   H5mdWriter(const std::string& path, std::size_t N,
              const std::vector<std::pair<std::string, std::string>>& parameters,
-             const std::string& config_toml, bool overwrite, bool write_velocities = true, bool write_forces = false);
+             const std::string& config_toml, bool overwrite, bool write_velocities = true,
+             bool write_forces = false);
 
   /// Reopens a trajectory written by H5mdWriter to continue a run restarted from a checkpoint
   /// taken at `restart_step`: frames and observable samples with step > restart_step (written

@@ -79,14 +79,30 @@ class Handle {
     if (m_id < 0) return true;
     herr_t rc = 0;
     switch (H5Iget_type(m_id)) {
-      case H5I_FILE: rc = H5Fclose(m_id); break;
-      case H5I_GROUP: rc = H5Gclose(m_id); break;
-      case H5I_DATASET: rc = H5Dclose(m_id); break;
-      case H5I_DATASPACE: rc = H5Sclose(m_id); break;
-      case H5I_DATATYPE: rc = H5Tclose(m_id); break;
-      case H5I_ATTR: rc = H5Aclose(m_id); break;
-      case H5I_GENPROP_LST: rc = H5Pclose(m_id); break;
-      default: rc = H5Idec_ref(m_id) < 0 ? -1 : 0; break;
+      case H5I_FILE:
+        rc = H5Fclose(m_id);
+        break;
+      case H5I_GROUP:
+        rc = H5Gclose(m_id);
+        break;
+      case H5I_DATASET:
+        rc = H5Dclose(m_id);
+        break;
+      case H5I_DATASPACE:
+        rc = H5Sclose(m_id);
+        break;
+      case H5I_DATATYPE:
+        rc = H5Tclose(m_id);
+        break;
+      case H5I_ATTR:
+        rc = H5Aclose(m_id);
+        break;
+      case H5I_GENPROP_LST:
+        rc = H5Pclose(m_id);
+        break;
+      default:
+        rc = H5Idec_ref(m_id) < 0 ? -1 : 0;
+        break;
     }
     m_id = H5I_INVALID_HID;
     return rc >= 0;
@@ -158,8 +174,7 @@ inline std::vector<std::string> children(hid_t loc) {
     static_cast<std::vector<std::string>*>(data)->emplace_back(name);
     return 0;
   };
-  if (H5Literate(loc, H5_INDEX_NAME, H5_ITER_INC, nullptr, cb, &names) < 0)
-    H5Eclear2(H5E_DEFAULT);
+  if (H5Literate(loc, H5_INDEX_NAME, H5_ITER_INC, nullptr, cb, &names) < 0) H5Eclear2(H5E_DEFAULT);
   return names;
 }
 
@@ -208,14 +223,18 @@ inline Handle varStringType() {
 inline void writeAttribute(hid_t obj, const std::string& name, hid_t file_type, hid_t mem_type,
                            const void* data, const std::vector<hsize_t>& dims,
                            const std::string& context) {
-  Handle space = dims.empty() ? Handle(H5Screate(H5S_SCALAR))
-                              : Handle(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
-  Handle attr = check(H5Acreate2(obj, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-                      context + ": cannot create attribute '" + name + "'");
-  checkStatus(H5Awrite(attr.get(), mem_type, data), context + ": cannot write attribute '" + name + "'");
+  Handle space =
+      dims.empty() ? Handle(H5Screate(H5S_SCALAR))
+                   : Handle(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
+  Handle attr =
+      check(H5Acreate2(obj, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+            context + ": cannot create attribute '" + name + "'");
+  checkStatus(H5Awrite(attr.get(), mem_type, data),
+              context + ": cannot write attribute '" + name + "'");
 }
 
-inline void writeAttribute(hid_t obj, const std::string& name, std::int64_t v, const std::string& ctx) {
+inline void writeAttribute(hid_t obj, const std::string& name, std::int64_t v,
+                           const std::string& ctx) {
   writeAttribute(obj, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &v, {}, ctx);
 }
 inline void writeAttribute(hid_t obj, const std::string& name, double v, const std::string& ctx) {
@@ -240,7 +259,8 @@ inline void writeFixedStringArrayAttribute(hid_t obj, const std::string& name,
   Handle type = fixedStringType(len);
   const std::size_t stride = len + 1;
   std::vector<char> buf(values.size() * stride, '\0');
-  for (std::size_t i = 0; i < values.size(); ++i) values[i].copy(buf.data() + i * stride, values[i].size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i].copy(buf.data() + i * stride, values[i].size());
   writeAttribute(obj, name, type.get(), type.get(), buf.data(), {values.size()}, ctx);
 }
 
@@ -257,8 +277,9 @@ inline void writeStringDataset(hid_t loc, const std::string& name, const std::st
                                const std::string& ctx) {
   Handle type = varStringType();
   Handle space(H5Screate(H5S_SCALAR));
-  Handle dset = check(H5Dcreate2(loc, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                      ctx + ": cannot create dataset '" + name + "'");
+  Handle dset = check(
+      H5Dcreate2(loc, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      ctx + ": cannot create dataset '" + name + "'");
   const char* p = value.c_str();
   checkStatus(H5Dwrite(dset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &p),
               ctx + ": cannot write dataset '" + name + "'");
@@ -267,15 +288,19 @@ inline void writeStringDataset(hid_t loc, const std::string& name, const std::st
 /// Reads a string stored in an attribute or a scalar dataset of fixed or variable length.
 /// `is_attr` selects H5Aread/H5Dread. Throws when the object is not a scalar string.
 inline std::string readString(hid_t obj, bool is_attr, const std::string& ctx) {
-  Handle type = check(is_attr ? H5Aget_type(obj) : H5Dget_type(obj), ctx + ": cannot read its type");
+  Handle type =
+      check(is_attr ? H5Aget_type(obj) : H5Dget_type(obj), ctx + ": cannot read its type");
   if (H5Tget_class(type.get()) != H5T_STRING) throw std::runtime_error(ctx + ": not a string");
-  Handle space = check(is_attr ? H5Aget_space(obj) : H5Dget_space(obj), ctx + ": cannot read its dataspace");
-  if (H5Sget_simple_extent_npoints(space.get()) != 1) throw std::runtime_error(ctx + ": not a single string");
+  Handle space =
+      check(is_attr ? H5Aget_space(obj) : H5Dget_space(obj), ctx + ": cannot read its dataspace");
+  if (H5Sget_simple_extent_npoints(space.get()) != 1)
+    throw std::runtime_error(ctx + ": not a single string");
   if (H5Tis_variable_str(type.get()) > 0) {
     Handle mem = varStringType();
     H5Tset_cset(mem.get(), H5Tget_cset(type.get()));
     char* p = nullptr;
-    const herr_t rc = is_attr ? H5Aread(obj, mem.get(), &p) : H5Dread(obj, mem.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &p);
+    const herr_t rc = is_attr ? H5Aread(obj, mem.get(), &p)
+                              : H5Dread(obj, mem.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &p);
     if (rc < 0) fail(ctx + ": cannot read");
     std::string s = p ? p : "";
     reclaimStrings(mem.get(), space.get(), &p);
@@ -295,7 +320,8 @@ inline std::string readString(hid_t obj, bool is_attr, const std::string& ctx) {
 /// Reads a 1D array of fixed- or variable-length strings from an attribute.
 inline std::vector<std::string> readStringArrayAttribute(hid_t attr, const std::string& ctx) {
   Handle type = check(H5Aget_type(attr), ctx + ": cannot read its type");
-  if (H5Tget_class(type.get()) != H5T_STRING) throw std::runtime_error(ctx + ": not a string attribute");
+  if (H5Tget_class(type.get()) != H5T_STRING)
+    throw std::runtime_error(ctx + ": not a string attribute");
   Handle space = check(H5Aget_space(attr), ctx + ": cannot read its dataspace");
   const hssize_t n = H5Sget_simple_extent_npoints(space.get());
   std::vector<std::string> out;
@@ -351,7 +377,8 @@ inline Handle openAttribute(hid_t obj, const std::string& name) {
 /// (default: whole inner extents).
 inline Handle createExtendible(hid_t loc, const std::string& name, hid_t file_type,
                                const std::vector<hsize_t>& inner, hsize_t chunk0,
-                               const std::string& ctx, const std::vector<hsize_t>& inner_chunk = {}) {
+                               const std::string& ctx,
+                               const std::vector<hsize_t>& inner_chunk = {}) {
   std::vector<hsize_t> dims{0}, maxdims{H5S_UNLIMITED}, chunk{chunk0};
   for (std::size_t k = 0; k < inner.size(); ++k) {
     const hsize_t d = inner[k];
@@ -362,20 +389,24 @@ inline Handle createExtendible(hid_t loc, const std::string& name, hid_t file_ty
   }
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), maxdims.data()));
   Handle dcpl = check(H5Pcreate(H5P_DATASET_CREATE), ctx);
-  checkStatus(H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data()), ctx + ": chunking '" + name + "'");
-  return check(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
-               ctx + ": cannot create dataset '" + name + "'");
+  checkStatus(H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data()),
+              ctx + ": chunking '" + name + "'");
+  return check(
+      H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
+      ctx + ": cannot create dataset '" + name + "'");
 }
 
 /// File and memory dataspaces selecting rows [row, row + count) of a dataset whose current
 /// dimensions are `dims` (first dimension = time index); shared by writeRows and readRows.
-inline void selectRows(hid_t dset, const std::vector<hsize_t>& dims, hsize_t row, hsize_t count, Handle& fspace,
-                       Handle& mspace, const std::string& ctx) {
+inline void selectRows(hid_t dset, const std::vector<hsize_t>& dims, hsize_t row, hsize_t count,
+                       Handle& fspace, Handle& mspace, const std::string& ctx) {
   fspace = check(H5Dget_space(dset), ctx);
   std::vector<hsize_t> start(dims.size(), 0), cnt = dims;
   start[0] = row;
   cnt[0] = count;
-  checkStatus(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr), ctx);
+  checkStatus(
+      H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr),
+      ctx);
   mspace = Handle(H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr));
 }
 
@@ -387,7 +418,8 @@ inline std::vector<std::string> attributeNames(hid_t obj, const std::string& ctx
     return 0;
   };
   hsize_t idx = 0;
-  if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0) fail(ctx + ": cannot list the attributes");
+  if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0)
+    fail(ctx + ": cannot list the attributes");
   return names;
 }
 
@@ -399,7 +431,8 @@ inline std::vector<std::string> datasetNames(hid_t group, const std::string& ctx
     return 0;
   };
   hsize_t idx = 0;
-  if (H5Literate(group, H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0) fail(ctx + ": cannot list the datasets");
+  if (H5Literate(group, H5_INDEX_NAME, H5_ITER_INC, &idx, cb, &names) < 0)
+    fail(ctx + ": cannot list the datasets");
   return names;
 }
 
@@ -416,7 +449,8 @@ inline void writeRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, co
   }
   Handle fspace, mspace;
   selectRows(dset, dims, row, count, fspace, mspace, ctx);
-  checkStatus(H5Dwrite(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data), ctx + ": cannot write");
+  checkStatus(H5Dwrite(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data),
+              ctx + ": cannot write");
 }
 
 /// Reads rows [row, row + count) of a dataset (first dimension = time index) into `out`, which
@@ -425,11 +459,13 @@ inline void readRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, voi
                      const std::string& ctx) {
   const std::vector<hsize_t> dims = datasetDims(dset, ctx);
   if (dims.empty() || dims[0] < row + count)
-    throw std::runtime_error(ctx + ": rows " + std::to_string(row) + ".." + std::to_string(row + count) +
-                             " requested, dataset has " + std::to_string(dims.empty() ? 0 : dims[0]));
+    throw std::runtime_error(ctx + ": rows " + std::to_string(row) + ".." +
+                             std::to_string(row + count) + " requested, dataset has " +
+                             std::to_string(dims.empty() ? 0 : dims[0]));
   Handle fspace, mspace;
   selectRows(dset, dims, row, count, fspace, mspace, ctx);
-  checkStatus(H5Dread(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, out), ctx + ": cannot read");
+  checkStatus(H5Dread(dset, mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, out),
+              ctx + ": cannot read");
 }
 
 /// Reads a whole dataset converted to `mem_type` (T must match it).
@@ -439,7 +475,9 @@ std::vector<T> readAll(hid_t dset, hid_t mem_type, const std::string& ctx) {
   std::size_t n = 1;
   for (hsize_t d : dims) n *= static_cast<std::size_t>(d);
   std::vector<T> out(n);
-  if (n > 0) checkStatus(H5Dread(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), ctx + ": cannot read");
+  if (n > 0)
+    checkStatus(H5Dread(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
+                ctx + ": cannot read");
   return out;
 }
 

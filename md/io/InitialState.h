@@ -39,7 +39,8 @@ Frame readInitialStateCsv(const std::string& path, double box);
 
 /// H5MD branch of readInitialState: frame `frame` (negative counts from the end, -1 = last) of
 /// the particle group `particle_group` ("" = the first group under /particles).
-Frame readInitialStateH5md(const std::string& path, long frame = -1, const std::string& particle_group = "");
+Frame readInitialStateH5md(const std::string& path, long frame = -1,
+                           const std::string& particle_group = "");
 
 /// Wraps one coordinate into [0, box), adding the number of box lengths removed to `image` (so
 /// x + image * box is unchanged up to round-off). Values already in [0, box) are left bit for

@@ -28,7 +28,8 @@ struct CellIndex {
   int nc;
   HD void operator()(int i) const {
     const Scalar4 r = pos[i];
-    int cx = static_cast<int>(r.x * inv_cell), cy = static_cast<int>(r.y * inv_cell), cz = static_cast<int>(r.z * inv_cell);
+    int cx = static_cast<int>(r.x * inv_cell), cy = static_cast<int>(r.y * inv_cell),
+        cz = static_cast<int>(r.z * inv_cell);
     cx = cx < 0 ? 0 : (cx >= nc ? nc - 1 : cx);
     cy = cy < 0 ? 0 : (cy >= nc ? nc - 1 : cy);
     cz = cz < 0 ? 0 : (cz >= nc ? nc - 1 : cz);
@@ -43,9 +44,9 @@ HD inline void append(int* row, int& n, int cap, int j) {
   ++n;
 }
 /// Branch-free append of candidate j if `hit`: j is written whatever `hit` -- to row[n], past the
-/// row's entries, or once the row is full to `spill` (never to a row slot: a full row may be exactly
-/// full, and its last entry must survive) -- and n advances by hit. Most candidates of a cell search
-/// miss, at random: a branch on them is mispredicted about as often as it is taken.
+/// row's entries, or once the row is full to `spill` (never to a row slot: a full row may be
+/// exactly full, and its last entry must survive) -- and n advances by hit. Most candidates of a
+/// cell search miss, at random: a branch on them is mispredicted about as often as it is taken.
 HD inline void appendIf(int* row, int& n, int cap, int j, bool hit, int& spill) {
   *(n < cap ? row + n : &spill) = j;
   n += hit;
@@ -79,7 +80,8 @@ HD inline void sortRowById(int* row, int n, const int* id) {
     // long rows: sort (id, slot) keys held in a local buffer, so that no comparison loads id[]
     // through the row (an indirect, cache-missing load per comparison dominated the build)
     std::uint64_t key[LOCAL];
-    for (int k = 0; k < n; ++k) key[k] = (static_cast<std::uint64_t>(id[row[k]]) << 32) | static_cast<std::uint32_t>(row[k]);
+    for (int k = 0; k < n; ++k)
+      key[k] = (static_cast<std::uint64_t>(id[row[k]]) << 32) | static_cast<std::uint32_t>(row[k]);
     for (int g = 0; g < 6; ++g) {
       const int gap = gaps[g];
       for (int k = gap; k < n; ++k) {
@@ -148,7 +150,8 @@ struct BuildCells {
   int nc, cap;
 
   /// Candidates in the slot range [s0, s1) of the cell order.
-  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill) const {
+  HD void scan(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n,
+               int& spill) const {
     for (int s = s0; s < s1; ++s) {
       const int j = SORTED ? s : order[s];
       const Scalar4 rj = pos[j];
@@ -163,8 +166,8 @@ struct BuildCells {
   /// the rest (dense cells only) is scanned at once. In a dilute gas a range holds about one
   /// particle: a loop per range costs a mispredicted exit each, here the candidates of all ranges
   /// are screened in one loop. Unsorted: scanned at once.
-  HD void range(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n, int& spill, int* cand,
-                int& m) const {
+  HD void range(int s0, int s1, int i, double xi, double yi, double zi, int* row, int& n,
+                int& spill, int* cand, int& m) const {
     if (!SORTED) return scan(s0, s1, i, xi, yi, zi, row, n, spill);
     const int len = s1 - s0;
     for (int k = 0; k < GATHER; ++k) cand[m + k] = s0 + k;
@@ -176,8 +179,8 @@ struct BuildCells {
   /// The candidates cand[0, m); WRAP: with minimum images (differences across the faces), without
   /// branches: about one candidate in three of a particle next to a face is across it.
   template <bool WRAP>
-  HD_INLINE void screen(const int* cand, int m, int i, double xi, double yi, double zi, int* row, int& n,
-                        int& spill) const {
+  HD_INLINE void screen(const int* cand, int m, int i, double xi, double yi, double zi, int* row,
+                        int& n, int& spill) const {
     for (int t = 0; t < m; ++t) {
       const int j = cand[t];
       const Scalar4 rj = pos[j];
@@ -194,7 +197,8 @@ struct BuildCells {
   HD int operator()(int i) const {
     const Scalar4 ri = pos[i];
     const double xi = ri.x, yi = ri.y, zi = ri.z;
-    int cx = static_cast<int>(xi * inv_cell), cy = static_cast<int>(yi * inv_cell), cz = static_cast<int>(zi * inv_cell);
+    int cx = static_cast<int>(xi * inv_cell), cy = static_cast<int>(yi * inv_cell),
+        cz = static_cast<int>(zi * inv_cell);
     cx = cx < 0 ? 0 : (cx >= nc ? nc - 1 : cx);
     cy = cy < 0 ? 0 : (cy >= nc ? nc - 1 : cy);
     cz = cz < 0 ? 0 : (cz >= nc ? nc - 1 : cz);
@@ -221,10 +225,12 @@ struct BuildCells {
           const int base = (xs[a] * nc + ys[b]) * nc;
           if (cz == 0) {
             range(cell_start[base], cell_start[base + 2], i, xi, yi, zi, row, n, spill, cand, m);
-            range(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
+            range(cell_start[base + nc - 1], cell_start[base + nc], i, xi, yi, zi, row, n, spill,
+                  cand, m);
           } else {
             range(cell_start[base], cell_start[base + 1], i, xi, yi, zi, row, n, spill, cand, m);
-            range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill, cand, m);
+            range(cell_start[base + nc - 2], cell_start[base + nc], i, xi, yi, zi, row, n, spill,
+                  cand, m);
           }
         }
     }
@@ -234,7 +240,8 @@ struct BuildCells {
       screen<false>(cand, m, i, xi, yi, zi, row, n, spill);
     else
       screen<true>(cand, m, i, xi, yi, zi, row, n, spill);
-    sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
+    sortRowById(row, n < cap ? n : cap,
+                id);  // sums over the row then run in id order (determinism)
     count[i] = n;
     if (owned) owned[i] = ownedEntries(row, n < cap ? n : cap, i);
     return 0;
@@ -259,7 +266,8 @@ struct FilterRows {
     for (int k = 0; k < super_count[i]; ++k) {
       const int j = in[k];
       const Scalar4 rj = pos[j];
-      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+      const double rx = box.minimumImageWrapped(ri.x - rj.x),
+                   ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       appendIf(row, n, cap, j, rx * rx + ry * ry + rz * rz < r2, spill);
     }
@@ -315,11 +323,13 @@ struct BuildAllPairs {
     for (int j = 0; j < N; ++j) {
       if (j == i) continue;
       const Scalar4 ri = pos[i], rj = pos[j];
-      const double rx = box.minimumImageWrapped(ri.x - rj.x), ry = box.minimumImageWrapped(ri.y - rj.y),
+      const double rx = box.minimumImageWrapped(ri.x - rj.x),
+                   ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       if (rx * rx + ry * ry + rz * rz < r2) append(row, n, cap, j);
     }
-    sortRowById(row, n < cap ? n : cap, id);  // sums over the row then run in id order (determinism)
+    sortRowById(row, n < cap ? n : cap,
+                id);  // sums over the row then run in id order (determinism)
     count[i] = n;
     if (owned) owned[i] = ownedEntries(row, n < cap ? n : cap, i);
   }
@@ -334,18 +344,22 @@ static std::uint64_t nextGeneration() {
 }
 
 NeighborList::NeighborList(double cutoff, double skin) : m_cutoff(cutoff), m_skin(skin) {
-  if (!(cutoff > 0.0) || !(skin > 0.0)) throw std::invalid_argument("neighbour list needs cutoff > 0 and skin > 0.");
+  if (!(cutoff > 0.0) || !(skin > 0.0))
+    throw std::invalid_argument("neighbour list needs cutoff > 0 and skin > 0.");
 }
 
 bool NeighborList::needsRebuild(const ParticleData& p, double max_displacement2) const {
-  return m_builds == 0 || m_built_n != p.size() || !(max_displacement2 <= 0.25 * m_skin * m_skin);  // NaN: rebuild
+  return m_builds == 0 || m_built_n != p.size() ||
+         !(max_displacement2 <= 0.25 * m_skin * m_skin);  // NaN: rebuild
 }
 
 int NeighborList::cellsPerSide(const common::Box& box) const {
   const double range = m_cutoff + m_skin;
   if (2.0 * range > box.L)
-    throw std::invalid_argument("box edge L = " + std::to_string(box.L) + " is smaller than twice the neighbour range " +
-                                std::to_string(range) + " (contact distance 1 + skin): use more particles or a smaller skin.");
+    throw std::invalid_argument(
+        "box edge L = " + std::to_string(box.L) + " is smaller than twice the neighbour range " +
+        std::to_string(range) +
+        " (contact distance 1 + skin): use more particles or a smaller skin.");
   return static_cast<int>(std::floor(box.L / range));
 }
 
@@ -365,7 +379,9 @@ const DVec<int>& NeighborList::computeCellOrder(const ParticleData& p, const com
   return m_order;
 }
 
-void NeighborList::build(const ParticleData& p, const common::Box& box) { buildImpl(p, box, false); }
+void NeighborList::build(const ParticleData& p, const common::Box& box) {
+  buildImpl(p, box, false);
+}
 
 void NeighborList::buildSorted(const ParticleData& p, const common::Box& box) {
   if (m_order.empty()) return buildImpl(p, box, false);  // box too small for cells: all-pairs build
@@ -382,7 +398,8 @@ void NeighborList::buildImpl(const ParticleData& p, const common::Box& box, bool
   m_count.resize(N);
   m_capacity = m_next_capacity;
   // sorted: computeCellOrder ran on these positions and the storage was permuted by its order, so
-  // m_cell (sorted in place with the order) holds the cell of every slot and the order is the identity
+  // m_cell (sorted in place with the order) holds the cell of every slot and the order is the
+  // identity
   if (nc >= 3 && !sorted) computeCellOrder(p, box);
   for (;;) {
     m_list.resize(static_cast<std::size_t>(N) * m_capacity);
@@ -392,22 +409,25 @@ void NeighborList::buildImpl(const ParticleData& p, const common::Box& box, bool
       m_cell_start.resize(ncell + 2);  // + 1: CellStarts' scratch slot
       // blocked loops (md/engine/Launch.h): the functors' members stay in registers
       const int block = blockSizeFor(N);
-      forEachBlocked(N, block, CellStarts{raw(m_cell), raw(m_cell_start), N, ncell}, NoReduction{}, nullptr);
+      forEachBlocked(N, block, CellStarts{raw(m_cell), raw(m_cell_start), N, ncell}, NoReduction{},
+                     nullptr);
       if (sorted)
         forEachBlocked(N, block,
-                       BuildCells<true>{raw(p.pos), nullptr, raw(m_cell_start), raw(p.id), raw(m_list), raw(m_count),
-                                        ownedOut(N), box, inv_cell, range * range, nc, m_capacity},
+                       BuildCells<true>{raw(p.pos), nullptr, raw(m_cell_start), raw(p.id),
+                                        raw(m_list), raw(m_count), ownedOut(N), box, inv_cell,
+                                        range * range, nc, m_capacity},
                        NoReduction{}, nullptr);
       else
         forEachBlocked(N, block,
-                       BuildCells<false>{raw(p.pos), raw(m_order), raw(m_cell_start), raw(p.id), raw(m_list),
-                                         raw(m_count), ownedOut(N), box, inv_cell, range * range, nc, m_capacity},
+                       BuildCells<false>{raw(p.pos), raw(m_order), raw(m_cell_start), raw(p.id),
+                                         raw(m_list), raw(m_count), ownedOut(N), box, inv_cell,
+                                         range * range, nc, m_capacity},
                        NoReduction{}, nullptr);
     } else {
       m_order.clear();
       thrust::for_each(first, last,
-                       BuildAllPairs{raw(p.pos), raw(p.id), raw(m_list), raw(m_count), ownedOut(N), box, range * range,
-                                     N, m_capacity});
+                       BuildAllPairs{raw(p.pos), raw(p.id), raw(m_list), raw(m_count), ownedOut(N),
+                                     box, range * range, N, m_capacity});
     }
     if (fitCapacity(N)) break;
   }
@@ -420,11 +440,13 @@ void NeighborList::compress(int N) {
   const auto first = thrust::counting_iterator<int>(0), last = thrust::counting_iterator<int>(N);
   m_entry_offsets.resize(N + 1);
   thrust::exclusive_scan(m_count.begin(), m_count.end(), m_entry_offsets.begin());
-  const int entries = N ? static_cast<int>(m_entry_offsets[N - 1]) + static_cast<int>(m_count[N - 1]) : 0;
+  const int entries =
+      N ? static_cast<int>(m_entry_offsets[N - 1]) + static_cast<int>(m_count[N - 1]) : 0;
   m_entry_offsets[N] = entries;
   // m_pair_offsets holds each row's owned pairs, counted by the build (ownedOut)
   const int last_owned = N ? static_cast<int>(m_pair_offsets[N - 1]) : 0;
-  thrust::exclusive_scan(m_pair_offsets.begin(), m_pair_offsets.begin() + N, m_pair_offsets.begin());
+  thrust::exclusive_scan(m_pair_offsets.begin(), m_pair_offsets.begin() + N,
+                         m_pair_offsets.begin());
   const int pairs = N ? static_cast<int>(m_pair_offsets[N - 1]) + last_owned : 0;
   m_pair_offsets[N] = pairs;
   m_pair_owners.resize(pairs);
@@ -434,8 +456,9 @@ void NeighborList::compress(int N) {
   m_pair_entries.resize(2 * static_cast<std::size_t>(pairs));
   const int missing = thrust::transform_reduce(
       first, last,
-      CompressRow{raw(m_list), raw(m_count), raw(m_pair_offsets), raw(m_entry_offsets), raw(m_pair_owners),
-                  raw(m_pair_partners), raw(m_entry_owners), raw(m_entry_pairs), raw(m_pair_entries), m_capacity},
+      CompressRow{raw(m_list), raw(m_count), raw(m_pair_offsets), raw(m_entry_offsets),
+                  raw(m_pair_owners), raw(m_pair_partners), raw(m_entry_owners), raw(m_entry_pairs),
+                  raw(m_pair_entries), m_capacity},
       0, thrust::plus<int>());
   if (missing != 0 || 2 * pairs != entries)
     throw std::logic_error("NeighborList: the rows are not symmetric (" + std::to_string(missing) +
@@ -449,7 +472,8 @@ int* NeighborList::ownedOut(int N) {
 }
 
 bool NeighborList::fitCapacity(int N) {
-  const int most = N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
+  const int most =
+      N ? thrust::reduce(m_count.begin(), m_count.end(), 0, thrust::maximum<int>()) : 0;
   if (most <= m_capacity) {
     if (m_keep_pairs) compress(N);
     // rows much wider than needed cost a cache line per particle per step for nothing: the next
@@ -458,22 +482,27 @@ bool NeighborList::fitCapacity(int N) {
     m_next_capacity = 2 * (most + most / 4 + 4) < m_capacity ? most + most / 4 + 4 : m_capacity;
     return true;
   }
-  m_capacity = m_next_capacity = most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
+  m_capacity = m_next_capacity =
+      most + most / 4 + 4;  // overflow detected: grow and rebuild, never truncate
   return false;
 }
 
-void NeighborList::buildFrom(const NeighborList& super, const ParticleData& p, const common::Box& box) {
+void NeighborList::buildFrom(const NeighborList& super, const ParticleData& p,
+                             const common::Box& box) {
   const int N = static_cast<int>(p.size());
   if (super.m_built_n != p.size() || super.listRange() < listRange())
-    throw std::logic_error("NeighborList::buildFrom: the longer list is not built for these particles or is too short");
+    throw std::logic_error(
+        "NeighborList::buildFrom: the longer list is not built for these particles or is too "
+        "short");
   const double range = m_cutoff + m_skin;
   m_count.resize(N);
   m_capacity = m_next_capacity;
   do {
     m_list.resize(static_cast<std::size_t>(N) * m_capacity);
-    thrust::for_each(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
-                     FilterRows{raw(p.pos), super.rows(), super.counts(), super.capacity(), raw(m_list), raw(m_count),
-                                ownedOut(N), box, range * range, m_capacity});
+    thrust::for_each(
+        thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
+        FilterRows{raw(p.pos), super.rows(), super.counts(), super.capacity(), raw(m_list),
+                   raw(m_count), ownedOut(N), box, range * range, m_capacity});
   } while (!fitCapacity(N));
   m_built_n = p.size();
   ++m_builds;

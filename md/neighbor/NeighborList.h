@@ -44,8 +44,8 @@ class NeighborList {
   /// Also keep the list in compressed pair form, rebuilt with every build, for passes that walk the
   /// entries of many particles as one loop and compute each pair's contact once (ContactForce.cpp):
   /// - pairs: every pair once, owned by its lower slot. Pair p joins pairOwners()[p] and
-  ///   pairPartners()[p] (> owner); the pairs of owner i are [pairOffsets()[i], pairOffsets()[i + 1]),
-  ///   in row (id) order.
+  ///   pairPartners()[p] (> owner); the pairs of owner i are [pairOffsets()[i], pairOffsets()[i +
+  ///   1]), in row (id) order.
   /// - entries: the full rows back to back, entry e of row entryOwners()[e] (the entries of row i
   ///   are [entryOffsets()[i], entryOffsets()[i + 1]), in row order), each with its pair:
   ///   entryPairs()[e] = p where the row owns pair p, ~p (negative) where the row is p's partner.
@@ -74,16 +74,19 @@ class NeighborList {
  private:
   int cellsPerSide(const common::Box& box) const;
   void buildImpl(const ParticleData& p, const common::Box& box, bool sorted);
-  /// Finishes a build: checks the rows against the capacity (true: they fit) and plans the next one.
+  /// Finishes a build: checks the rows against the capacity (true: they fit) and plans the next
+  /// one.
   bool fitCapacity(int N);
-  /// The compressed pair form of the rows (keepPairs), from the rows and their owned pairs (ownedOut).
+  /// The compressed pair form of the rows (keepPairs), from the rows and their owned pairs
+  /// (ownedOut).
   void compress(int N);
   /// With keepPairs, where a build writes the number of pairs each row owns (its entries j > i,
   /// the pair form's pair counts before the scan); otherwise null.
   int* ownedOut(int N);
   double m_cutoff, m_skin;
-  int m_capacity = 16;       // row stride of the current list
-  int m_next_capacity = 16;  // for the next build: grows on overflow, shrinks when rows are mostly empty
+  int m_capacity = 16;  // row stride of the current list
+  int m_next_capacity =
+      16;  // for the next build: grows on overflow, shrinks when rows are mostly empty
   std::int64_t m_builds = 0;
   DVec<int> m_list, m_count;
   bool m_keep_pairs = false;

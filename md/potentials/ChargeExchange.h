@@ -34,14 +34,15 @@ struct ChargeExchange {
   /// The charge gained by the partner with the smaller particle id at a collision of the pair
   /// (id_lo < id_hi) at `step` with approach speed xi_dot (> 0); the other partner gains minus it.
   /// Grazing or receding pairs (xi_dot <= 0) exchange nothing.
-  HD static double transferToLower(const Params& p, std::int64_t step, std::uint32_t id_lo, std::uint32_t id_hi,
-                                   double xi_dot) {
+  HD static double transferToLower(const Params& p, std::int64_t step, std::uint32_t id_lo,
+                                   std::uint32_t id_hi, double xi_dot) {
     if (!(xi_dot > 0.0)) return 0.0;
     // the step's high bits go into the stream word (above the 8-bit stream id): unique counters
     // for 2^56 steps
     const std::uint64_t s = static_cast<std::uint64_t>(step);
-    const auto r = philoxDraw(p.seed, RNG_CHARGE_EXCHANGE | static_cast<std::uint32_t>((s >> 32) << 8),
-                              static_cast<std::uint32_t>(s), id_lo, id_hi);
+    const auto r =
+        philoxDraw(p.seed, RNG_CHARGE_EXCHANGE | static_cast<std::uint32_t>((s >> 32) << 8),
+                   static_cast<std::uint32_t>(s), id_lo, id_hi);
     const double psi1 = p.psi1_min + (p.psi1_max - p.psi1_min) * uniform01(r[0]);
     const double psi2 = p.psi2_half_width * (2.0 * uniform01(r[1]) - 1.0);
     const double magnitude = p.Q * pow(psi1 * p.m_eff * xi_dot * xi_dot, p.kappa + psi2);
@@ -49,8 +50,10 @@ struct ChargeExchange {
   }
 
   /// The charge particle `self` gains at its collision with `other` (ids), as above.
-  HD static double transferTo(const Params& p, std::int64_t step, std::uint32_t self, std::uint32_t other, double xi_dot) {
-    return self < other ? transferToLower(p, step, self, other, xi_dot) : -transferToLower(p, step, other, self, xi_dot);
+  HD static double transferTo(const Params& p, std::int64_t step, std::uint32_t self,
+                              std::uint32_t other, double xi_dot) {
+    return self < other ? transferToLower(p, step, self, other, xi_dot)
+                        : -transferToLower(p, step, other, self, xi_dot);
   }
 };
 

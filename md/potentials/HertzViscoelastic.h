@@ -1,8 +1,8 @@
 #pragma once
 /// \file HertzViscoelastic.h
-/// Viscoelastic Hertz contact (Singh & Mazza 2018, eq. of motion; Brilliantov et al. 1996; design.md
-/// section 2). For two spheres of diameter 1 with overlap xi = 1 - |r_ij| > 0 approaching at rate
-/// xi' (> 0 while approaching), each partner feels the normal force
+/// Viscoelastic Hertz contact (Singh & Mazza 2018, eq. of motion; Brilliantov et al. 1996;
+/// design.md section 2). For two spheres of diameter 1 with overlap xi = 1 - |r_ij| > 0 approaching
+/// at rate xi' (> 0 while approaching), each partner feels the normal force
 ///
 ///     F = E xi^{3/2} + D xi^{1/2} xi'        (reduced units: force in T0/d)
 ///
@@ -31,7 +31,9 @@ struct HertzViscoelastic {
     return (p.clamp && f < 0.0) ? 0.0 : f;
   }
   /// Elastic energy of the contact, (2/5) E xi^{5/2} (F_el = dV/dxi).
-  HD static double elasticEnergy(double xi, const Params& p) { return 0.4 * p.E * xi * xi * sqrt(xi); }
+  HD static double elasticEnergy(double xi, const Params& p) {
+    return 0.4 * p.E * xi * xi * sqrt(xi);
+  }
   /// Duration of an elastic (D = 0) Hertz contact at impact speed v for reduced mass m_eff:
   /// t_c = 3.218065 (m_eff^2 / (E^2 v))^{1/5} (Landau & Lifshitz, Theory of Elasticity, sec. 9;
   /// design.md section 2). Longer for slower impacts and with damping.

@@ -5,11 +5,11 @@
 ///
 ///     F = k_n xi + gamma_n xi'      (xi' > 0 while approaching)
 ///
-/// With reduced mass m_eff, zeta = gamma_n / (2 m_eff) and omega0^2 = k_n / m_eff, a contact that ends
-/// at xi = 0 (unclamped) rebounds with epsilon = exp(-pi zeta / omega), omega = sqrt(omega0^2 - zeta^2),
-/// for every impact speed; inverted: zeta = -ln(eps) omega0 / sqrt(pi^2 + ln(eps)^2) (e.g. Schaefer,
-/// Dippel & Wolf, J. Phys. I France 6, 5 (1996)). Contact time pi / omega. With `clamp` the force
-/// is cut at zero and the rebound is slightly more elastic than epsilon.
+/// With reduced mass m_eff, zeta = gamma_n / (2 m_eff) and omega0^2 = k_n / m_eff, a contact that
+/// ends at xi = 0 (unclamped) rebounds with epsilon = exp(-pi zeta / omega), omega = sqrt(omega0^2
+/// - zeta^2), for every impact speed; inverted: zeta = -ln(eps) omega0 / sqrt(pi^2 + ln(eps)^2)
+/// (e.g. Schaefer, Dippel & Wolf, J. Phys. I France 6, 5 (1996)). Contact time pi / omega. With
+/// `clamp` the force is cut at zero and the rebound is slightly more elastic than epsilon.
 #include <cmath>
 #include <stdexcept>
 
@@ -34,7 +34,8 @@ struct SpringDashpot {
   /// Parameters giving restitution epsilon in (0, 1] for stiffness k (unclamped closed form above).
   static Params makeParams(double k, double epsilon, bool clamp, double m_eff = 0.5) {
     if (!(k > 0.0)) throw std::invalid_argument("contact.stiffness must be positive.");
-    if (!(epsilon > 0.0 && epsilon <= 1.0)) throw std::invalid_argument("contact.restitution must lie in (0, 1].");
+    if (!(epsilon > 0.0 && epsilon <= 1.0))
+      throw std::invalid_argument("contact.restitution must lie in (0, 1].");
     const double omega0 = std::sqrt(k / m_eff);
     const double le = std::log(epsilon);
     const double zeta = -le * omega0 / std::sqrt(M_PI * M_PI + le * le);

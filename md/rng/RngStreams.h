@@ -14,18 +14,19 @@
 namespace granagg::md {
 
 enum RngStream : std::uint32_t {
-  RNG_INIT_POSITION = 0x11,   ///< (particle, attempt): random insertion
-  RNG_INIT_VELOCITY = 0x12,   ///< (particle): Maxwell velocities
-  RNG_INIT_CHARGE = 0x13,     ///< (particle): which half of a bipolar initial state is positive
-  RNG_CHARGE_EXCHANGE = 0x21, ///< (step, min id, max id): collisional charging; the step's high
-                              ///< 32 bits sit above the 8-bit stream id (ChargeExchange.h)
+  RNG_INIT_POSITION = 0x11,    ///< (particle, attempt): random insertion
+  RNG_INIT_VELOCITY = 0x12,    ///< (particle): Maxwell velocities
+  RNG_INIT_CHARGE = 0x13,      ///< (particle): which half of a bipolar initial state is positive
+  RNG_CHARGE_EXCHANGE = 0x21,  ///< (step, min id, max id): collisional charging; the step's high
+                               ///< 32 bits sit above the 8-bit stream id (ChargeExchange.h)
 };
 
 /// Four 32-bit random words for (seed, stream, a, b, c).
-HD inline r123::Philox4x32::ctr_type philoxDraw(std::uint64_t seed, std::uint32_t stream, std::uint32_t a,
-                                                std::uint32_t b, std::uint32_t c) {
+HD inline r123::Philox4x32::ctr_type philoxDraw(std::uint64_t seed, std::uint32_t stream,
+                                                std::uint32_t a, std::uint32_t b, std::uint32_t c) {
   r123::Philox4x32 rng;
-  r123::Philox4x32::key_type key = {{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32)}};
+  r123::Philox4x32::key_type key = {
+      {static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32)}};
   r123::Philox4x32::ctr_type ctr = {{stream, a, b, c}};
   return rng(ctr, key);
 }

@@ -84,8 +84,8 @@ Frame initialState(const MdConfig& cfg) {
   Frame init = readInitialState(cfg.system.initial, boxLength(cfg.system));
   if (static_cast<int>(init.size()) != cfg.system.N)
     throw std::invalid_argument("system.initial '" + cfg.system.initial + "' holds " +
-                                std::to_string(init.size()) + " particles but system.N = " +
-                                std::to_string(cfg.system.N));
+                                std::to_string(init.size()) +
+                                " particles but system.N = " + std::to_string(cfg.system.N));
   Engine::assignInitialCharges(cfg, init);
   return init;
 }
@@ -101,8 +101,7 @@ void writeProfile(const Engine& engine, const fs::path& path, const std::string&
   for (const auto& [name, s] : engine.phaseSeconds()) {
     std::string col;  // "PPPM k-space" -> "pppm_k_space"
     for (char c : name)
-      col += std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::tolower(c))
-                                                         : '_';
+      col += std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::tolower(c)) : '_';
     while (col.find("__") != std::string::npos) col.erase(col.find("__"), 1);
     if (!col.empty() && col.back() == '_') col.pop_back();
     columns.push_back(col + "_s");
@@ -213,9 +212,9 @@ Simulation Simulation::resume(const fs::path& out, const std::vector<std::string
   validateConfig(d->cfg);
   d->setUp(std::make_unique<Engine>(d->cfg, ck));
   d->last_checkpoint_step = d->engine->step();
-  d->writer = std::make_unique<H5mdWriter>(H5mdWriter::reopen(
-      d->trajectory().string(), d->engine->size(), d->engine->step(),
-      d->cfg.output.write_velocities, d->cfg.output.write_forces));
+  d->writer = std::make_unique<H5mdWriter>(
+      H5mdWriter::reopen(d->trajectory().string(), d->engine->size(), d->engine->step(),
+                         d->cfg.output.write_velocities, d->cfg.output.write_forces));
   return Simulation(std::move(d));
 }
 
@@ -270,12 +269,12 @@ RunSummary Simulation::run() {
   } catch (const RunAborted& e) {
     d.writer->close();
     const fs::path cpath = d.checkpointFile();
-    throw RunAborted(std::string(e.what()) + ". Trajectory up to the last frame in " +
-                     d.trajectory().string() +
-                     (d.last_checkpoint_step >= 0 ? "; last good checkpoint (step " +
-                                              std::to_string(d.last_checkpoint_step) +
-                                              ") kept in " + cpath.string()
-                                        : "; no checkpoint was written before the failure"));
+    throw RunAborted(
+        std::string(e.what()) + ". Trajectory up to the last frame in " + d.trajectory().string() +
+        (d.last_checkpoint_step >= 0
+             ? "; last good checkpoint (step " + std::to_string(d.last_checkpoint_step) +
+                   ") kept in " + cpath.string()
+             : "; no checkpoint was written before the failure"));
   }
   RunSummary s;
   s.loop_seconds = std::chrono::duration<double>(Clock::now() - loop_start).count();

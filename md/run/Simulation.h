@@ -56,10 +56,10 @@ struct RunOptions {
 
 /// What run() did, for the log.
 struct RunSummary {
-  std::int64_t steps = 0;            ///< steps taken by this run() (not since t = 0)
-  double loop_seconds = 0.0;         ///< wall time of the loop, output included
-  std::int64_t neighbor_builds = 0;  ///< contact-list builds in this run()
-  std::int64_t slow_evaluations = 0; ///< evaluations of the slow Coulomb part in this run()
+  std::int64_t steps = 0;             ///< steps taken by this run() (not since t = 0)
+  double loop_seconds = 0.0;          ///< wall time of the loop, output included
+  std::int64_t neighbor_builds = 0;   ///< contact-list builds in this run()
+  std::int64_t slow_evaluations = 0;  ///< evaluations of the slow Coulomb part in this run()
 };
 
 class Simulation {
@@ -114,8 +114,7 @@ class Simulation {
   /// Steps at which frames are written for `config` and `dt` up to `last`: t = 0, log-spaced
   /// (output.frames_per_decade from t = 0.01, or from dt if larger), linear
   /// (output.frame_interval) and `last`.
-  static std::vector<std::int64_t> frameSteps(const MdConfig& config, double dt,
-                                              std::int64_t last);
+  static std::vector<std::int64_t> frameSteps(const MdConfig& config, double dt, std::int64_t last);
 
  private:
   struct Impl;

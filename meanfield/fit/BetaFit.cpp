@@ -34,12 +34,13 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/// Interval from bootstrap replicates over R runs: estimate -/+ t_{R-1} sqrt(R / (R - 1)) sd(replicates).
-/// The bootstrap standard deviation of a mean over R resampled runs is biased low by sqrt((R - 1) / R),
-/// and with few runs the quantile must be Student's t with R - 1 degrees of freedom: a percentile
-/// interval over 5 runs covers only about 1.75 standard errors where 2.78 are needed.
-void bootstrapInterval(const std::vector<double>& values, double estimate, std::size_t runs, double confidence,
-                       double& low, double& high) {
+/// Interval from bootstrap replicates over R runs: estimate -/+ t_{R-1} sqrt(R / (R - 1))
+/// sd(replicates). The bootstrap standard deviation of a mean over R resampled runs is biased low
+/// by sqrt((R - 1) / R), and with few runs the quantile must be Student's t with R - 1 degrees of
+/// freedom: a percentile interval over 5 runs covers only about 1.75 standard errors where 2.78 are
+/// needed.
+void bootstrapInterval(const std::vector<double>& values, double estimate, std::size_t runs,
+                       double confidence, double& low, double& high) {
   const double sd = gsl_stats_sd(values.data(), 1, values.size());
   const double R = static_cast<double>(runs);
   const double tq = gsl_cdf_tdist_Pinv(0.5 + confidence / 2.0, R - 1.0);
@@ -60,7 +61,9 @@ std::vector<double> resampledMean(const GrowthData& data, const std::vector<std:
 /// RAII wrapper of a GSL random number generator (mt19937 with a fixed seed).
 struct Rng {
   gsl_rng* r;
-  explicit Rng(std::uint64_t seed) : r(gsl_rng_alloc(gsl_rng_mt19937)) { gsl_rng_set(r, static_cast<unsigned long>(seed)); }
+  explicit Rng(std::uint64_t seed) : r(gsl_rng_alloc(gsl_rng_mt19937)) {
+    gsl_rng_set(r, static_cast<unsigned long>(seed));
+  }
   ~Rng() { gsl_rng_free(r); }
   Rng(const Rng&) = delete;
   Rng& operator=(const Rng&) = delete;
@@ -72,7 +75,8 @@ struct Rng {
 };
 
 /// OLS slope and intercept of y on x.
-void ols(const std::vector<double>& x, const std::vector<double>& y, double& slope, double& intercept, double& se_slope) {
+void ols(const std::vector<double>& x, const std::vector<double>& y, double& slope,
+         double& intercept, double& se_slope) {
   double c0, c1, cov00, cov01, cov11, sumsq;
   gsl_fit_linear(x.data(), 1, y.data(), 1, x.size(), &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
   slope = c1;
@@ -98,7 +102,8 @@ GrowthData growthFromRuns(std::vector<double> t, std::vector<std::vector<double>
   d.t = std::move(t);
   for (const auto& r : runs)
     if (r.size() != d.t.size())
-      throw std::invalid_argument("every run must have one S per time (" + std::to_string(d.t.size()) + "), found " +
+      throw std::invalid_argument("every run must have one S per time (" +
+                                  std::to_string(d.t.size()) + "), found " +
                                   std::to_string(r.size()) + ".");
   if (runs.size() == 1) {
     d.S = std::move(runs.front());
@@ -113,27 +118,30 @@ GrowthData growthFromRuns(std::vector<double> t, std::vector<std::vector<double>
 
 void validateGrowthData(const GrowthData& d) {
   if (d.t.size() != d.S.size())
-    throw std::invalid_argument("t and S must have the same length (" + std::to_string(d.t.size()) + " and " +
-                                std::to_string(d.S.size()) + ").");
+    throw std::invalid_argument("t and S must have the same length (" + std::to_string(d.t.size()) +
+                                " and " + std::to_string(d.S.size()) + ").");
   for (std::size_t i = 0; i < d.t.size(); ++i) {
     if (!(d.t[i] > 0.0) || !std::isfinite(d.t[i]))
-      throw std::invalid_argument("t must be positive and finite (t = " + formatReal(d.t[i]) + " at row " +
-                                  std::to_string(i + 1) + ").");
+      throw std::invalid_argument("t must be positive and finite (t = " + formatReal(d.t[i]) +
+                                  " at row " + std::to_string(i + 1) + ").");
     if (i && !(d.t[i] > d.t[i - 1]))
-      throw std::invalid_argument("t must increase strictly (t = " + formatReal(d.t[i]) + " follows " +
-                                  formatReal(d.t[i - 1]) + " at row " + std::to_string(i + 1) + ").");
+      throw std::invalid_argument("t must increase strictly (t = " + formatReal(d.t[i]) +
+                                  " follows " + formatReal(d.t[i - 1]) + " at row " +
+                                  std::to_string(i + 1) + ").");
     if (!(d.S[i] > 0.0) || !std::isfinite(d.S[i]))
-      throw std::invalid_argument("S must be positive and finite (S = " + formatReal(d.S[i]) + " at t = " +
-                                  formatReal(d.t[i]) + ").");
+      throw std::invalid_argument("S must be positive and finite (S = " + formatReal(d.S[i]) +
+                                  " at t = " + formatReal(d.t[i]) + ").");
   }
   for (std::size_t r = 0; r < d.runs.size(); ++r) {
     if (d.runs[r].size() != d.t.size())
-      throw std::invalid_argument("run " + std::to_string(r) + " has " + std::to_string(d.runs[r].size()) +
-                                  " values of S for " + std::to_string(d.t.size()) + " times.");
+      throw std::invalid_argument("run " + std::to_string(r) + " has " +
+                                  std::to_string(d.runs[r].size()) + " values of S for " +
+                                  std::to_string(d.t.size()) + " times.");
     for (std::size_t i = 0; i < d.t.size(); ++i)
       if (!(d.runs[r][i] > 0.0) || !std::isfinite(d.runs[r][i]))
-        throw std::invalid_argument("S must be positive and finite (S = " + formatReal(d.runs[r][i]) + " in run " +
-                                    std::to_string(r) + " at t = " + formatReal(d.t[i]) + ").");
+        throw std::invalid_argument(
+            "S must be positive and finite (S = " + formatReal(d.runs[r][i]) + " in run " +
+            std::to_string(r) + " at t = " + formatReal(d.t[i]) + ").");
   }
 }
 
@@ -142,7 +150,8 @@ void validateGrowthData(const GrowthData& d) {
 
 SlopeWindow explicitWindow(const GrowthData& data, double t0, double t1, int min_points) {
   if (!(t0 < t1) || !std::isfinite(t0) || !std::isfinite(t1))
-    throw std::invalid_argument("the window must satisfy T0 < T1 (got " + formatReal(t0) + ", " + formatReal(t1) + ").");
+    throw std::invalid_argument("the window must satisfy T0 < T1 (got " + formatReal(t0) + ", " +
+                                formatReal(t1) + ").");
   SlopeWindow w;
   w.automatic = false;
   bool first = true;
@@ -156,9 +165,9 @@ SlopeWindow explicitWindow(const GrowthData& data, double t0, double t1, int min
       ++w.points;
     }
   if (w.points < min_points)
-    throw std::invalid_argument("too few points in the window [" + formatReal(t0) + ", " + formatReal(t1) + "]: " +
-                                std::to_string(w.points) + " samples, at least " + std::to_string(min_points) +
-                                " needed.");
+    throw std::invalid_argument("too few points in the window [" + formatReal(t0) + ", " +
+                                formatReal(t1) + "]: " + std::to_string(w.points) +
+                                " samples, at least " + std::to_string(min_points) + " needed.");
   w.rule = "window given by the user: [" + formatReal(t0) + ", " + formatReal(t1) + "]";
   return w;
 }
@@ -169,7 +178,8 @@ SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& o) {
   const std::size_t n = data.t.size();
   const std::size_t min_points = static_cast<std::size_t>(o.min_points);
   if (n < min_points)
-    throw std::invalid_argument("too few points: S(t) has " + std::to_string(n) + " samples, a window needs at least " +
+    throw std::invalid_argument("too few points: S(t) has " + std::to_string(n) +
+                                " samples, a window needs at least " +
                                 std::to_string(o.min_points) + ".");
   std::vector<double> x(n), y(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -196,7 +206,8 @@ SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& o) {
       // second difference on a non-uniform grid, normalised to the noise of one sample
       const double h0 = x[i] - x[i - 1], h1 = x[i + 1] - x[i];
       const double w0 = h1 / (h0 + h1), w1 = h0 / (h0 + h1);  // y_i - (w0 y_{i-1} + w1 y_{i+1})
-      d2.push_back(std::fabs(y[i] - w0 * y[i - 1] - w1 * y[i + 1]) / std::sqrt(1.0 + w0 * w0 + w1 * w1));
+      d2.push_back(std::fabs(y[i] - w0 * y[i - 1] - w1 * y[i + 1]) /
+                   std::sqrt(1.0 + w0 * w0 + w1 * w1));
     }
     sigma = 1.4826 * median(d2);
     noise_from = "scatter about neighbours";
@@ -218,8 +229,8 @@ SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& o) {
     se = sigma / std::sqrt(sxx);
     return sxy / sxx;
   };
-  // A stretch [a, n) is flat when the exponents fitted to its earlier and later halves (split at the
-  // middle in ln t) differ by at most max(noise_factor x the standard error of the difference,
+  // A stretch [a, n) is flat when the exponents fitted to its earlier and later halves (split at
+  // the middle in ln t) differ by at most max(noise_factor x the standard error of the difference,
   // min_tolerance).
   auto flat = [&](std::size_t a) {
     const double mid = 0.5 * (x[a] + x[n - 1]);
@@ -228,7 +239,8 @@ SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& o) {
     if (m - a < 3 || n - m < 3) return true;
     double se1, se2;
     const double z1 = slope(a, m, se1), z2 = slope(m, n, se2);
-    return std::fabs(z2 - z1) <= std::max(o.noise_factor * std::sqrt(se1 * se1 + se2 * se2), o.min_tolerance);
+    return std::fabs(z2 - z1) <=
+           std::max(o.noise_factor * std::sqrt(se1 * se1 + se2 * se2), o.min_tolerance);
   };
   std::size_t a = n - min_points;
   while (a > 0 && flat(a - 1)) --a;
@@ -242,11 +254,14 @@ SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& o) {
   w.points = static_cast<int>(n - a);
   const bool fallback = a == n - min_points && a > 0;  // the loop stopped at its first test
   const std::string tail =
-      fallback ? ", no longer flat stretch: the last " + std::to_string(o.min_points) + " samples" : std::string();
+      fallback ? ", no longer flat stretch: the last " + std::to_string(o.min_points) + " samples"
+               : std::string();
   char buf[600];
   std::snprintf(buf, sizeof buf,
-                "automatic: longest stretch ending at the last sample over which the local slope is flat -- power-law "
-                "exponents of its earlier and later halves (in ln t) agree within max(%g standard errors, %g); noise "
+                "automatic: longest stretch ending at the last sample over which the local slope "
+                "is flat -- power-law "
+                "exponents of its earlier and later halves (in ln t) agree within max(%g standard "
+                "errors, %g); noise "
                 "of ln S %.3g (%s)%s",
                 o.noise_factor, o.min_tolerance, sigma, noise_from.c_str(), tail.c_str());
   w.rule = buf;
@@ -256,15 +271,18 @@ SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& o) {
 // ---------------------------------------------------------------------------------------------
 // z fit
 
-ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window, const BootstrapOptions& o) {
+ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window,
+                       const BootstrapOptions& o) {
   validateGrowthData(data);
-  if (!(o.confidence > 0.0 && o.confidence < 1.0)) throw std::invalid_argument("confidence must lie in (0, 1).");
+  if (!(o.confidence > 0.0 && o.confidence < 1.0))
+    throw std::invalid_argument("confidence must lie in (0, 1).");
   std::vector<std::size_t> idx;
   for (std::size_t i = 0; i < data.t.size(); ++i)
     if (data.t[i] >= window.t0 && data.t[i] <= window.t1) idx.push_back(i);
   if (idx.size() < 3)
     throw std::invalid_argument("too few points in the window [" + formatReal(window.t0) + ", " +
-                                formatReal(window.t1) + "]: " + std::to_string(idx.size()) + ", at least 3 needed.");
+                                formatReal(window.t1) + "]: " + std::to_string(idx.size()) +
+                                ", at least 3 needed.");
   std::vector<double> x, y;
   for (std::size_t i : idx) {
     x.push_back(std::log(data.t[i]));
@@ -298,7 +316,8 @@ ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window, const 
     f.interval_method = "bootstrap-runs";
     f.replicates = o.replicates_z;
   } else {
-    const double tq = gsl_cdf_tdist_Pinv(0.5 + o.confidence / 2.0, static_cast<double>(idx.size() - 2));
+    const double tq =
+        gsl_cdf_tdist_Pinv(0.5 + o.confidence / 2.0, static_cast<double>(idx.size() - 2));
     const double half = std::max(tq * se, ROUNDOFF);
     f.z_low = f.z - half;
     f.z_high = f.z + half;
@@ -348,7 +367,9 @@ MeanFieldCurves::Node& MeanFieldCurves::node(int k, double t_needed) {
   auto& slot = m_nodes[k];
   auto solve = [&](double s_end) {
     const double beta = k * m_options.beta_step;
-    if (!(beta > 0.0)) throw std::invalid_argument("mean-field curves need beta > 0 (got " + formatReal(beta) + ").");
+    if (!(beta > 0.0))
+      throw std::invalid_argument("mean-field curves need beta > 0 (got " + formatReal(beta) +
+                                  ").");
     SectionalOptions so;
     so.ratio = m_options.ratio;
     so.rtol = m_options.rtol;
@@ -369,18 +390,21 @@ MeanFieldCurves::Node& MeanFieldCurves::node(int k, double t_needed) {
         nd->lS.push_back(std::log(s.S));
       }
     if (nd->lt.size() < 8)
-      throw std::runtime_error("mean-field solve for beta = " + formatReal(beta) + " returned only " +
-                               std::to_string(nd->lt.size()) + " valid samples" +
-                               (r.stopped_early.empty() ? std::string() : " (" + r.stopped_early + ")"));
+      throw std::runtime_error(
+          "mean-field solve for beta = " + formatReal(beta) + " returned only " +
+          std::to_string(nd->lt.size()) + " valid samples" +
+          (r.stopped_early.empty() ? std::string() : " (" + r.stopped_early + ")"));
     nd->complete = s_end >= m_options.s_cap || std::exp(nd->lS.back()) < 0.5 * s_end;
     nd->acc = gsl_interp_accel_alloc();
     nd->spline = gsl_spline_alloc(gsl_interp_cspline, nd->lt.size());
     gsl_spline_init(nd->spline, nd->lt.data(), nd->lS.data(), nd->lt.size());
     // local slope over a factor ~2 in t at the end
-    const std::size_t m = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(0.30103 * m_options.per_decade)));
+    const std::size_t m = std::max<std::size_t>(
+        1, static_cast<std::size_t>(std::lround(0.30103 * m_options.per_decade)));
     const std::size_t last = nd->lt.size() - 1;
     const std::size_t m_used = std::min(m, last);
-    nd->tail_slope = (nd->lS[last] - nd->lS[last - m_used]) / (nd->lt[last] - nd->lt[last - m_used]);
+    nd->tail_slope =
+        (nd->lS[last] - nd->lS[last - m_used]) / (nd->lt[last] - nd->lt[last - m_used]);
     slot = std::move(nd);
   };
   if (!slot) solve(m_options.initial_s_end);
@@ -392,7 +416,8 @@ MeanFieldCurves::Node& MeanFieldCurves::node(int k, double t_needed) {
 double MeanFieldCurves::logS(double t, double beta) {
   if (!(t > 0.0)) throw std::invalid_argument("mean-field S needs t > 0.");
   const double h = m_options.beta_step;
-  if (!(beta > 2.0 * h)) throw std::invalid_argument("mean-field curves need beta > " + formatReal(2.0 * h) + ".");
+  if (!(beta > 2.0 * h))
+    throw std::invalid_argument("mean-field curves need beta > " + formatReal(2.0 * h) + ".");
   const double lt = std::log(t);
   const double x = beta / h;
   const double kr = std::round(x);
@@ -408,7 +433,8 @@ double MeanFieldCurves::logS(double t, double beta) {
 
 double MeanFieldCurves::timeAtS(double S, double beta) {
   if (!(S > 1.0) || !std::isfinite(S))
-    throw std::invalid_argument("the mean-field S starts at 1: no time has S = " + formatReal(S) + ".");
+    throw std::invalid_argument("the mean-field S starts at 1: no time has S = " + formatReal(S) +
+                                ".");
   const double target = std::log(S);
   double lo = std::log(1e-8), hi = 0.0;
   while (logS(std::exp(hi), beta) < target) {
@@ -442,14 +468,14 @@ double MeanFieldCurves::exponentBetween(double S0, double S1, double beta) {
 
 void validateBetaRange(double beta_min, double beta_max) {
   if (!(beta_min >= BETA_LOWEST) || !(beta_min <= BETA_HIGHEST))
-    throw std::invalid_argument("--beta-min must lie in [" + formatReal(BETA_LOWEST) + ", " + formatReal(BETA_HIGHEST) +
-                                "] (got " + formatReal(beta_min) + ").");
+    throw std::invalid_argument("--beta-min must lie in [" + formatReal(BETA_LOWEST) + ", " +
+                                formatReal(BETA_HIGHEST) + "] (got " + formatReal(beta_min) + ").");
   if (!(beta_max >= BETA_LOWEST) || !(beta_max <= BETA_HIGHEST))
-    throw std::invalid_argument("--beta-max must lie in [" + formatReal(BETA_LOWEST) + ", " + formatReal(BETA_HIGHEST) +
-                                "] (got " + formatReal(beta_max) + ").");
+    throw std::invalid_argument("--beta-max must lie in [" + formatReal(BETA_LOWEST) + ", " +
+                                formatReal(BETA_HIGHEST) + "] (got " + formatReal(beta_max) + ").");
   if (!(beta_max - beta_min >= 0.1))
-    throw std::invalid_argument("--beta-max must exceed --beta-min by at least 0.1 (got " + formatReal(beta_min) + ", " +
-                                formatReal(beta_max) + ").");
+    throw std::invalid_argument("--beta-max must exceed --beta-min by at least 0.1 (got " +
+                                formatReal(beta_min) + ", " + formatReal(beta_max) + ").");
 }
 
 namespace {
@@ -475,28 +501,34 @@ BetaFromZ betaAsymptotic(double z, double z_low, double z_high) {
   };
   if (!std::isfinite(z) || z <= 0.0 || z >= 3.0) {
     out.beta = out.beta_low = out.beta_high = NaN;
-    out.note = std::isfinite(z) ? (z <= 0.0 ? "z = " + formatReal(z) + " <= 0: S does not grow, no beta."
-                                            : "z = " + formatReal(z) + " >= 3: faster than 3 beta/(beta + 3) for every beta, no beta.")
-                                : "z is not finite: no beta.";
+    out.note =
+        std::isfinite(z)
+            ? (z <= 0.0 ? "z = " + formatReal(z) + " <= 0: S does not grow, no beta."
+                        : "z = " + formatReal(z) +
+                              " >= 3: faster than 3 beta/(beta + 3) for every beta, no beta.")
+            : "z is not finite: no beta.";
     return out;
   }
   out.beta = beta(z);
   out.beta_low = beta(z_low);
   out.beta_high = beta(z_high);
-  if (std::isfinite(z_high) && z_high >= 3.0) out.note += "z_high = " + formatReal(z_high) + " >= 3: no upper bound on beta. ";
-  if (std::isfinite(z_low) && z_low <= 0.0) out.note += "z_low = " + formatReal(z_low) + " <= 0: the interval reaches beta = 0. ";
+  if (std::isfinite(z_high) && z_high >= 3.0)
+    out.note += "z_high = " + formatReal(z_high) + " >= 3: no upper bound on beta. ";
+  if (std::isfinite(z_low) && z_low <= 0.0)
+    out.note += "z_low = " + formatReal(z_low) + " <= 0: the interval reaches beta = 0. ";
   if (!out.note.empty()) out.note.pop_back();
   return out;
 }
 
-BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_high, double S0, double S1,
-                    double beta_min, double beta_max) {
+BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_high, double S0,
+                    double S1, double beta_min, double beta_max) {
   validateBetaRange(beta_min, beta_max);
   BetaFromZ out;
   std::string note;
   const double S_floor = 1.0001;
   if (S0 < S_floor) {
-    note += "window starts at S = " + formatReal(S0) + " <= 1, the mean field's initial S; compared from S = 1.0001. ";
+    note += "window starts at S = " + formatReal(S0) +
+            " <= 1, the mean field's initial S; compared from S = 1.0001. ";
     S0 = S_floor;
   }
   out.S0 = S0;
@@ -521,14 +553,16 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
     if (zt <= out.z_at_beta_min || zt >= out.z_at_beta_max) {
       const bool below = zt <= out.z_at_beta_min;
       note += std::string(what) + " = " + formatReal(zt) + " lies " + (below ? "below" : "above") +
-              " the mean-field z = " + formatReal(below ? out.z_at_beta_min : out.z_at_beta_max) + " at beta = " +
-              formatReal(below ? beta_min : beta_max) + (central ? ": no beta" : ": clamped to the range") + ". ";
+              " the mean-field z = " + formatReal(below ? out.z_at_beta_min : out.z_at_beta_max) +
+              " at beta = " + formatReal(below ? beta_min : beta_max) +
+              (central ? ": no beta" : ": clamped to the range") + ". ";
       return central ? NaN : (below ? beta_min : beta_max);
     }
     // Bracket on the beta nodes first (exact nodes need one solve each, interpolated betas four):
     // bisection over node indices, then Brent's method inside one node cell.
     double lo = beta_min, hi = beta_max;
-    int klo = static_cast<int>(std::ceil(beta_min / h - 1e-9)), khi = static_cast<int>(std::floor(beta_max / h + 1e-9));
+    int klo = static_cast<int>(std::ceil(beta_min / h - 1e-9)),
+        khi = static_cast<int>(std::floor(beta_max / h + 1e-9));
     if (klo <= khi) {
       if (zt < zNode(klo)) {
         hi = klo * h;
@@ -551,7 +585,8 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
     for (int it = 0; it < 100; ++it) {
       if (gsl_root_fsolver_iterate(s) != GSL_SUCCESS) break;
       root = gsl_root_fsolver_root(s);
-      if (gsl_root_test_interval(gsl_root_fsolver_x_lower(s), gsl_root_fsolver_x_upper(s), 1e-7, 0.0) == GSL_SUCCESS)
+      if (gsl_root_test_interval(gsl_root_fsolver_x_lower(s), gsl_root_fsolver_x_upper(s), 1e-7,
+                                 0.0) == GSL_SUCCESS)
         break;
     }
     gsl_root_fsolver_free(s);
@@ -584,8 +619,10 @@ struct CurveProblem {
 
 int curveResidual(const gsl_vector* x, void* params, gsl_vector* f) {
   auto* p = static_cast<CurveProblem*>(params);
-  const double beta = gsl_vector_get(x, 0), lnSc = gsl_vector_get(x, 1), lntau = gsl_vector_get(x, 2);
-  if (!std::isfinite(beta) || !std::isfinite(lnSc) || !std::isfinite(lntau) || std::fabs(lntau) > 200.0)
+  const double beta = gsl_vector_get(x, 0), lnSc = gsl_vector_get(x, 1),
+               lntau = gsl_vector_get(x, 2);
+  if (!std::isfinite(beta) || !std::isfinite(lnSc) || !std::isfinite(lntau) ||
+      std::fabs(lntau) > 200.0)
     return GSL_EDOM;
   try {
     for (std::size_t i = 0; i < p->y.size(); ++i)
@@ -608,7 +645,8 @@ LmResult runLm(CurveProblem& prob, double beta0, double lnSc0, double lntau0, bo
   gsl_multifit_nlinear_parameters params = gsl_multifit_nlinear_default_parameters();
   params.trs = gsl_multifit_nlinear_trs_lm;
   params.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
-  gsl_multifit_nlinear_workspace* w = gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &params, n, p);
+  gsl_multifit_nlinear_workspace* w =
+      gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &params, n, p);
   gsl_multifit_nlinear_fdf fdf;
   fdf.f = &curveResidual;
   fdf.df = nullptr;  // finite differences
@@ -624,7 +662,8 @@ LmResult runLm(CurveProblem& prob, double beta0, double lnSc0, double lntau0, bo
   r.ok = gsl_multifit_nlinear_init(x, &fdf, w) == GSL_SUCCESS;
   int info = 0;
   if (r.ok) {
-    const int status = gsl_multifit_nlinear_driver(200, 1e-10, 1e-10, 0.0, nullptr, nullptr, &info, w);
+    const int status =
+        gsl_multifit_nlinear_driver(200, 1e-10, 1e-10, 0.0, nullptr, nullptr, &info, w);
     r.ok = status == GSL_SUCCESS || status == GSL_EMAXITER || status == GSL_ENOPROG;
   }
   const gsl_vector* xs = gsl_multifit_nlinear_position(w);
@@ -654,7 +693,9 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   validateGrowthData(data);
   validateBetaRange(o.beta_min, o.beta_max);
   const std::size_t n = data.t.size();
-  if (n < 5) throw std::invalid_argument("too few points for the curve fit: " + std::to_string(n) + ", at least 5 needed.");
+  if (n < 5)
+    throw std::invalid_argument("too few points for the curve fit: " + std::to_string(n) +
+                                ", at least 5 needed.");
   std::vector<double> lt(n);
   for (std::size_t i = 0; i < n; ++i) lt[i] = std::log(data.t[i]);
   CurveProblem prob{&curves, &lt, {}, o.beta_min, o.beta_max};
@@ -667,7 +708,8 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   // at which the last sample sits at t/tau_c = 1e-3 (all data in the early linear regime).
   const double y_min = *std::min_element(prob.y.begin(), prob.y.end());
   const double y_max = *std::max_element(prob.y.begin(), prob.y.end());
-  const double S_scan = std::min(curves.options().s_cap, std::max(1e3, 4.0 * std::exp(y_max - y_min)));
+  const double S_scan =
+      std::min(curves.options().s_cap, std::max(1e3, 4.0 * std::exp(y_max - y_min)));
   std::vector<double> betas{o.beta_min};
   for (double b = o.beta_min + 1.0; b < o.beta_max - 0.25; b += 1.0) betas.push_back(b);
   betas.push_back(o.beta_max);
@@ -684,7 +726,8 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
       }
       mean /= static_cast<double>(n);
       double ssr = 0.0;
-      for (std::size_t i = 0; i < n; ++i) ssr += (prob.y[i] - m[i] - mean) * (prob.y[i] - m[i] - mean);
+      for (std::size_t i = 0; i < n; ++i)
+        ssr += (prob.y[i] - m[i] - mean) * (prob.y[i] - m[i] - mean);
       if (ssr < best) {
         best = ssr;
         b0 = beta;
@@ -709,7 +752,8 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   const double dof = static_cast<double>(n - 3);
   fit.chi2_dof = r.chi2 / dof;
   const double conf = o.bootstrap.confidence;
-  if (data.runs.size() >= static_cast<std::size_t>(std::max(o.bootstrap.min_runs, 2)) && o.bootstrap.replicates_curve > 0) {
+  if (data.runs.size() >= static_cast<std::size_t>(std::max(o.bootstrap.min_runs, 2)) &&
+      o.bootstrap.replicates_curve > 0) {
     Rng rng(o.bootstrap.seed);
     std::vector<double> bs, ss, ts;
     CurveProblem pb = prob;
@@ -753,10 +797,12 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   const double edge = 1e-4 * (o.beta_max - o.beta_min);
   fit.at_bound = fit.beta <= o.beta_min + edge || fit.beta >= o.beta_max - edge;
   if (fit.at_bound)
-    fit.note = "beta_fit lies at the bound " + formatReal(fit.beta <= o.beta_min + edge ? o.beta_min : o.beta_max) +
+    fit.note = "beta_fit lies at the bound " +
+               formatReal(fit.beta <= o.beta_min + edge ? o.beta_min : o.beta_max) +
                " of the search range; widen --beta-min/--beta-max.";
   fit.S_fitted.resize(n);
-  for (std::size_t i = 0; i < n; ++i) fit.S_fitted[i] = fit.S_c * std::exp(prob.model(lt[i], fit.beta, r.lntau));
+  for (std::size_t i = 0; i < n; ++i)
+    fit.S_fitted[i] = fit.S_c * std::exp(prob.model(lt[i], fit.beta, r.lntau));
   return fit;
 }
 

@@ -7,19 +7,19 @@
 ///    local slope of S(t) is flat within its noise at late times, with a 95 % interval (Student t
 ///    on the residuals, or a bootstrap over independent runs);
 /// 2. beta from z: the beta for which the full Smoluchowski solution (sectional solver, beta kernel
-///    K = (i^{1/3} + j^{1/3})^2 (1/i + 1/j)^{1/beta}) grows with the same exponent over the same range
-///    of S as the data window. Not 3 beta/(beta + 3): that is only the S -> infinity limit, and the
-///    local slope of the mean field approaches it slowly (1.19 at S ~ 250 for beta = 2, design.md
-///    section 4), so the comparison is made at equal S (cli/ repeats it at S / S_c, with S_c from
-///    the curve fit, for data whose S unit differs from the mean field's monomer count);
+///    K = (i^{1/3} + j^{1/3})^2 (1/i + 1/j)^{1/beta}) grows with the same exponent over the same
+///    range of S as the data window. Not 3 beta/(beta + 3): that is only the S -> infinity limit,
+///    and the local slope of the mean field approaches it slowly (1.19 at S ~ 250 for beta = 2,
+///    design.md section 4), so the comparison is made at equal S (cli/ repeats it at S / S_c, with
+///    S_c from the curve fit, for data whose S unit differs from the mean field's monomer count);
 /// 3. a full-curve fit of log S(t_i) against log[S_c S_MF(t_i / tau_c; beta)] (GSL nonlinear least
 ///    squares, trust region / Levenberg-Marquardt), parameters (beta, ln S_c, ln tau_c), with 95 %
 ///    intervals from the covariance scaled by chi^2/dof, or from a bootstrap over runs (>= 3 runs).
 ///
 /// Units: t in the data's own unit (MD: sqrt(m d^2 / T0)); S in the data's own unit (MD: grid sites
 /// or particles). S_MF(t; beta) is the mean-field S = M2/M1 (monomer masses) from the monodisperse
-/// start n_1(0) = 1 with K0 = 1, its time in 1/(K0 n_1(0)); tau_c converts that time into the data's
-/// time and S_c the mean-field size into the data's size.
+/// start n_1(0) = 1 with K0 = 1, its time in 1/(K0 n_1(0)); tau_c converts that time into the
+/// data's time and S_c the mean-field size into the data's size.
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -47,31 +47,32 @@ void validateGrowthData(const GrowthData& data);
 
 /// Options of the automatic window.
 struct WindowOptions {
-  int min_points = 5;           ///< fewest samples of S in a window
-  double noise_factor = 3.0;    ///< flat = the halves' exponents agree within noise_factor standard errors ...
+  int min_points = 5;  ///< fewest samples of S in a window
+  double noise_factor =
+      3.0;  ///< flat = the halves' exponents agree within noise_factor standard errors ...
   double min_tolerance = 0.01;  ///< ... or within this absolute tolerance in z, whichever is larger
 };
 
 /// A fit window [t0, t1] over the samples of S.
 struct SlopeWindow {
   double t0 = 0.0, t1 = 0.0;
-  int points = 0;            ///< samples of S with t0 <= t <= t1
+  int points = 0;  ///< samples of S with t0 <= t <= t1
   bool automatic = false;
-  double sigma_lnS = 0.0;    ///< noise of ln S per sample (automatic window)
-  double tolerance = 0.0;    ///< min_tolerance used (automatic window)
-  std::string rule;          ///< one sentence: how the window was chosen
+  double sigma_lnS = 0.0;  ///< noise of ln S per sample (automatic window)
+  double tolerance = 0.0;  ///< min_tolerance used (automatic window)
+  std::string rule;        ///< one sentence: how the window was chosen
 };
 
 /// The automatic window: the longest stretch of samples ending at the last one over which the local
 /// slope of S(t) is flat within its noise. Rule: the stretch [t_a, t_last] grows one sample at a
-/// time to earlier times (starting from the last min_points samples) while it is flat: the power-law
-/// exponents fitted to its earlier and later halves (split at the middle of ln t_a..ln t_last) -- the
-/// local slope at two times a factor sqrt(t_last / t_a) apart -- differ by at most
+/// time to earlier times (starting from the last min_points samples) while it is flat: the
+/// power-law exponents fitted to its earlier and later halves (split at the middle of ln t_a..ln
+/// t_last) -- the local slope at two times a factor sqrt(t_last / t_a) apart -- differ by at most
 /// max(noise_factor x the standard error of the difference, min_tolerance). The standard errors
 /// use the noise of ln S: with >= 2 runs, the median over times of the relative standard error of
 /// the mean over runs; with one series, 1.4826 x the median absolute deviation of ln S_i from the
-/// line through its neighbours (normalised to one sample). Growth stops at the first stretch that is
-/// not flat. Samples correlated in time (one MD run) make the noise look smaller and the window
+/// line through its neighbours (normalised to one sample). Growth stops at the first stretch that
+/// is not flat. Samples correlated in time (one MD run) make the noise look smaller and the window
 /// shorter, never longer. Throws std::invalid_argument when the data hold fewer than min_points.
 SlopeWindow automaticWindow(const GrowthData& data, const WindowOptions& options = {});
 /// The window [t0, t1] given by the user (ends widened by a relative 1e-4, so that a frame a
@@ -82,9 +83,9 @@ SlopeWindow explicitWindow(const GrowthData& data, double t0, double t1, int min
 /// Options of the z fit and of every bootstrap.
 struct BootstrapOptions {
   double confidence = 0.95;
-  int replicates_z = 2000;      ///< bootstrap replicates of the z fit
-  int replicates_curve = 200;   ///< bootstrap replicates of the full-curve fit
-  int min_runs = 3;             ///< bootstrap over runs only with at least this many runs
+  int replicates_z = 2000;        ///< bootstrap replicates of the z fit
+  int replicates_curve = 200;     ///< bootstrap replicates of the full-curve fit
+  int min_runs = 3;               ///< bootstrap over runs only with at least this many runs
   std::uint64_t seed = 20180901;  ///< fixed seed (GSL mt19937): intervals are reproducible
 };
 
@@ -106,7 +107,8 @@ struct ZFit {
 };
 /// Fits z over the window. The interval half-width is never below 1e-12 (the round-off of a
 /// least-squares slope in double precision, so that an exact power law is inside its interval).
-ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window, const BootstrapOptions& options = {});
+ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window,
+                       const BootstrapOptions& options = {});
 
 /// Options of the mean-field curves S_MF(t; beta).
 struct MeanFieldCurveOptions {
@@ -114,13 +116,13 @@ struct MeanFieldCurveOptions {
   /// nearly constant for S > 30 (absorbed into S_c), the local slope within 2e-3 at S ~ 10-30 and
   /// 5e-4 at S ~ 300 -- far below MD's uncertainty in z -- at a third of the cost of ratio 1.05.
   double ratio = 1.1;
-  double rtol = 1e-7;        ///< CVODE relative tolerance
+  double rtol = 1e-7;  ///< CVODE relative tolerance
   /// Spacing of the beta nodes (curves between nodes: Catmull-Rom in beta; its error in ln S, ~1e-4
   /// at 0.1, is far below the noise of MD data).
   double beta_step = 0.1;
   double initial_s_end = 1e4;  ///< first solve of a node stops at this S; extended x10 when needed
-  double s_cap = 1e8;        ///< largest S solved; beyond it ln S continues with the last local slope
-  int per_decade = 40;       ///< output times per decade of t
+  double s_cap = 1e8;   ///< largest S solved; beyond it ln S continues with the last local slope
+  int per_decade = 40;  ///< output times per decade of t
 };
 
 /// S_MF(t; beta) of the full Smoluchowski equation (sectional solver, beta kernel, monodisperse
@@ -158,17 +160,18 @@ class MeanFieldCurves {
 
 /// Result of inverting z -> beta.
 struct BetaFromZ {
-  double beta = 0.0, beta_low = 0.0, beta_high = 0.0;  ///< NaN when z lies outside z(beta) on the range
+  double beta = 0.0, beta_low = 0.0,
+         beta_high = 0.0;     ///< NaN when z lies outside z(beta) on the range
   double S0 = 0.0, S1 = 0.0;  ///< S range at which the mean-field exponent was computed
   double z_at_beta_min = 0.0, z_at_beta_max = 0.0;  ///< mean-field z at the range ends
   std::string note;  ///< empty, or why a value is NaN or clamped to the range
 };
 /// beta such that curves.exponentBetween(S0, S1, beta) = z (Brent's method on [beta_min, beta_max];
-/// z(beta) increases with beta). Interval ends from z_low and z_high; an end whose z lies beyond the
-/// range is clamped to beta_min or beta_max (the interval extends at least that far; noted), a
+/// z(beta) increases with beta). Interval ends from z_low and z_high; an end whose z lies beyond
+/// the range is clamped to beta_min or beta_max (the interval extends at least that far; noted), a
 /// central value beyond it is NaN. S0 is raised to 1.0001 if lower (S_MF >= 1; noted).
-BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_high, double S0, double S1,
-                    double beta_min, double beta_max);
+BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_high, double S0,
+                    double S1, double beta_min, double beta_max);
 
 /// beta from z through the asymptotic law z = 3 beta / (beta + 3), i.e. beta = 3 z / (3 - z): the
 /// growth exponent the full Smoluchowski equation with the beta kernel converges to at large S
@@ -199,7 +202,7 @@ struct CurveFit {
   /// sqrt(R / (R - 1)) x the bootstrap standard deviation; for S_c and tau_c in ln).
   std::string interval_method;
   int replicates = 0;
-  std::string note;             ///< empty, or e.g. that beta ended at a bound of its range
+  std::string note;  ///< empty, or e.g. that beta ended at a bound of its range
   /// true when beta ended at a bound of [beta_min, beta_max]: then beta is not determined by the
   /// data (the best curve lies beyond the range, or the data are not of the mean field's shape).
   bool at_bound = false;
@@ -211,7 +214,8 @@ struct CurveFit {
 /// Levenberg-Marquardt, finite-difference Jacobian); beta is confined to [beta_min, beta_max]
 /// (the model is evaluated at the nearest bound outside it). Throws std::invalid_argument for a
 /// bad beta range or fewer than 5 samples; std::runtime_error when GSL fails.
-CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFitOptions& options = {});
+CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data,
+                  const CurveFitOptions& options = {});
 
 /// Allowed beta range of the fits: beta_min >= BETA_LOWEST, beta_max <= BETA_HIGHEST.
 constexpr double BETA_LOWEST = 1.0;

@@ -16,20 +16,22 @@ void checkSeries(const std::vector<double>& t, const std::vector<double>& S) {
   if (t.size() != S.size()) throw std::invalid_argument("t and S must have the same length.");
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (!(t[i] > 0.0) || !std::isfinite(t[i]))
-      throw std::invalid_argument("times must be positive and finite (t[" + std::to_string(i) + "] = " +
-                                  common::formatReal(t[i]) + ").");
+      throw std::invalid_argument("times must be positive and finite (t[" + std::to_string(i) +
+                                  "] = " + common::formatReal(t[i]) + ").");
     if (i && !(t[i] > t[i - 1]))
-      throw std::invalid_argument("times must increase strictly (t[" + std::to_string(i) + "] = " +
-                                  common::formatReal(t[i]) + ").");
+      throw std::invalid_argument("times must increase strictly (t[" + std::to_string(i) +
+                                  "] = " + common::formatReal(t[i]) + ").");
     if (!(S[i] > 0.0) || !std::isfinite(S[i]))
-      throw std::invalid_argument("S must be positive and finite (S[" + std::to_string(i) + "] = " +
-                                  common::formatReal(S[i]) + ").");
+      throw std::invalid_argument("S must be positive and finite (S[" + std::to_string(i) +
+                                  "] = " + common::formatReal(S[i]) + ").");
   }
 }
 }  // namespace
 
 LocalSlope localSlope(const std::vector<double>& t, const std::vector<double>& S, double p) {
-  if (!(p > 1.0)) throw std::invalid_argument("the local-slope ratio p must be > 1 (got " + common::formatReal(p) + ").");
+  if (!(p > 1.0))
+    throw std::invalid_argument("the local-slope ratio p must be > 1 (got " +
+                                common::formatReal(p) + ").");
   checkSeries(t, S);
   LocalSlope out;
   const double lp = std::log(p);
@@ -56,7 +58,8 @@ PowerLawFit fitPowerLaw(const std::vector<double>& t, const std::vector<double>&
                         double t_max, double confidence) {
   checkSeries(t, S);
   if (!(confidence > 0.0 && confidence < 1.0))
-    throw std::invalid_argument("confidence must lie in (0, 1) (got " + common::formatReal(confidence) + ").");
+    throw std::invalid_argument("confidence must lie in (0, 1) (got " +
+                                common::formatReal(confidence) + ").");
   std::vector<double> x, y;
   for (std::size_t i = 0; i < t.size(); ++i)
     if (t[i] >= t_min && t[i] <= t_max) {
@@ -64,8 +67,9 @@ PowerLawFit fitPowerLaw(const std::vector<double>& t, const std::vector<double>&
       y.push_back(std::log(S[i]));
     }
   if (x.size() < 3)
-    throw std::invalid_argument("power-law fit needs at least 3 points in the window [" + common::formatReal(t_min) +
-                                ", " + common::formatReal(t_max) + "], found " + std::to_string(x.size()) + ".");
+    throw std::invalid_argument("power-law fit needs at least 3 points in the window [" +
+                                common::formatReal(t_min) + ", " + common::formatReal(t_max) +
+                                "], found " + std::to_string(x.size()) + ".");
   double c0, c1, cov00, cov01, cov11, sumsq;
   gsl_fit_linear(x.data(), 1, y.data(), 1, x.size(), &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
   PowerLawFit f;
@@ -83,11 +87,13 @@ PowerLawFit fitPowerLaw(const std::vector<double>& t, const std::vector<double>&
   return f;
 }
 
-AsymptoticExponent asymptoticExponent(const std::vector<double>& t, const std::vector<double>& S, double p,
-                                      double tolerance) {
+AsymptoticExponent asymptoticExponent(const std::vector<double>& t, const std::vector<double>& S,
+                                      double p, double tolerance) {
   if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive.");
   const LocalSlope ls = localSlope(t, S, p);
-  if (ls.t.size() < 3) throw std::invalid_argument("asymptotic exponent needs at least 3 local slopes; extend the time range.");
+  if (ls.t.size() < 3)
+    throw std::invalid_argument(
+        "asymptotic exponent needs at least 3 local slopes; extend the time range.");
   const double t_last = ls.t.back();
   std::vector<double> x, y;
   for (std::size_t i = 0; i < ls.t.size(); ++i)
@@ -115,9 +121,11 @@ AsymptoticExponent asymptoticExponent(const std::vector<double>& t, const std::v
 std::string AsymptoticExponent::describe() const {
   char buf[400];
   std::snprintf(buf, sizeof buf,
-                "z_inf = %.5f extrapolated in 1/t from the local slope over the last decade (z(t_last) = %.5f, "
+                "z_inf = %.5f extrapolated in 1/t from the local slope over the last decade "
+                "(z(t_last) = %.5f, "
                 "correction %.1e, change over the decade %.1e): %s (criterion: both below %.0e)",
-                z, z_last, correction, change, converged ? "converged" : "NOT converged", tolerance);
+                z, z_last, correction, change, converged ? "converged" : "NOT converged",
+                tolerance);
   return buf;
 }
 

@@ -21,9 +21,9 @@ LocalSlope localSlope(const std::vector<double>& t, const std::vector<double>& S
 
 /// Least-squares fit of log S = log A + z log t on the points with t_min <= t <= t_max.
 struct PowerLawFit {
-  double z = 0.0;          ///< exponent
-  double z_stderr = 0.0;   ///< standard error of z from the residuals
-  double z_low = 0.0;      ///< lower end of the `confidence` interval (Student t, n - 2 dof)
+  double z = 0.0;         ///< exponent
+  double z_stderr = 0.0;  ///< standard error of z from the residuals
+  double z_low = 0.0;     ///< lower end of the `confidence` interval (Student t, n - 2 dof)
   double z_high = 0.0;
   double prefactor = 0.0;  ///< A
   double confidence = 0.95;

@@ -9,7 +9,8 @@
 ///
 ///     K(i,j) = K0 * (i+j)^e * sum_t w_t * i^{p_t} * j^{q_t}
 ///
-/// - beta kernel (Singh & Mazza 2018, eq. kernel_beta with its typo corrected, design.md section 2):
+/// - beta kernel (Singh & Mazza 2018, eq. kernel_beta with its typo corrected, design.md section
+/// 2):
 ///     K = K0 (i^{1/3} + j^{1/3})^2 (1/i + 1/j)^{1/beta}
 ///       = K0 (i+j)^{1/beta} [ i^{2/3} + 2 i^{1/3} j^{1/3} + j^{2/3} ] (ij)^{-1/beta}
 ///   homogeneity lambda = 2/3 - 1/beta;

@@ -3,15 +3,15 @@
 
 #include <algorithm>
 #include <array>
-#include <exception>
 #include <cmath>
+#include <exception>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
-#include <boost/numeric/odeint.hpp>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
+#include <boost/numeric/odeint.hpp>
 
 #include "common/Csv.h"
 
@@ -25,18 +25,22 @@ constexpr double PI = 3.141592653589793238462643383279502884;
 
 void checkTemperature(double T, const char* what) {
   if (!(T >= 0.0) || !std::isfinite(T))
-    throw std::invalid_argument(std::string(what) + " requires a non-negative, finite temperature T (got " +
+    throw std::invalid_argument(std::string(what) +
+                                " requires a non-negative, finite temperature T (got " +
                                 formatReal(T) + ").");
 }
 
 void checkRestitution(double eps) {
   if (!(eps >= 0.0 && eps <= 1.0))
-    throw std::invalid_argument("Haff's law requires a restitution coefficient eps in [0, 1] (got " + formatReal(eps) + ").");
+    throw std::invalid_argument(
+        "Haff's law requires a restitution coefficient eps in [0, 1] (got " + formatReal(eps) +
+        ").");
 }
 
 void checkTime(double t) {
   if (!(t >= 0.0) || !std::isfinite(t))
-    throw std::invalid_argument("cooling time t must be non-negative and finite (got " + formatReal(t) + ").");
+    throw std::invalid_argument("cooling time t must be non-negative and finite (got " +
+                                formatReal(t) + ").");
 }
 
 /// Disables GSL's abort-on-error handler while a GSL call runs, so that failures come back as
@@ -56,7 +60,8 @@ class GslHandlerOff {
 
 void validateFillingFraction(double phi) {
   if (!(phi > 0.0 && phi < 0.74))
-    throw std::invalid_argument("filling fraction phi must lie in (0, 0.74) (got " + formatReal(phi) + ").");
+    throw std::invalid_argument("filling fraction phi must lie in (0, 0.74) (got " +
+                                formatReal(phi) + ").");
 }
 
 double numberDensity(double phi) {
@@ -71,17 +76,19 @@ double carnahanStarlingG2(double phi) {
 
 double enskogCollisionFrequency(double phi, double T) {
   checkTemperature(T, "the Enskog collision frequency");
-  return 4.0 * std::sqrt(PI) * numberDensity(phi) * carnahanStarlingG2(phi) * std::sqrt(T);  // m = d = 1
+  return 4.0 * std::sqrt(PI) * numberDensity(phi) * carnahanStarlingG2(phi) *
+         std::sqrt(T);  // m = d = 1
 }
 
 // Haff's law (Haff 1983; design.md section 2). With a constant restitution L = 1 - eps^2, so the
 // cooling equation below reads dT/dt = -(1 - eps^2) omega0 sqrt(T/T0) T / 3. Substituting
-// T = T0 u^{-2}: -2 T0 u^{-3} u' = -(1 - eps^2) omega0 T0 u^{-3} / 3, i.e. u' = (1 - eps^2) omega0 / 6
-// = 1/tau0 and T = T0 / (1 + t/tau0)^2.
+// T = T0 u^{-2}: -2 T0 u^{-3} u' = -(1 - eps^2) omega0 T0 u^{-3} / 3, i.e. u' = (1 - eps^2) omega0
+// / 6 = 1/tau0 and T = T0 / (1 + t/tau0)^2.
 double haffInverseTau0(double eps, double phi, double T0) {
   checkRestitution(eps);
   if (!(T0 > 0.0) || !std::isfinite(T0))
-    throw std::invalid_argument("Haff's law requires a positive initial temperature T0 (got " + formatReal(T0) + ").");
+    throw std::invalid_argument("Haff's law requires a positive initial temperature T0 (got " +
+                                formatReal(T0) + ").");
   return (1.0 - eps * eps) * enskogCollisionFrequency(phi, T0) / 6.0;
 }
 
@@ -109,8 +116,11 @@ double haffTemperature(double t, double eps, double phi, double T0) {
 double energyLossFactor(const RestitutionFunction& e, double T, double rel_tol) {
   checkTemperature(T, "the energy loss factor");
   if (!(rel_tol > 0.0 && rel_tol < 1.0))
-    throw std::invalid_argument("energy loss quadrature tolerance must lie in (0, 1) (got " + formatReal(rel_tol) + ").");
-  if (!e) throw std::invalid_argument("energy loss factor requires a restitution function (got an empty one).");
+    throw std::invalid_argument("energy loss quadrature tolerance must lie in (0, 1) (got " +
+                                formatReal(rel_tol) + ").");
+  if (!e)
+    throw std::invalid_argument(
+        "energy loss factor requires a restitution function (got an empty one).");
   // Substituting g = 2 sqrt(T) y: L = int_0^inf 2 y^3 exp(-y^2) [1 - e(2 sqrt(T) y)^2] dy. The
   // weight has unit integral; the range is cut at y = 10, where the tail weight is
   // 101 exp(-100) ~ 4e-42.
@@ -144,8 +154,8 @@ double energyLossFactor(const RestitutionFunction& e, double T, double rel_tol) 
   }
   if (ctx.error) std::rethrow_exception(ctx.error);
   if (status != GSL_SUCCESS && !(abserr <= 100.0 * rel_tol * std::fabs(result)))
-    throw std::runtime_error(std::string("velocity average of the energy loss failed at T = ") + formatReal(T) + ": " +
-                             gsl_strerror(status) + ".");
+    throw std::runtime_error(std::string("velocity average of the energy loss failed at T = ") +
+                             formatReal(T) + ": " + gsl_strerror(status) + ".");
   return result;
 }
 
@@ -154,21 +164,24 @@ double coolingRate(const RestitutionFunction& e, double phi, double T) {
   return -enskogCollisionFrequency(phi, T) * T * energyLossFactor(e, T) / 3.0;
 }
 
-std::vector<CoolingSample> solveCooling(const RestitutionFunction& e, const std::vector<double>& times,
-                                        const CoolingOptions& o) {
+std::vector<CoolingSample> solveCooling(const RestitutionFunction& e,
+                                        const std::vector<double>& times, const CoolingOptions& o) {
   namespace odeint = boost::numeric::odeint;
   validateFillingFraction(o.phi);
   if (!(o.T0 > 0.0) || !std::isfinite(o.T0))
-    throw std::invalid_argument("cooling requires a positive, finite initial temperature T0 (got " + formatReal(o.T0) + ").");
+    throw std::invalid_argument("cooling requires a positive, finite initial temperature T0 (got " +
+                                formatReal(o.T0) + ").");
   if (!(o.rtol > 0.0 && o.rtol < 1.0) || !(o.atol > 0.0 && o.atol < 1.0))
-    throw std::invalid_argument("cooling tolerances rtol and atol must lie in (0, 1) (got rtol = " + formatReal(o.rtol) +
-                                ", atol = " + formatReal(o.atol) + ").");
-  if (!e) throw std::invalid_argument("cooling requires a restitution function (got an empty one).");
+    throw std::invalid_argument("cooling tolerances rtol and atol must lie in (0, 1) (got rtol = " +
+                                formatReal(o.rtol) + ", atol = " + formatReal(o.atol) + ").");
+  if (!e)
+    throw std::invalid_argument("cooling requires a restitution function (got an empty one).");
   for (std::size_t k = 0; k < times.size(); ++k) {
     checkTime(times[k]);
     if (k > 0 && times[k] < times[k - 1])
-      throw std::invalid_argument("cooling output times must not decrease (got " + formatReal(times[k - 1]) + " then " +
-                                  formatReal(times[k]) + ").");
+      throw std::invalid_argument("cooling output times must not decrease (got " +
+                                  formatReal(times[k - 1]) + " then " + formatReal(times[k]) +
+                                  ").");
   }
   std::vector<CoolingSample> out;
   if (times.empty()) return out;
@@ -212,7 +225,8 @@ std::vector<CoolingSample> solveCooling(const RestitutionFunction& e, const std:
   return out;
 }
 
-std::vector<CoolingSample> solveViscoelasticCooling(const ContactParams& params, const std::vector<double>& times,
+std::vector<CoolingSample> solveViscoelasticCooling(const ContactParams& params,
+                                                    const std::vector<double>& times,
                                                     const CoolingOptions& options) {
   // The velocity average reaches g = 20 sqrt(T0) (y = 10 in energyLossFactor); extend the table
   // beyond the default b_max = 20 if that impact speed needs it (strong damping).
@@ -226,7 +240,8 @@ std::vector<CoolingSample> solveViscoelasticCooling(const ContactParams& params,
 // Small-damping closed form. To first order, 1 - e^2 = 2 (1 - e) = 2 C1 b1 g^{1/5}, and with
 // <g^p>_P = (4T)^{p/2} Gamma(1 + p/2):
 //   L(T) = 2 C1 b1 <g^{11/5}> / (4T) = 2 C1 b1 (4T)^{1/10} Gamma(21/10),
-//   dT/dt = -omega0 sqrt(T/T0) T L / 3 = -(2/3) 4^{1/10} Gamma(21/10) C1 b1 omega0 T0^{-1/2} T^{8/5}.
+//   dT/dt = -omega0 sqrt(T/T0) T L / 3 = -(2/3) 4^{1/10} Gamma(21/10) C1 b1 omega0 T0^{-1/2}
+//   T^{8/5}.
 // Separating, T^{-3/5} - T0^{-3/5} = (3/5)(2/3) 4^{1/10} Gamma(21/10) C1 b1 omega0 T0^{-1/2} t, so
 // T = T0 (1 + t/tau0')^{-5/3} with 1/tau0' = (2/5) 4^{1/10} Gamma(21/10) C1 b1 T0^{1/10} omega0
 // = (16/5) q0 delta omega0, q0 = 2^{1/5} Gamma(21/10) / 8, delta = C1 b1 T0^{1/10}
@@ -236,16 +251,20 @@ std::vector<CoolingSample> solveViscoelasticCooling(const ContactParams& params,
 double viscoelasticCoolingTau0(const ContactParams& params, double phi, double T0) {
   validateContactParams(params);
   if (!(T0 > 0.0) || !std::isfinite(T0))
-    throw std::invalid_argument("viscoelastic cooling requires a positive initial temperature T0 (got " + formatReal(T0) + ").");
+    throw std::invalid_argument(
+        "viscoelastic cooling requires a positive initial temperature T0 (got " + formatReal(T0) +
+        ").");
   if (params.D == 0.0)
-    throw std::invalid_argument("viscoelastic cooling law requires a positive dissipative constant D (got 0: no cooling).");
+    throw std::invalid_argument(
+        "viscoelastic cooling law requires a positive dissipative constant D (got 0: no cooling).");
   const double b1 = params.D * std::pow(M_EFF, -0.4) * std::pow(params.E, -0.6);
   const double delta = RESTITUTION_C1 * b1 * std::pow(T0, 0.1);
   const double q0 = std::pow(2.0, 0.2) * std::tgamma(2.1) / 8.0;
   return 1.0 / (16.0 / 5.0 * q0 * delta * enskogCollisionFrequency(phi, T0));
 }
 
-double viscoelasticCoolingTemperature(double t, const ContactParams& params, double phi, double T0) {
+double viscoelasticCoolingTemperature(double t, const ContactParams& params, double phi,
+                                      double T0) {
   checkTime(t);
   return T0 * std::pow(1.0 + t / viscoelasticCoolingTau0(params, phi, T0), -5.0 / 3.0);
 }

@@ -62,10 +62,10 @@ double coolingRate(const RestitutionFunction& e, double phi, double T);
 
 /// Options of the cooling ODE.
 struct CoolingOptions {
-  double phi = 0.076;     ///< filling fraction, 0 < phi < 0.74
-  double T0 = 1.0;        ///< temperature at t = 0 (units T0; > 0)
-  double rtol = 1e-10;    ///< relative tolerance of the Odeint Dormand-Prince stepper on ln T
-  double atol = 1e-12;    ///< absolute tolerance on ln T
+  double phi = 0.076;        ///< filling fraction, 0 < phi < 0.74
+  double T0 = 1.0;           ///< temperature at t = 0 (units T0; > 0)
+  double rtol = 1e-10;       ///< relative tolerance of the Odeint Dormand-Prince stepper on ln T
+  double atol = 1e-12;       ///< absolute tolerance on ln T
   double quad_rtol = 1e-12;  ///< relative tolerance of the velocity average L(T)
 };
 
@@ -82,11 +82,13 @@ struct CoolingSample {
 /// Dormand-Prince in the variables ln T against ln(1 + t), in which both Haff's t^{-2} and the
 /// viscoelastic t^{-5/3} tails are straight lines) and returns T at the requested times (>= 0,
 /// non-decreasing, finite; std::invalid_argument otherwise).
-std::vector<CoolingSample> solveCooling(const RestitutionFunction& e, const std::vector<double>& times,
+std::vector<CoolingSample> solveCooling(const RestitutionFunction& e,
+                                        const std::vector<double>& times,
                                         const CoolingOptions& options = {});
 
 /// Viscoelastic cooling: solveCooling with e(g) from a RestitutionTable of the contact params.
-std::vector<CoolingSample> solveViscoelasticCooling(const ContactParams& params, const std::vector<double>& times,
+std::vector<CoolingSample> solveViscoelasticCooling(const ContactParams& params,
+                                                    const std::vector<double>& times,
                                                     const CoolingOptions& options = {});
 
 /// Characteristic time tau0' of the small-damping viscoelastic cooling law
@@ -103,6 +105,7 @@ double viscoelasticCoolingTau0(const ContactParams& params, double phi, double T
 /// delta << 1; its large-t form T0 (t / tau0')^{-5/3} is the exact asymptote of the
 /// viscoelastic cooling ODE for any damping (e -> 1 as T -> 0), approached with relative
 /// corrections of order T^{1/10} ~ t^{-1/6}.
-double viscoelasticCoolingTemperature(double t, const ContactParams& params, double phi, double T0 = 1.0);
+double viscoelasticCoolingTemperature(double t, const ContactParams& params, double phi,
+                                      double T0 = 1.0);
 
 }  // namespace granagg::meanfield

@@ -12,9 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include <gsl/gsl_spline.h>
 #include <boost/math/tools/toms748_solve.hpp>
 #include <boost/numeric/odeint.hpp>
-#include <gsl/gsl_spline.h>
 
 #include "common/Csv.h"
 
@@ -24,18 +24,22 @@ using common::formatReal;
 
 void validateContactParams(const ContactParams& p) {
   if (!(p.E > 0.0) || !std::isfinite(p.E))
-    throw std::invalid_argument("viscoelastic contact requires the elastic constant E to be positive and finite (got " +
-                                formatReal(p.E) + ").");
+    throw std::invalid_argument(
+        "viscoelastic contact requires the elastic constant E to be positive and finite (got " +
+        formatReal(p.E) + ").");
   if (!(p.D >= 0.0) || !std::isfinite(p.D))
-    throw std::invalid_argument("viscoelastic contact requires the dissipative constant D to be non-negative and finite (got " +
-                                formatReal(p.D) + ").");
+    throw std::invalid_argument(
+        "viscoelastic contact requires the dissipative constant D to be non-negative and finite "
+        "(got " +
+        formatReal(p.D) + ").");
 }
 
 namespace {
 
 void validateOptions(const RestitutionOptions& o) {
   if (!(o.tolerance >= 1e-15 && o.tolerance <= 1e-3))
-    throw std::invalid_argument("restitution tolerance must lie in [1e-15, 1e-3] (got " + formatReal(o.tolerance) + ").");
+    throw std::invalid_argument("restitution tolerance must lie in [1e-15, 1e-3] (got " +
+                                formatReal(o.tolerance) + ").");
   if (!(o.max_scaled_time > 0.0) || !std::isfinite(o.max_scaled_time))
     throw std::invalid_argument("restitution max_scaled_time must be positive and finite (got " +
                                 formatReal(o.max_scaled_time) + ").");
@@ -64,8 +68,8 @@ double bracketRoot(F f, double a, double c, double fa, double fc) {
   if (fa == 0.0) return a;
   if (fc == 0.0) return c;
   std::uintmax_t iterations = 200;
-  const auto r = boost::math::tools::toms748_solve(f, a, c, fa, fc, boost::math::tools::eps_tolerance<double>(52),
-                                                   iterations);
+  const auto r = boost::math::tools::toms748_solve(
+      f, a, c, fa, fc, boost::math::tools::eps_tolerance<double>(52), iterations);
   return 0.5 * (r.first + r.second);
 }
 
@@ -74,7 +78,9 @@ double bracketRoot(F f, double a, double c, double fa, double fc) {
 CollisionResult collideScaled(double b, bool clamped, const RestitutionOptions& options) {
   namespace odeint = boost::numeric::odeint;
   if (!(b >= 0.0) || !std::isfinite(b))
-    throw std::invalid_argument("restitution scaling parameter b must be non-negative and finite (got " + formatReal(b) + ").");
+    throw std::invalid_argument(
+        "restitution scaling parameter b must be non-negative and finite (got " + formatReal(b) +
+        ").");
   validateOptions(options);
 
   // Start off the singular point x = 0 (where x^{1/2} is not Lipschitz) on the short-time series
@@ -88,11 +94,13 @@ CollisionResult collideScaled(double b, bool clamped, const RestitutionOptions& 
   // e is unchanged when the tolerance is tightened.
   const double s0 = 1e-4 / std::max(1.0, b);
   const double s12 = std::sqrt(s0), s32 = s0 * s12, s52 = s32 * s0, s72 = s52 * s0;
-  State y{s0 - (4.0 / 15.0) * b * s52 - (4.0 / 35.0) * s72 + (1.0 / 15.0) * b * b * s0 * s0 * s0 * s0,
-          1.0 - (2.0 / 3.0) * b * s32 - 0.4 * s52 + (4.0 / 15.0) * b * b * s0 * s0 * s0};
+  State y{
+      s0 - (4.0 / 15.0) * b * s52 - (4.0 / 35.0) * s72 + (1.0 / 15.0) * b * b * s0 * s0 * s0 * s0,
+      1.0 - (2.0 / 3.0) * b * s32 - 0.4 * s52 + (4.0 / 15.0) * b * b * s0 * s0 * s0};
 
   const ScaledContact rhs{b};
-  auto stepper = odeint::make_dense_output(options.tolerance, options.tolerance, odeint::runge_kutta_dopri5<State>());
+  auto stepper = odeint::make_dense_output(options.tolerance, options.tolerance,
+                                           odeint::runge_kutta_dopri5<State>());
   stepper.initialize(y, s0, s0);
 
   // Event functions on the dense output: x' (maximum compression), x (overlap closes) and
@@ -113,17 +121,20 @@ CollisionResult collideScaled(double b, bool clamped, const RestitutionOptions& 
     const State& ya = stepper.previous_state();
     const State& yc = stepper.current_state();
     if (!std::isfinite(yc[0]) || !std::isfinite(yc[1]))
-      throw std::runtime_error("restitution integration produced a non-finite state at b = " + formatReal(b) + ".");
+      throw std::runtime_error(
+          "restitution integration produced a non-finite state at b = " + formatReal(b) + ".");
 
     if (!receding && yc[1] <= 0.0) {
       // Maximum compression inside this step: x' crosses zero.
-      const double sm = bracketRoot([&](double s) { return component(s, 1, b); }, sa, sc, ya[1], yc[1]);
+      const double sm =
+          bracketRoot([&](double s) { return component(s, 1, b); }, sa, sc, ya[1], yc[1]);
       r.max_overlap = component(sm, 0, b);
       receding = true;
     } else if (receding && yc[1] > 0.0) {
       // Only the unclamped attractive tail can turn the separation round.
-      throw std::runtime_error("unclamped contact is captured by its attractive force at b = " + formatReal(b) +
-                               ": the overlap never closes (use the clamped force).");
+      throw std::runtime_error(
+          "unclamped contact is captured by its attractive force at b = " + formatReal(b) +
+          ": the overlap never closes (use the clamped force).");
     }
 
     if (receding && clamped) {
@@ -142,19 +153,23 @@ CollisionResult collideScaled(double b, bool clamped, const RestitutionOptions& 
       }
     }
     if (receding && !clamped && yc[0] <= 0.0) {
-      const double se = bracketRoot([&](double s) { return component(s, 0, b); }, sa, sc, ya[0], yc[0]);
+      const double se =
+          bracketRoot([&](double s) { return component(s, 0, b); }, sa, sc, ya[0], yc[0]);
       r.restitution = -component(se, 1, b);
       r.release_time = se;
       r.contact_time = se;
       return r;
     }
     if (sc > options.max_scaled_time)
-      throw std::runtime_error("viscoelastic contact at b = " + formatReal(b) + " has not ended after " +
-                               formatReal(options.max_scaled_time) + " scaled time units.");
+      throw std::runtime_error("viscoelastic contact at b = " + formatReal(b) +
+                               " has not ended after " + formatReal(options.max_scaled_time) +
+                               " scaled time units.");
   }
 }
 
-double seriesRestitutionScaled(double b) { return 1.0 - RESTITUTION_C1 * b + RESTITUTION_C2 * b * b; }
+double seriesRestitutionScaled(double b) {
+  return 1.0 - RESTITUTION_C1 * b + RESTITUTION_C2 * b * b;
+}
 
 // First-order coefficient, rederived: along the elastic trajectory (1/2) m_eff xi'^2 +
 // (2/5) E xi^{5/2} = (1/2) m_eff v^2 the dissipated energy is
@@ -172,7 +187,8 @@ Restitution::Restitution(const ContactParams& params, const RestitutionOptions& 
 
 void Restitution::checkSpeed(double v) const {
   if (!(v > 0.0) || !std::isfinite(v))
-    throw std::invalid_argument("restitution requires a positive, finite impact speed v (got " + formatReal(v) + ").");
+    throw std::invalid_argument("restitution requires a positive, finite impact speed v (got " +
+                                formatReal(v) + ").");
 }
 
 double Restitution::scalingParameter(double v) const {
@@ -199,7 +215,9 @@ CollisionResult Restitution::collide(double v) const {
   return r;
 }
 
-double Restitution::seriesRestitution(double v) const { return seriesRestitutionScaled(scalingParameter(v)); }
+double Restitution::seriesRestitution(double v) const {
+  return seriesRestitutionScaled(scalingParameter(v));
+}
 
 double Restitution::elasticContactTime(double v) const {
   checkSpeed(v);
@@ -220,15 +238,17 @@ struct RestitutionTable::Spline {
   Spline& operator=(const Spline&) = delete;
 };
 
-RestitutionTable::RestitutionTable(const ContactParams& params, double b_min, double b_max, int points,
-                                   const RestitutionOptions& options)
+RestitutionTable::RestitutionTable(const ContactParams& params, double b_min, double b_max,
+                                   int points, const RestitutionOptions& options)
     : m_params(params), m_options(options), m_b_min(b_min), m_b_max(b_max) {
   validateContactParams(m_params);
   validateOptions(m_options);
   if (!(b_min > 0.0) || !(b_max > b_min) || !std::isfinite(b_max))
-    throw std::invalid_argument("restitution table requires 0 < b_min < b_max < inf (got b_min = " + formatReal(b_min) +
-                                ", b_max = " + formatReal(b_max) + ").");
-  if (points < 8) throw std::invalid_argument("restitution table requires at least 8 points (got " + std::to_string(points) + ").");
+    throw std::invalid_argument("restitution table requires 0 < b_min < b_max < inf (got b_min = " +
+                                formatReal(b_min) + ", b_max = " + formatReal(b_max) + ").");
+  if (points < 8)
+    throw std::invalid_argument("restitution table requires at least 8 points (got " +
+                                std::to_string(points) + ").");
   m_b1 = m_params.D * std::pow(M_EFF, -0.4) * std::pow(m_params.E, -0.6);
 
   // Knots uniform in ln b for ln[(1 - e)/b], which is smooth and nearly linear at both ends:
@@ -257,11 +277,14 @@ double RestitutionTable::restitutionScaled(double b) const {
   return 1.0 - b * std::exp(gsl_spline_eval(m_spline->spline, std::log(b), nullptr));
 }
 
-double RestitutionTable::operator()(double v) const { return restitutionScaled(m_b1 * std::pow(v, 0.2)); }
+double RestitutionTable::operator()(double v) const {
+  return restitutionScaled(m_b1 * std::pow(v, 0.2));
+}
 
 double RestitutionTable::restitution(double v) const {
   if (!(v > 0.0) || !std::isfinite(v))
-    throw std::invalid_argument("restitution requires a positive, finite impact speed v (got " + formatReal(v) + ").");
+    throw std::invalid_argument("restitution requires a positive, finite impact speed v (got " +
+                                formatReal(v) + ").");
   return (*this)(v);
 }
 

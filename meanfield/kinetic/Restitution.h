@@ -143,8 +143,9 @@ class RestitutionTable {
  public:
   /// Builds the table: `points` direct integrations for b from b_min to b_max.
   /// Throws std::invalid_argument for bad parameters, 0 < b_min < b_max, points >= 8.
-  explicit RestitutionTable(const ContactParams& params = {}, double b_min = 1e-6, double b_max = 20.0,
-                            int points = 600, const RestitutionOptions& options = {});
+  explicit RestitutionTable(const ContactParams& params = {}, double b_min = 1e-6,
+                            double b_max = 20.0, int points = 600,
+                            const RestitutionOptions& options = {});
 
   /// e(v) from the table, dimensionless; v in sqrt(T0/m), v > 0 (std::invalid_argument).
   double restitution(double v) const;

@@ -46,8 +46,8 @@ struct CvodeSolver::Impl {
   SUNLinearSolver LS = nullptr;
   SUNNonlinearSolver NLS = nullptr;
   void* mem = nullptr;
-  double t_last = 0.0;       // time of the state held in y
-  Stats accumulated;         // counters of integrations before the last reset()
+  double t_last = 0.0;  // time of the state held in y
+  Stats accumulated;    // counters of integrations before the last reset()
 
   ~Impl() {
     // Reverse order of creation (CVODE memory references LS, NLS, A and the vectors).
@@ -130,8 +130,8 @@ extern "C" int cvodeRhsTrampoline(realtype t, N_Vector y, N_Vector ydot, void* u
   }
 }
 
-extern "C" int cvodePrecSetup(realtype t, N_Vector y, N_Vector, booleantype jok, booleantype* jcurPtr, realtype,
-                              void* user_data) {
+extern "C" int cvodePrecSetup(realtype t, N_Vector y, N_Vector, booleantype jok,
+                              booleantype* jcurPtr, realtype, void* user_data) {
   auto* impl = static_cast<CallbackData*>(user_data);
   if (jok) {  // CVODE allows reusing the stored Jacobian data
     *jcurPtr = SUNFALSE;
@@ -148,8 +148,8 @@ extern "C" int cvodePrecSetup(realtype t, N_Vector y, N_Vector, booleantype jok,
   }
 }
 
-extern "C" int cvodePrecSolve(realtype, N_Vector, N_Vector, N_Vector r, N_Vector z, realtype gamma, realtype, int,
-                              void* user_data) {
+extern "C" int cvodePrecSolve(realtype, N_Vector, N_Vector, N_Vector r, N_Vector z, realtype gamma,
+                              realtype, int, void* user_data) {
   auto* impl = static_cast<CallbackData*>(user_data);
   const double* rv = N_VGetArrayPointer(r);
   double* zv = N_VGetArrayPointer(z);
@@ -158,8 +158,8 @@ extern "C" int cvodePrecSolve(realtype, N_Vector, N_Vector, N_Vector r, N_Vector
   return 0;
 }
 
-extern "C" void cvodeErrorHandler(int error_code, const char* module, const char* function, char* msg,
-                                  void* user_data) {
+extern "C" void cvodeErrorHandler(int error_code, const char* module, const char* function,
+                                  char* msg, void* user_data) {
   auto* impl = static_cast<CallbackData*>(user_data);
   if (error_code == CV_WARNING) return;  // warnings (e.g. t + h = t) are not errors; stay quiet
   impl->last_message = std::string(module ? module : "") + "/" + (function ? function : "") + ": " +
@@ -178,36 +178,48 @@ CvodeSolver::Method CvodeSolver::parseMethod(const std::string& name) {
 
 std::string CvodeSolver::methodName() const {
   switch (m_impl->method) {
-    case Method::Adams: return "adams";
-    case Method::BdfGmres: return "bdf-gmres";
-    case Method::BdfDense: return "bdf-dense";
+    case Method::Adams:
+      return "adams";
+    case Method::BdfGmres:
+      return "bdf-gmres";
+    case Method::BdfDense:
+      return "bdf-dense";
   }
   return "?";
 }
 
 CvodeSolver::CvodeSolver(int n, Rhs rhs, const Options& options, double t0, const double* y0)
     : m_impl(std::make_unique<Impl>()), m_n(n) {
-  if (n < 1) throw std::invalid_argument("CvodeSolver requires at least one unknown (got N = " + std::to_string(n) + ").");
+  if (n < 1)
+    throw std::invalid_argument(
+        "CvodeSolver requires at least one unknown (got N = " + std::to_string(n) + ").");
   if (!rhs) throw std::invalid_argument("CvodeSolver requires a right-hand side function.");
   if (!y0) throw std::invalid_argument("CvodeSolver requires an initial state y0.");
   if (!(options.rtol > 0.0) || !std::isfinite(options.rtol))
-    throw std::invalid_argument("CVODE rtol must be positive and finite (got " + common::formatReal(options.rtol) + ").");
+    throw std::invalid_argument("CVODE rtol must be positive and finite (got " +
+                                common::formatReal(options.rtol) + ").");
   if (options.atol_vector.empty()) {
     if (!(options.atol > 0.0) || !std::isfinite(options.atol))
-      throw std::invalid_argument("CVODE atol must be positive and finite (got " + common::formatReal(options.atol) + ").");
+      throw std::invalid_argument("CVODE atol must be positive and finite (got " +
+                                  common::formatReal(options.atol) + ").");
   } else {
     if (static_cast<int>(options.atol_vector.size()) != n)
-      throw std::invalid_argument("CVODE atol_vector must have N = " + std::to_string(n) + " entries (got " +
-                                  std::to_string(options.atol_vector.size()) + ").");
+      throw std::invalid_argument("CVODE atol_vector must have N = " + std::to_string(n) +
+                                  " entries (got " + std::to_string(options.atol_vector.size()) +
+                                  ").");
     for (double a : options.atol_vector)
       if (!(a > 0.0) || !std::isfinite(a))
-        throw std::invalid_argument("CVODE atol_vector entries must be positive and finite (got " + common::formatReal(a) + ").");
+        throw std::invalid_argument("CVODE atol_vector entries must be positive and finite (got " +
+                                    common::formatReal(a) + ").");
   }
   if (options.max_steps <= 0)
-    throw std::invalid_argument("CVODE max_steps must be positive (got " + std::to_string(options.max_steps) + ").");
-  if (options.max_order < 0 || options.max_step < 0.0 || options.initial_step < 0.0 || options.krylov_dim < 0 ||
-      options.anderson_depth < 0)
-    throw std::invalid_argument("CVODE max_order, max_step, initial_step, krylov_dim and anderson_depth must not be negative.");
+    throw std::invalid_argument("CVODE max_steps must be positive (got " +
+                                std::to_string(options.max_steps) + ").");
+  if (options.max_order < 0 || options.max_step < 0.0 || options.initial_step < 0.0 ||
+      options.krylov_dim < 0 || options.anderson_depth < 0)
+    throw std::invalid_argument(
+        "CVODE max_order, max_step, initial_step, krylov_dim and anderson_depth must not be "
+        "negative.");
 
   Impl& d = *m_impl;
   d.cb.rhs = std::move(rhs);
@@ -216,10 +228,13 @@ CvodeSolver::CvodeSolver(int n, Rhs rhs, const Options& options, double t0, cons
   d.n = n;
 
   // SUNDIALS 6.x: every object belongs to a context (no MPI communicator: NULL).
-  if (SUNContext_Create(nullptr, &d.ctx) != 0 || !d.ctx) throw std::runtime_error("SUNContext_Create failed.");
+  if (SUNContext_Create(nullptr, &d.ctx) != 0 || !d.ctx)
+    throw std::runtime_error("SUNContext_Create failed.");
   d.y = N_VNew_Serial(n, d.ctx);
   d.work = N_VNew_Serial(n, d.ctx);
-  if (!d.y || !d.work) throw std::runtime_error("CVODE: could not allocate N_Vector of length " + std::to_string(n) + ".");
+  if (!d.y || !d.work)
+    throw std::runtime_error("CVODE: could not allocate N_Vector of length " + std::to_string(n) +
+                             ".");
   std::copy(y0, y0 + n, N_VGetArrayPointer(d.y));
 
   d.mem = CVodeCreate(d.method == Method::Adams ? CV_ADAMS : CV_BDF, d.ctx);
@@ -237,7 +252,8 @@ CvodeSolver::CvodeSolver(int n, Rhs rhs, const Options& options, double t0, cons
   d.check(CVodeSetMaxNumSteps(d.mem, options.max_steps), "CVodeSetMaxNumSteps");
   if (options.max_order > 0) d.check(CVodeSetMaxOrd(d.mem, options.max_order), "CVodeSetMaxOrd");
   if (options.max_step > 0.0) d.check(CVodeSetMaxStep(d.mem, options.max_step), "CVodeSetMaxStep");
-  if (options.initial_step > 0.0) d.check(CVodeSetInitStep(d.mem, options.initial_step), "CVodeSetInitStep");
+  if (options.initial_step > 0.0)
+    d.check(CVodeSetInitStep(d.mem, options.initial_step), "CVodeSetInitStep");
 
   switch (d.method) {
     case Method::Adams:
@@ -249,14 +265,15 @@ CvodeSolver::CvodeSolver(int n, Rhs rhs, const Options& options, double t0, cons
     case Method::BdfGmres:
       // Newton (CVODE's default nonlinear solver) with matrix-free GMRES; left-preconditioned
       // with the Jacobian diagonal when the caller provides it.
-      d.LS = SUNLinSol_SPGMR(d.y, options.jacobian_diagonal ? SUN_PREC_LEFT : SUN_PREC_NONE, options.krylov_dim,
-                             d.ctx);
+      d.LS = SUNLinSol_SPGMR(d.y, options.jacobian_diagonal ? SUN_PREC_LEFT : SUN_PREC_NONE,
+                             options.krylov_dim, d.ctx);
       if (!d.LS) throw std::runtime_error("SUNLinSol_SPGMR failed.");
       d.check(CVodeSetLinearSolver(d.mem, d.LS, nullptr), "CVodeSetLinearSolver");
       if (options.jacobian_diagonal) {
         d.cb.jacobian_diagonal = options.jacobian_diagonal;
         d.cb.jdiag.assign(n, 0.0);
-        d.check(CVodeSetPreconditioner(d.mem, cvodePrecSetup, cvodePrecSolve), "CVodeSetPreconditioner");
+        d.check(CVodeSetPreconditioner(d.mem, cvodePrecSetup, cvodePrecSolve),
+                "CVodeSetPreconditioner");
       }
       break;
     case Method::BdfDense:
@@ -313,10 +330,14 @@ void CvodeSolver::interpolate(double t, double* out, int k) const {
   std::copy(N_VGetArrayPointer(d.work), N_VGetArrayPointer(d.work) + m_n, out);
 }
 
-void CvodeSolver::setStopTime(double tstop) { m_impl->check(CVodeSetStopTime(m_impl->mem, tstop), "CVodeSetStopTime"); }
+void CvodeSolver::setStopTime(double tstop) {
+  m_impl->check(CVodeSetStopTime(m_impl->mem, tstop), "CVodeSetStopTime");
+}
 
 void CvodeSolver::setMaxStep(double hmax) {
-  if (hmax < 0.0) throw std::invalid_argument("CVODE max_step must not be negative (got " + common::formatReal(hmax) + ").");
+  if (hmax < 0.0)
+    throw std::invalid_argument("CVODE max_step must not be negative (got " +
+                                common::formatReal(hmax) + ").");
   m_impl->check(CVodeSetMaxStep(m_impl->mem, hmax), "CVodeSetMaxStep");
 }
 

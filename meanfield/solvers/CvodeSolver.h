@@ -17,9 +17,11 @@
 /// exception, stores it and returns -1 (unrecoverable) — or 1 (recoverable: CVODE retries with a
 /// smaller step) for CvodeRecoverableError; the exception is rethrown once CVode returns
 /// (Cantera #119, deal.II's callback policy). CVODE failures throw std::runtime_error whose message
-/// carries CVodeGetReturnFlagName(flag) and CVODE's own error text. SUNDIALS never prints to stderr.
+/// carries CVodeGetReturnFlagName(flag) and CVODE's own error text. SUNDIALS never prints to
+/// stderr.
 ///
-/// Version-specific calls (SUNContext_Create(NULL, &ctx) of SUNDIALS 6) live in CvodeSolver.cpp only.
+/// Version-specific calls (SUNContext_Create(NULL, &ctx) of SUNDIALS 6) live in CvodeSolver.cpp
+/// only.
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -71,12 +73,12 @@ class CvodeSolver {
   /// Cost counters since construction (summed across reset() calls).
   struct Stats {
     long steps = 0;
-    long rhs_evaluations = 0;     ///< including those for difference-quotient Jacobians
-    long linear_iterations = 0;   ///< GMRES iterations (BdfGmres)
+    long rhs_evaluations = 0;    ///< including those for difference-quotient Jacobians
+    long linear_iterations = 0;  ///< GMRES iterations (BdfGmres)
     long nonlinear_iterations = 0;
     long nonlinear_failures = 0;  ///< nonlinear-solver convergence failures
     long error_test_failures = 0;
-    double last_step = 0.0;       ///< size of the last internal step (time units)
+    double last_step = 0.0;  ///< size of the last internal step (time units)
   };
 
   /// Sets up CVODE for N >= 1 unknowns starting from y(t0) = y0[0..N). Throws

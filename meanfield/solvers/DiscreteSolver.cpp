@@ -16,19 +16,26 @@ namespace granagg::meanfield {
 namespace {
 
 void validate(const DiscreteOptions& o) {
-  if (o.times.empty()) throw std::invalid_argument("the discrete solver needs at least one output time.");
+  if (o.times.empty())
+    throw std::invalid_argument("the discrete solver needs at least one output time.");
   for (std::size_t i = 0; i < o.times.size(); ++i) {
     if (!(o.times[i] > 0.0) || !std::isfinite(o.times[i]))
-      throw std::invalid_argument("output times must be positive and finite (got " + common::formatReal(o.times[i]) + ").");
-    if (i && !(o.times[i] > o.times[i - 1])) throw std::invalid_argument("output times must increase strictly.");
+      throw std::invalid_argument("output times must be positive and finite (got " +
+                                  common::formatReal(o.times[i]) + ").");
+    if (i && !(o.times[i] > o.times[i - 1]))
+      throw std::invalid_argument("output times must increase strictly.");
   }
-  if (o.max_size < 2) throw std::invalid_argument("the largest size M must be at least 2 (got " + std::to_string(o.max_size) + ").");
+  if (o.max_size < 2)
+    throw std::invalid_argument("the largest size M must be at least 2 (got " +
+                                std::to_string(o.max_size) + ").");
   if (o.initial_size < 0) throw std::invalid_argument("initial_size must be >= 0.");
   if (!(o.range_factor >= 4.0))
-    throw std::invalid_argument("range_factor must be at least 4 (got " + common::formatReal(o.range_factor) + ").");
+    throw std::invalid_argument("range_factor must be at least 4 (got " +
+                                common::formatReal(o.range_factor) + ").");
   if (!(o.rtol > 0.0 && o.rtol < 1.0)) throw std::invalid_argument("rtol must lie in (0, 1).");
   if (!(o.atol > 0.0)) throw std::invalid_argument("atol must be positive.");
-  if (!(o.mass_loss_tolerance > 0.0)) throw std::invalid_argument("mass_loss_tolerance must be positive.");
+  if (!(o.mass_loss_tolerance > 0.0))
+    throw std::invalid_argument("mass_loss_tolerance must be positive.");
   if (o.snapshot_max_size < 0) throw std::invalid_argument("snapshot_max_size must be >= 0.");
 }
 
@@ -56,22 +63,26 @@ void addStats(SolveStats& acc, const CvodeSolver::Stats& s) {
 
 }  // namespace
 
-SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o, const std::vector<double>* initial) {
+SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o,
+                         const std::vector<double>* initial) {
   validate(o);
   const auto wall0 = std::chrono::steady_clock::now();
   std::vector<double> n0 = initial ? *initial : std::vector<double>{1.0};
   if (n0.empty()) throw std::invalid_argument("the initial distribution is empty.");
   for (double v : n0)
-    if (!(v >= 0.0) || !std::isfinite(v)) throw std::invalid_argument("initial number densities must be >= 0 and finite.");
+    if (!(v >= 0.0) || !std::isfinite(v))
+      throw std::invalid_argument("initial number densities must be >= 0 and finite.");
   if (static_cast<int>(n0.size()) > o.max_size)
-    throw std::invalid_argument("the initial distribution has sizes up to " + std::to_string(n0.size()) +
-                                ", beyond the largest size M = " + std::to_string(o.max_size) + ".");
+    throw std::invalid_argument(
+        "the initial distribution has sizes up to " + std::to_string(n0.size()) +
+        ", beyond the largest size M = " + std::to_string(o.max_size) + ".");
   const double M1_0 = moments(n0.data(), static_cast<int>(n0.size())).M1;
   if (!(M1_0 > 0.0)) throw std::invalid_argument("the initial distribution has no mass.");
 
   int M = o.max_size;
   if (o.grow) {
-    const int want = o.initial_size > 0 ? o.initial_size : std::max(128, 4 * static_cast<int>(n0.size()));
+    const int want =
+        o.initial_size > 0 ? o.initial_size : std::max(128, 4 * static_cast<int>(n0.size()));
     M = std::min(o.max_size, std::max(fftFriendlySize(want), static_cast<int>(n0.size())));
   }
 
@@ -88,9 +99,11 @@ SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o, const s
   auto makeSolver = [&](double t0) {
     SmoluchowskiRhs* r = rhs.get();
     if (copt.method == CvodeSolver::Method::BdfGmres)
-      copt.jacobian_diagonal = [r](double, const double* n, double* jd) { r->jacobianDiagonal(n, jd); };
-    return std::make_unique<CvodeSolver>(M, [r](double, const double* n, double* f) { r->evaluate(n, f); }, copt, t0,
-                                         y.data());
+      copt.jacobian_diagonal = [r](double, const double* n, double* jd) {
+        r->jacobianDiagonal(n, jd);
+      };
+    return std::make_unique<CvodeSolver>(
+        M, [r](double, const double* n, double* f) { r->evaluate(n, f); }, copt, t0, y.data());
   };
   auto solver = makeSolver(0.0);
 
@@ -128,15 +141,18 @@ SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o, const s
       }
       if (o.on_sample) o.on_sample(s);
       if (!s.valid && o.stop_on_truncation) {
-        const std::string head = "relative mass loss " + common::formatReal(s.mass_loss) + " at t = " +
-                                 common::formatReal(t) + " exceeds the tolerance " +
-                                 common::formatReal(o.mass_loss_tolerance) + " (S = " + common::formatReal(s.S) + "): ";
-        res.stopped_early =
-            s.mass_loss > 0.0
-                ? head + "the size range M = " + std::to_string(M) +
-                      (M >= o.max_size ? " (the largest allowed; raise --M)" : "") + " truncates the distribution"
-                : head + "mass was gained, an integration error (tighten --rtol, or use --integrator adams, which "
-                         "conserves mass to round-off)";
+        const std::string head = "relative mass loss " + common::formatReal(s.mass_loss) +
+                                 " at t = " + common::formatReal(t) + " exceeds the tolerance " +
+                                 common::formatReal(o.mass_loss_tolerance) +
+                                 " (S = " + common::formatReal(s.S) + "): ";
+        res.stopped_early = s.mass_loss > 0.0
+                                ? head + "the size range M = " + std::to_string(M) +
+                                      (M >= o.max_size ? " (the largest allowed; raise --M)" : "") +
+                                      " truncates the distribution"
+                                : head +
+                                      "mass was gained, an integration error (tighten --rtol, or "
+                                      "use --integrator adams, which "
+                                      "conserves mass to round-off)";
         done = true;
         break;
       }
@@ -151,7 +167,8 @@ SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o, const s
     const Moments m = moments(st, M);
     const double S = m.M2 / m.M1;
     if (S * o.range_factor > M) {
-      const int newM = std::min(o.max_size, fftFriendlySize(static_cast<int>(std::ceil(2.0 * o.range_factor * S))));
+      const int newM = std::min(
+          o.max_size, fftFriendlySize(static_cast<int>(std::ceil(2.0 * o.range_factor * S))));
       y.assign(newM, 0.0);
       std::copy(st, st + M, y.begin());
       addStats(res.stats, solver->stats());
@@ -163,7 +180,8 @@ SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o, const s
     }
   }
   addStats(res.stats, solver->stats());
-  res.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  res.stats.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return res;
 }
 

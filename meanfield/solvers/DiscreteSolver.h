@@ -4,15 +4,16 @@
 /// SUNDIALS CVODE, with an active size range that grows with the mean size.
 ///
 /// Growing range: the solver integrates sizes 1..M_active and enlarges M_active (to about
-/// 2 * range_factor * S (40 S by default), an FFT-friendly length, at most max_size) whenever S > M_active /
-/// range_factor. The scaling distribution decays exponentially in k/S, so with M_active/S >= 20
-/// the mass beyond the range is far below round-off; a truncated grid with M/S below ~12 loses
-/// mass and its local slope collapses (design.md section 4). Each resize restarts CVODE from the
-/// current state (zero-padded), so the history of the multistep method is lost: a few small steps.
+/// 2 * range_factor * S (40 S by default), an FFT-friendly length, at most max_size) whenever S >
+/// M_active / range_factor. The scaling distribution decays exponentially in k/S, so with
+/// M_active/S >= 20 the mass beyond the range is far below round-off; a truncated grid with M/S
+/// below ~12 loses mass and its local slope collapses (design.md section 4). Each resize restarts
+/// CVODE from the current state (zero-padded), so the history of the multistep method is lost: a
+/// few small steps.
 ///
 /// Truncation is detected, never hidden: every output sample carries the relative mass loss
-/// (M1(0) - M1(t)) / M1(0) and is marked invalid when it exceeds mass_loss_tolerance; by default the
-/// solve stops at the first invalid sample (SmolResult::stopped_early says why).
+/// (M1(0) - M1(t)) / M1(0) and is marked invalid when it exceeds mass_loss_tolerance; by default
+/// the solve stops at the first invalid sample (SmolResult::stopped_early says why).
 #include <functional>
 #include <limits>
 #include <string>
@@ -30,7 +31,8 @@ struct DiscreteOptions {
   int max_size = 1 << 21;
   /// First active range; 0 picks max(128, 4 * length of the initial distribution).
   int initial_size = 0;
-  /// Keep M_active >= range_factor * S while max_size allows (false: M_active = max_size throughout).
+  /// Keep M_active >= range_factor * S while max_size allows (false: M_active = max_size
+  /// throughout).
   bool grow = true;
   double range_factor = 20.0;
   /// CVODE relative tolerance and absolute tolerance (the latter relative to M1(0)).

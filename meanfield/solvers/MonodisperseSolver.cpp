@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "common/Csv.h"
@@ -28,14 +28,16 @@ double monodisperseBlowUpTime(const Kernel& kernel, double initial_size) {
   const double lambda = kernel.homogeneity();
   if (lambda <= 1.0) return std::numeric_limits<double>::infinity();
   const double c = kernel(1.0, 1.0);  // K(i, i) = c i^lambda by homogeneity
-  // i^{1-lambda} = i0^{1-lambda} - (lambda - 1) c t reaches zero (design.md section 4; separation of variables)
+  // i^{1-lambda} = i0^{1-lambda} - (lambda - 1) c t reaches zero (design.md section 4; separation
+  // of variables)
   return std::pow(initial_size, 1.0 - lambda) / ((lambda - 1.0) * c);
 }
 
 double monodisperseMeanSize(const Kernel& kernel, double t, double initial_size) {
   checkInitialSize(initial_size);
   if (!(t >= 0.0) || !std::isfinite(t))
-    throw std::invalid_argument("monodisperse time must be finite and >= 0 (got " + common::formatReal(t) + ").");
+    throw std::invalid_argument("monodisperse time must be finite and >= 0 (got " +
+                                common::formatReal(t) + ").");
   const double lambda = kernel.homogeneity();
   const double c = kernel(1.0, 1.0);
   // di/dt = c i^lambda separated: i^{1-lambda} = i0^{1-lambda} + (1 - lambda) c t  (lambda != 1),
@@ -43,8 +45,9 @@ double monodisperseMeanSize(const Kernel& kernel, double t, double initial_size)
   if (lambda == 1.0) return initial_size * std::exp(c * t);
   const double t_star = monodisperseBlowUpTime(kernel, initial_size);
   if (!(t < t_star))
-    throw std::invalid_argument("monodisperse time " + common::formatReal(t) + " is at or beyond the blow-up time " +
-                                common::formatReal(t_star) + " of kernel '" + kernel.name() + "'.");
+    throw std::invalid_argument("monodisperse time " + common::formatReal(t) +
+                                " is at or beyond the blow-up time " + common::formatReal(t_star) +
+                                " of kernel '" + kernel.name() + "'.");
   const double a = 1.0 - lambda;
   const double base = std::pow(initial_size, a) + a * c * t;
   return std::exp(std::log(base) / a);
@@ -56,24 +59,33 @@ SmolResult solveMonodisperse(const Kernel& kernel, const MonodisperseOptions& op
   const auto wall_start = std::chrono::steady_clock::now();
 
   const MonodisperseOptions& o = options;
-  if (o.times.empty()) throw std::invalid_argument("monodisperse solver requires at least one output time (times is empty).");
+  if (o.times.empty())
+    throw std::invalid_argument(
+        "monodisperse solver requires at least one output time (times is empty).");
   for (size_t k = 0; k < o.times.size(); ++k) {
     if (!(o.times[k] > 0.0) || !std::isfinite(o.times[k]))
-      throw std::invalid_argument("monodisperse times must be positive and finite (got " + formatReal(o.times[k]) + ").");
+      throw std::invalid_argument("monodisperse times must be positive and finite (got " +
+                                  formatReal(o.times[k]) + ").");
     if (k > 0 && !(o.times[k] > o.times[k - 1]))
-      throw std::invalid_argument("monodisperse times must increase strictly (got " + formatReal(o.times[k - 1]) +
-                                  " then " + formatReal(o.times[k]) + ").");
+      throw std::invalid_argument("monodisperse times must increase strictly (got " +
+                                  formatReal(o.times[k - 1]) + " then " + formatReal(o.times[k]) +
+                                  ").");
   }
   checkInitialSize(o.initial_size);
   if (!(o.rtol > 0.0) || !std::isfinite(o.rtol))
-    throw std::invalid_argument("monodisperse rtol must be positive and finite (got " + formatReal(o.rtol) + ").");
+    throw std::invalid_argument("monodisperse rtol must be positive and finite (got " +
+                                formatReal(o.rtol) + ").");
   if (!(o.atol > 0.0) || !std::isfinite(o.atol))
-    throw std::invalid_argument("monodisperse atol must be positive and finite (got " + formatReal(o.atol) + ").");
-  if (!(o.s_end > 0.0)) throw std::invalid_argument("monodisperse s_end must be positive (got " + formatReal(o.s_end) + ").");
+    throw std::invalid_argument("monodisperse atol must be positive and finite (got " +
+                                formatReal(o.atol) + ").");
+  if (!(o.s_end > 0.0))
+    throw std::invalid_argument("monodisperse s_end must be positive (got " + formatReal(o.s_end) +
+                                ").");
   const double t_star = monodisperseBlowUpTime(kernel, o.initial_size);
   if (!(o.times.back() < t_star))
-    throw std::invalid_argument("monodisperse times must stay before the blow-up time " + formatReal(t_star) +
-                                " of kernel '" + kernel.name() + "' (got " + formatReal(o.times.back()) + ").");
+    throw std::invalid_argument("monodisperse times must stay before the blow-up time " +
+                                formatReal(t_star) + " of kernel '" + kernel.name() + "' (got " +
+                                formatReal(o.times.back()) + ").");
 
   // u = ln i against s = ln(1 + t): du/ds = (dt/ds) (di/dt) / i = (1 + t) K(i, i) / i.
   using State = std::vector<double>;
@@ -94,7 +106,8 @@ SmolResult solveMonodisperse(const Kernel& kernel, const MonodisperseOptions& op
   for (double tout : o.times) {
     const double s_out = std::log1p(tout);
     if (s_out > s) {
-      result.stats.steps += static_cast<long>(odeint::integrate_adaptive(stepper, system, u, s, s_out, std::min(ds, s_out - s)));
+      result.stats.steps += static_cast<long>(
+          odeint::integrate_adaptive(stepper, system, u, s, s_out, std::min(ds, s_out - s)));
       ds = std::max(ds, 0.1 * (s_out - s));
       s = s_out;
     }
@@ -104,7 +117,7 @@ SmolResult solveMonodisperse(const Kernel& kernel, const MonodisperseOptions& op
     m.S = i;
     m.M0 = 1.0 / i;  // n = M1 / i with M1 = 1
     m.M1 = 1.0;
-    m.M2 = i;        // sum k^2 n_k = i^2 n
+    m.M2 = i;  // sum k^2 n_k = i^2 n
     m.mass_loss = 0.0;
     m.valid = std::isfinite(i);
     m.max_size = i;
@@ -116,7 +129,8 @@ SmolResult solveMonodisperse(const Kernel& kernel, const MonodisperseOptions& op
     if (i >= o.s_end) break;
   }
   result.stats.rhs_evaluations = rhs_evaluations;
-  result.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  result.stats.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;
 }
 

@@ -48,7 +48,8 @@ struct MonodisperseOptions {
 SmolResult solveMonodisperse(const Kernel& kernel, const MonodisperseOptions& options);
 
 /// Closed-form i(t) above, with c = K(1, 1) and lambda = kernel.homogeneity(); t >= 0 (time unit
-/// 1 / K0), initial_size > 0. Throws std::invalid_argument for t < 0, t >= t* or a bad initial size.
+/// 1 / K0), initial_size > 0. Throws std::invalid_argument for t < 0, t >= t* or a bad initial
+/// size.
 double monodisperseMeanSize(const Kernel& kernel, double t, double initial_size = 1.0);
 
 /// Blow-up time t* = i0^{1-lambda} / ((lambda - 1) c) of the monodisperse equation for lambda > 1;

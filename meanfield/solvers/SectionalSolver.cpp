@@ -17,12 +17,14 @@ namespace {
 constexpr int MAX_SECTIONS = 4096;
 
 /// Index of the section pair (j, k), j <= k, in the upper-triangular pair table of I sections.
-inline size_t rowStart(size_t j, size_t I) { return j * I - j * (j - 1) / 2 - j; }  // + k gives (j, k)
+inline size_t rowStart(size_t j, size_t I) {
+  return j * I - j * (j - 1) / 2 - j;
+}  // + k gives (j, k)
 
-/// Splits an aggregate of size v between the two pivots around it (Kumar & Ramkrishna 1996, eq. 27):
-/// returns the lower pivot t with x_t <= v <= x_{t+1} and the share b that goes to x_{t+1}; 1 - b
-/// goes to x_t. Then (1 - b) + b = 1 (number) and (1 - b) x_t + b x_{t+1} = v (mass). t = -1 when v
-/// lies beyond the last pivot.
+/// Splits an aggregate of size v between the two pivots around it (Kumar & Ramkrishna 1996, eq.
+/// 27): returns the lower pivot t with x_t <= v <= x_{t+1} and the share b that goes to x_{t+1}; 1
+/// - b goes to x_t. Then (1 - b) + b = 1 (number) and (1 - b) x_t + b x_{t+1} = v (mass). t = -1
+/// when v lies beyond the last pivot.
 void splitSize(const std::vector<double>& x, double v, int& t, double& b) {
   const int I = static_cast<int>(x.size());
   if (v > x.back()) {
@@ -93,7 +95,8 @@ class FixedPivotRhs {
     double* loss = m_loss.data();
     double* gain_lo = m_gain_lo.data();
     double* gain_hi = m_gain_hi.data();
-    // largest target of the pairs within [lo, hi]: that of (hi, hi), as x_j + x_k grows with j and k
+    // largest target of the pairs within [lo, hi]: that of (hi, hi), as x_j + x_k grows with j and
+    // k
     const int32_t t_hh = m_t[rowStart(hi, m_I) + hi];
     const size_t top = t_hh >= 0 ? static_cast<size_t>(t_hh) : m_I - 2;
     std::fill(loss + lo, loss + hi + 1, 0.0);
@@ -141,29 +144,37 @@ class FixedPivotRhs {
   std::vector<double> m_x;
   size_t m_I;
   double m_cutoff;
-  std::vector<double> m_c;    // (1 - delta_jk / 2) K(x_j, x_k)
-  std::vector<double> m_b;    // share to the upper target pivot (or v for escaped pairs)
-  std::vector<int32_t> m_t;   // lower target pivot, -1 if the aggregate leaves the grid
+  std::vector<double> m_c;   // (1 - delta_jk / 2) K(x_j, x_k)
+  std::vector<double> m_b;   // share to the upper target pivot (or v for escaped pairs)
+  std::vector<int32_t> m_t;  // lower target pivot, -1 if the aggregate leaves the grid
   std::vector<size_t> m_escape;
-  std::vector<double> m_loss, m_gain_lo, m_gain_hi;  // scratch of operator()  // first k >= j whose pair (j, k) leaves the grid (I if none)
+  std::vector<double> m_loss, m_gain_lo, m_gain_hi;  // scratch of operator()  // first k >= j whose
+                                                     // pair (j, k) leaves the grid (I if none)
 };
 
 void validate(const SectionalOptions& o) {
   using common::formatReal;
-  if (o.times.empty()) throw std::invalid_argument("sectional solver requires at least one output time (times is empty).");
+  if (o.times.empty())
+    throw std::invalid_argument(
+        "sectional solver requires at least one output time (times is empty).");
   for (size_t i = 0; i < o.times.size(); ++i) {
     if (!(o.times[i] > 0.0) || !std::isfinite(o.times[i]))
-      throw std::invalid_argument("sectional times must be positive and finite (got " + formatReal(o.times[i]) + ").");
+      throw std::invalid_argument("sectional times must be positive and finite (got " +
+                                  formatReal(o.times[i]) + ").");
     if (i > 0 && !(o.times[i] > o.times[i - 1]))
-      throw std::invalid_argument("sectional times must increase strictly (got " + formatReal(o.times[i - 1]) +
-                                  " then " + formatReal(o.times[i]) + ").");
+      throw std::invalid_argument("sectional times must increase strictly (got " +
+                                  formatReal(o.times[i - 1]) + " then " + formatReal(o.times[i]) +
+                                  ").");
   }
   if (!(o.rtol > 0.0) || !std::isfinite(o.rtol))
-    throw std::invalid_argument("sectional rtol must be positive and finite (got " + formatReal(o.rtol) + ").");
+    throw std::invalid_argument("sectional rtol must be positive and finite (got " +
+                                formatReal(o.rtol) + ").");
   if (!(o.atol > 0.0) || !std::isfinite(o.atol))
-    throw std::invalid_argument("sectional atol must be positive and finite (got " + formatReal(o.atol) + ").");
+    throw std::invalid_argument("sectional atol must be positive and finite (got " +
+                                formatReal(o.atol) + ").");
   if (!(o.s_end > 0.0))
-    throw std::invalid_argument("sectional s_end must be positive (got " + formatReal(o.s_end) + ").");
+    throw std::invalid_argument("sectional s_end must be positive (got " + formatReal(o.s_end) +
+                                ").");
   if (!(o.mass_loss_tolerance >= 0.0))
     throw std::invalid_argument("sectional mass_loss_tolerance must not be negative (got " +
                                 formatReal(o.mass_loss_tolerance) + ").");
@@ -178,15 +189,18 @@ void validate(const SectionalOptions& o) {
 SectionalGrid makeSectionalGrid(double ratio, double max_size) {
   using common::formatReal;
   if (!(ratio > 1.0) || !std::isfinite(ratio))
-    throw std::invalid_argument("sectional ratio must be a finite number > 1 (got " + formatReal(ratio) + ").");
+    throw std::invalid_argument("sectional ratio must be a finite number > 1 (got " +
+                                formatReal(ratio) + ").");
   if (!(max_size >= 2.0) || !std::isfinite(max_size))
-    throw std::invalid_argument("sectional max_size must be finite and >= 2 (got " + formatReal(max_size) + ").");
+    throw std::invalid_argument("sectional max_size must be finite and >= 2 (got " +
+                                formatReal(max_size) + ").");
   SectionalGrid g;
   // integers 1..m with m the first integer whose geometric step m (r - 1) is at least one
   const double m_real = std::ceil(1.0 / (ratio - 1.0) - 1e-12);
   if (m_real > MAX_SECTIONS)
-    throw std::invalid_argument("sectional ratio " + formatReal(ratio) + " is too close to 1: more than " +
-                                std::to_string(MAX_SECTIONS) + " integer pivots.");
+    throw std::invalid_argument("sectional ratio " + formatReal(ratio) +
+                                " is too close to 1: more than " + std::to_string(MAX_SECTIONS) +
+                                " integer pivots.");
   const int m = std::max(1, static_cast<int>(m_real));
   for (int k = 1; k <= m; ++k) {
     g.pivots.push_back(k);
@@ -196,14 +210,16 @@ SectionalGrid makeSectionalGrid(double ratio, double max_size) {
   while (g.pivots.back() < max_size) {
     g.pivots.push_back(g.pivots.back() * ratio);
     if (g.pivots.size() > static_cast<size_t>(MAX_SECTIONS))
-      throw std::invalid_argument("sectional grid with ratio " + formatReal(ratio) + " and max_size " +
-                                  formatReal(max_size) + " needs more than " + std::to_string(MAX_SECTIONS) +
+      throw std::invalid_argument("sectional grid with ratio " + formatReal(ratio) +
+                                  " and max_size " + formatReal(max_size) + " needs more than " +
+                                  std::to_string(MAX_SECTIONS) +
                                   " sections: raise ratio or lower max_size.");
   }
   return g;
 }
 
-SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options, const std::vector<double>* initial) {
+SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
+                          const std::vector<double>* initial) {
   using common::formatReal;
   const auto wall_start = std::chrono::steady_clock::now();
   validate(options);
@@ -218,15 +234,16 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
     for (size_t k = 0; k < initial->size(); ++k) {
       const double n = (*initial)[k];
       if (!(n >= 0.0) || !std::isfinite(n))
-        throw std::invalid_argument("sectional initial n_k must be finite and >= 0 (got " + formatReal(n) +
-                                    " at k = " + std::to_string(k + 1) + ").");
+        throw std::invalid_argument("sectional initial n_k must be finite and >= 0 (got " +
+                                    formatReal(n) + " at k = " + std::to_string(k + 1) + ").");
       if (n == 0.0) continue;
       int t;
       double b;
       splitSize(x, static_cast<double>(k + 1), t, b);
       if (t < 0)
-        throw std::invalid_argument("sectional initial distribution reaches size " + std::to_string(k + 1) +
-                                    ", beyond max_size " + formatReal(options.max_size) + ".");
+        throw std::invalid_argument("sectional initial distribution reaches size " +
+                                    std::to_string(k + 1) + ", beyond max_size " +
+                                    formatReal(options.max_size) + ".");
       y[t] += (1.0 - b) * n;
       y[t + 1] += b * n;
     }
@@ -240,15 +257,17 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
   }
   if (!(M1_0 > 0.0)) throw std::invalid_argument("sectional initial distribution has no mass.");
 
-  // Gelling kernels: the solution exists only before t_gel = 1 / (K0 M2(0)) (Ziff 1980 for K = K0 i j).
+  // Gelling kernels: the solution exists only before t_gel = 1 / (K0 M2(0)) (Ziff 1980 for K = K0 i
+  // j).
   if (kernel.type() == KernelType::Multiplicative) {
     const double t_gel = 1.0 / (kernel.K0() * M2_0);
     if (options.times.back() >= t_gel)
-      throw std::invalid_argument("sectional times must stay before the gel time 1/(K0 M2(0)) = " +
-                                  formatReal(t_gel) + " of the multiplicative kernel (got " +
-                                  formatReal(options.times.back()) + ").");
+      throw std::invalid_argument(
+          "sectional times must stay before the gel time 1/(K0 M2(0)) = " + formatReal(t_gel) +
+          " of the multiplicative kernel (got " + formatReal(options.times.back()) + ").");
   } else if (kernel.gels()) {
-    throw std::invalid_argument("sectional solver: kernel '" + kernel.name() + "' gels; no gel time known.");
+    throw std::invalid_argument("sectional solver: kernel '" + kernel.name() +
+                                "' gels; no gel time known.");
   }
 
   FixedPivotRhs rhs(kernel, x, options.section_cutoff * M1_0);
@@ -258,10 +277,11 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
   co.rtol = options.rtol;
   co.atol_vector.resize(I + 1);
   for (size_t i = 0; i < I; ++i) co.atol_vector[i] = options.atol * M1_0 / x[i];  // mass-weighted
-  co.atol_vector[I] = options.atol * M1_0;                                       // escaped mass
+  co.atol_vector[I] = options.atol * M1_0;                                        // escaped mass
   co.max_steps = 1000000;
   const int n_unknowns = static_cast<int>(I + 1);
-  CvodeSolver cvode(n_unknowns, [&rhs](double, const double* yy, double* dd) { rhs(yy, dd); }, co, 0.0, y.data());
+  CvodeSolver cvode(
+      n_unknowns, [&rhs](double, const double* yy, double* dd) { rhs(yy, dd); }, co, 0.0, y.data());
   cvode.setStopTime(options.times.back());  // never step past the last output (gel time, blow-up)
 
   SmolResult result;
@@ -292,10 +312,10 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
       result.snapshots.push_back(std::move(snap));
     }
     if (!s.valid && options.stop_on_truncation) {
-      result.stopped_early = "mass loss " + formatReal(s.mass_loss) + " at t = " + formatReal(tout) +
-                             " exceeds mass_loss_tolerance " + formatReal(options.mass_loss_tolerance) +
-                             " (aggregates beyond the last pivot " + formatReal(x.back()) +
-                             "; raise max_size)";
+      result.stopped_early =
+          "mass loss " + formatReal(s.mass_loss) + " at t = " + formatReal(tout) +
+          " exceeds mass_loss_tolerance " + formatReal(options.mass_loss_tolerance) +
+          " (aggregates beyond the last pivot " + formatReal(x.back()) + "; raise max_size)";
       break;
     }
     if (s.S >= options.s_end) break;

@@ -1,30 +1,34 @@
 #pragma once
 /// \file SectionalSolver.h
 /// Sectional Smoluchowski solver: the fixed-pivot method of Kumar & Ramkrishna, Chem. Eng. Sci. 51,
-/// 1311 (1996), eq. (27), for mean sizes far beyond what a discrete grid holds (design.md section 4).
+/// 1311 (1996), eq. (27), for mean sizes far beyond what a discrete grid holds (design.md section
+/// 4).
 ///
 /// Grid: pivots x_i are the integers 1, 2, ..., m, with m the first integer for which the geometric
-/// step exceeds one size unit, m (r - 1) >= 1; then x_{i+1} = r x_i up to the first pivot >= max_size.
-/// Below m the method reduces to the discrete equation exactly (every sum of two integer pivots
+/// step exceeds one size unit, m (r - 1) >= 1; then x_{i+1} = r x_i up to the first pivot >=
+/// max_size. Below m the method reduces to the discrete equation exactly (every sum of two integer
+/// pivots
 /// <= m is a pivot), so small sizes carry no discretisation error.
 ///
 /// Equation (Kumar & Ramkrishna 1996, eq. 27), N_i = number of clusters (per unit volume) assigned
 /// to pivot x_i:
 ///
-///     dN_i/dt = sum_{j <= k, x_{i-1} <= x_j + x_k <= x_{i+1}} (1 - delta_jk / 2) eta_i(x_j + x_k) K(x_j, x_k) N_j N_k
+///     dN_i/dt = sum_{j <= k, x_{i-1} <= x_j + x_k <= x_{i+1}} (1 - delta_jk / 2) eta_i(x_j + x_k)
+///     K(x_j, x_k) N_j N_k
 ///               - N_i sum_k K(x_i, x_k) N_k,
 ///     eta_i(v) = (x_{i+1} - v) / (x_{i+1} - x_i)  for x_i <= v <= x_{i+1},
 ///                (v - x_{i-1}) / (x_i - x_{i-1})  for x_{i-1} <= v <= x_i:
 ///
 /// an aggregate of size v between two pivots is split between them so that number and mass are
-/// both conserved exactly. The kernel is evaluated at the real pivot sizes. Each pair (j, k) and its
-/// target section and weight are tabulated once, so the right-hand side is an O(I^2) loop over the
-/// pairs of sections that hold non-negligible mass. The fixed-pivot error in S scales as (r - 1)^2
-/// (design.md section 4: 3e-4 at r = 1.02).
+/// both conserved exactly. The kernel is evaluated at the real pivot sizes. Each pair (j, k) and
+/// its target section and weight are tabulated once, so the right-hand side is an O(I^2) loop over
+/// the pairs of sections that hold non-negligible mass. The fixed-pivot error in S scales as (r -
+/// 1)^2 (design.md section 4: 3e-4 at r = 1.02).
 ///
 /// Truncation: aggregates larger than the last pivot leave the grid. Their mass is integrated as an
-/// extra unknown, so that M1 + escaped mass is a linear invariant; every sample reports the relative
-/// mass lost, (M1(0) - M1(t)) / M1(0), and is marked invalid when it exceeds mass_loss_tolerance.
+/// extra unknown, so that M1 + escaped mass is a linear invariant; every sample reports the
+/// relative mass lost, (M1(0) - M1(t)) / M1(0), and is marked invalid when it exceeds
+/// mass_loss_tolerance.
 ///
 /// Gelling kernels (multiplicative, K0 i j): the solution only exists before the gel time
 /// t_gel = 1 / (K0 M2(0)) (Ziff 1980; 1/K0 for the monodisperse start); later output times are
@@ -54,7 +58,8 @@ struct SectionalOptions {
   double s_end = std::numeric_limits<double>::infinity();
   /// Relative mass loss beyond which a sample is marked invalid.
   double mass_loss_tolerance = 1e-8;
-  /// Stop at the first invalid sample (SmolResult::stopped_early says why); otherwise go on marking.
+  /// Stop at the first invalid sample (SmolResult::stopped_early says why); otherwise go on
+  /// marking.
   bool stop_on_truncation = true;
   /// Store the pivots and N_i at every output time.
   bool snapshots = false;

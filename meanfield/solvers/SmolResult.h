@@ -16,7 +16,7 @@ struct MomentSample {
   double M0 = 0.0;  ///< number of clusters per unit volume
   double M1 = 0.0;  ///< mass per unit volume (conserved up to truncation)
   double M2 = 0.0;
-  double S = 0.0;   ///< M2 / M1
+  double S = 0.0;  ///< M2 / M1
   /// Relative mass lost so far, (M1(0) - M1(t)) / M1(0): truncation (discrete), escape past the
   /// last section (sectional), or integration error.
   double mass_loss = 0.0;
@@ -41,7 +41,7 @@ struct SolveStats {
   long linear_iterations = 0;
   long nonlinear_failures = 0;  ///< convergence failures of the nonlinear solver
   long error_test_failures = 0;
-  int resizes = 0;              ///< times the active size range was enlarged
+  int resizes = 0;  ///< times the active size range was enlarged
   double wall_seconds = 0.0;
 };
 

@@ -40,8 +40,8 @@ int exponentIndex(std::vector<double>& list, double v) {
 }  // namespace
 
 struct SmoluchowskiRhs::FftState {
-  int L = 0;   // transform length
-  int Lc = 0;  // complex length L/2+1
+  int L = 0;                            // transform length
+  int Lc = 0;                           // complex length L/2+1
   std::vector<double> exponents;        // distinct exponents among p_t, q_t
   std::vector<std::vector<double>> pw;  // pw[e][k-1] = k^{exponents[e]}
   struct TermIdx {
@@ -51,15 +51,15 @@ struct SmoluchowskiRhs::FftState {
     int iq;  // index into distinct_q (correlation buffer)
   };
   std::vector<TermIdx> terms;
-  std::vector<int> distinct_q;          // exponent indices used as q (one correlation each)
-  std::vector<double> sum_pow;          // k^e for the gain prefactor, k = 1..M
-  bool plain_sum = false;               // e == 0: correlations are plain sums
+  std::vector<int> distinct_q;  // exponent indices used as q (one correlation each)
+  std::vector<double> sum_pow;  // k^e for the gain prefactor, k = 1..M
+  bool plain_sum = false;       // e == 0: correlations are plain sums
   RealBuf work_real;
-  std::vector<CplxBuf> spectra;         // forward transforms of x^{(e)}
+  std::vector<CplxBuf> spectra;  // forward transforms of x^{(e)}
   CplxBuf gain_spec, work_spec;
-  CplxBuf phi_spec;                     // transform of g(m) = m^e, m = 2..2M
-  std::vector<RealBuf> corr;            // correlation results per distinct q
-  RealBuf conv;                         // gain convolution result
+  CplxBuf phi_spec;           // transform of g(m) = m^e, m = 2..2M
+  std::vector<RealBuf> corr;  // correlation results per distinct q
+  RealBuf conv;               // gain convolution result
   fftw_plan fwd = nullptr, inv = nullptr;
   ~FftState() {
     if (fwd) fftw_destroy_plan(fwd);
@@ -67,8 +67,11 @@ struct SmoluchowskiRhs::FftState {
   }
 };
 
-SmoluchowskiRhs::SmoluchowskiRhs(const Kernel& kernel, int M, Method method) : m_kernel(kernel), m_M(M) {
-  if (M < 2) throw std::invalid_argument("the largest size class M must be at least 2 (got " + std::to_string(M) + ").");
+SmoluchowskiRhs::SmoluchowskiRhs(const Kernel& kernel, int M, Method method)
+    : m_kernel(kernel), m_M(M) {
+  if (M < 2)
+    throw std::invalid_argument("the largest size class M must be at least 2 (got " +
+                                std::to_string(M) + ").");
   m_use_fft = method == Method::Fft || (method == Method::Auto && M > 64);
   if (!m_use_fft) return;
 
@@ -80,7 +83,8 @@ SmoluchowskiRhs::SmoluchowskiRhs(const Kernel& kernel, int M, Method method) : m
   st->L = fftFriendlySize(2 * M + 1);
   st->Lc = st->L / 2 + 1;
   for (const auto& t : kernel.terms()) {
-    FftState::TermIdx ti{t.weight, exponentIndex(st->exponents, t.p), exponentIndex(st->exponents, t.q), 0};
+    FftState::TermIdx ti{t.weight, exponentIndex(st->exponents, t.p),
+                         exponentIndex(st->exponents, t.q), 0};
     auto it = std::find(st->distinct_q.begin(), st->distinct_q.end(), ti.q);
     ti.iq = static_cast<int>(it - st->distinct_q.begin());
     if (it == st->distinct_q.end()) st->distinct_q.push_back(ti.q);
@@ -111,7 +115,8 @@ SmoluchowskiRhs::SmoluchowskiRhs(const Kernel& kernel, int M, Method method) : m
   }
   st->fwd = fftw_plan_dft_r2c_1d(L, st->work_real.get(), st->work_spec.get(), FFTW_ESTIMATE);
   st->inv = fftw_plan_dft_c2r_1d(L, st->work_spec.get(), st->conv.get(), FFTW_ESTIMATE);
-  if (!st->fwd || !st->inv) throw std::runtime_error("FFTW could not create a plan of length " + std::to_string(L));
+  if (!st->fwd || !st->inv)
+    throw std::runtime_error("FFTW could not create a plan of length " + std::to_string(L));
 
   if (!st->plain_sum) {
     st->phi_spec = allocCplx(Lc);
@@ -175,7 +180,8 @@ void SmoluchowskiRhs::evaluate(const double* n, double* dndt) {
   if (!st.plain_sum) {
     const auto* G = reinterpret_cast<const std::complex<double>*>(st.phi_spec.get());
     for (std::size_t iq = 0; iq < st.distinct_q.size(); ++iq) {
-      const auto* X = reinterpret_cast<const std::complex<double>*>(st.spectra[st.distinct_q[iq]].get());
+      const auto* X =
+          reinterpret_cast<const std::complex<double>*>(st.spectra[st.distinct_q[iq]].get());
       auto* w = reinterpret_cast<std::complex<double>*>(st.work_spec.get());
 #pragma omp parallel for schedule(static) if (Lc > (1 << 15))
       for (int f = 0; f < Lc; ++f) w[f] = G[f] * std::conj(X[f]);

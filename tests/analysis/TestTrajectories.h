@@ -17,17 +17,19 @@ using granagg::analysis::Frame;
 namespace h5 = granagg::analysis::h5;
 
 struct H5mdLayout {
-  bool box = true;          // write /particles/all/box
+  bool box = true;  // write /particles/all/box
   bool images = true;
   bool velocities = true;
   bool charges = true;
-  std::size_t velocity_rows = static_cast<std::size_t>(-1);  // fewer rows than frames: a truncated element
-  bool fixed_step_time = false;  // H5MD fixed-increment step/time (scalars)
+  std::size_t velocity_rows =
+      static_cast<std::size_t>(-1);  // fewer rows than frames: a truncated element
+  bool fixed_step_time = false;      // H5MD fixed-increment step/time (scalars)
   std::vector<std::pair<std::string, std::string>> parameters;  // string attributes of /parameters
 };
 
-inline void writeSeries(hid_t part, const std::string& name, hid_t ftype, hid_t mtype, std::size_t rows,
-                        std::vector<hsize_t> inner, const void* data, hid_t step_src_group) {
+inline void writeSeries(hid_t part, const std::string& name, hid_t ftype, hid_t mtype,
+                        std::size_t rows, std::vector<hsize_t> inner, const void* data,
+                        hid_t step_src_group) {
   h5::Handle g = h5::createGroup(part, name, "test");
   std::vector<hsize_t> shape{rows};
   shape.insert(shape.end(), inner.begin(), inner.end());
@@ -39,7 +41,8 @@ inline void writeSeries(hid_t part, const std::string& name, hid_t ftype, hid_t 
 }
 
 /// Writes frames (positions wrapped in [0, L), images, velocities, charges) as H5MD.
-inline void writeH5md(const std::string& path, const std::vector<Frame>& frames, const H5mdLayout& lay = {}) {
+inline void writeH5md(const std::string& path, const std::vector<Frame>& frames,
+                      const H5mdLayout& lay = {}) {
   h5::silenceErrors();
   h5::Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
   const std::size_t F = frames.size(), N = frames.front().size();
@@ -48,7 +51,8 @@ inline void writeH5md(const std::string& path, const std::vector<Frame>& frames,
     const int version[2] = {1, 1};
     const hsize_t two = 2;
     h5::Handle space(H5Screate_simple(1, &two, nullptr));
-    h5::Handle a(H5Acreate2(g.get(), "version", H5T_STD_I32LE, space.get(), H5P_DEFAULT, H5P_DEFAULT));
+    h5::Handle a(
+        H5Acreate2(g.get(), "version", H5T_STD_I32LE, space.get(), H5P_DEFAULT, H5P_DEFAULT));
     H5Awrite(a.get(), H5T_NATIVE_INT, version);
   }
   h5::Handle part = h5::createGroup(file.get(), "particles/all", "test");
@@ -66,7 +70,8 @@ inline void writeH5md(const std::string& path, const std::vector<Frame>& frames,
   }
   {
     h5::Handle g = h5::createGroup(part.get(), "position", "test");
-    h5::writeDataset(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {F, N, 3}, pos.data(), "test");
+    h5::writeDataset(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {F, N, 3}, pos.data(),
+                     "test");
     if (lay.fixed_step_time) {
       const long long ds = F > 1 ? step[1] - step[0] : 1;
       const double dt = F > 1 ? time[1] - time[0] : 1.0;
@@ -74,19 +79,25 @@ inline void writeH5md(const std::string& path, const std::vector<Frame>& frames,
       h5::writeDataset(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, &dt, "test");
     } else {
       h5::writeDataset(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, {F}, step.data(), "test");
-      h5::writeDataset(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {F}, time.data(), "test");
+      h5::writeDataset(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {F}, time.data(),
+                       "test");
     }
   }
   h5::Handle posg(H5Gopen2(part.get(), "position", H5P_DEFAULT));
   if (lay.box) {
     h5::Handle box = h5::createGroup(part.get(), "box", "test");
-    writeSeries(box.get(), "edges", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, F, {3, 3}, edges.data(), posg.get());
+    writeSeries(box.get(), "edges", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, F, {3, 3}, edges.data(),
+                posg.get());
   }
-  if (lay.images) writeSeries(part.get(), "image", H5T_STD_I32LE, H5T_NATIVE_INT, F, {N, 3}, img.data(), posg.get());
+  if (lay.images)
+    writeSeries(part.get(), "image", H5T_STD_I32LE, H5T_NATIVE_INT, F, {N, 3}, img.data(),
+                posg.get());
   if (lay.velocities && !vel.empty())
-    writeSeries(part.get(), "velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, std::min(F, lay.velocity_rows), {N, 3},
-                vel.data(), posg.get());
-  if (lay.charges && !q.empty()) writeSeries(part.get(), "charge", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, F, {N}, q.data(), posg.get());
+    writeSeries(part.get(), "velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                std::min(F, lay.velocity_rows), {N, 3}, vel.data(), posg.get());
+  if (lay.charges && !q.empty())
+    writeSeries(part.get(), "charge", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, F, {N}, q.data(),
+                posg.get());
   if (!lay.parameters.empty()) {
     h5::Handle g = h5::createGroup(file.get(), "parameters", "test");
     for (const auto& [k, v] : lay.parameters) h5::writeStringAttribute(g.get(), k, v, "test");
@@ -102,10 +113,13 @@ inline void writeLammps(const std::string& path, const std::vector<Frame>& frame
   std::mt19937_64 rng(7);
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const Frame& f = frames[k];
-    std::fprintf(out, "ITEM: TIME\n%.17g\nITEM: TIMESTEP\n%lld\nITEM: NUMBER OF ATOMS\n%zu\nITEM: BOX BOUNDS pp pp pp\n",
+    std::fprintf(out,
+                 "ITEM: TIME\n%.17g\nITEM: TIMESTEP\n%lld\nITEM: NUMBER OF ATOMS\n%zu\nITEM: BOX "
+                 "BOUNDS pp pp pp\n",
                  f.time, static_cast<long long>(f.step), f.size());
     for (int d = 0; d < 3; ++d) std::fprintf(out, "%.17g %.17g\n", lo, lo + f.box);
-    std::fprintf(out, unwrapped ? "ITEM: ATOMS id type xu yu zu vx vy vz q\n" : "ITEM: ATOMS id type x y z ix iy iz vx vy vz q\n");
+    std::fprintf(out, unwrapped ? "ITEM: ATOMS id type xu yu zu vx vy vz q\n"
+                                : "ITEM: ATOMS id type x y z ix iy iz vx vy vz q\n");
     std::vector<std::size_t> order(f.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::shuffle(order.begin(), order.end(), rng);
@@ -113,13 +127,14 @@ inline void writeLammps(const std::string& path, const std::vector<Frame>& frame
     for (std::size_t i : order) {
       if (k + 1 == frames.size() && cut_last_after >= 0 && written == cut_last_after) break;
       if (unwrapped) {
-        std::fprintf(out, "%zu 1 %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", i + 1, lo + f.unwrapped(i, 0),
-                     lo + f.unwrapped(i, 1), lo + f.unwrapped(i, 2), f.velocity[3 * i], f.velocity[3 * i + 1],
-                     f.velocity[3 * i + 2], f.charge[i]);
+        std::fprintf(out, "%zu 1 %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", i + 1,
+                     lo + f.unwrapped(i, 0), lo + f.unwrapped(i, 1), lo + f.unwrapped(i, 2),
+                     f.velocity[3 * i], f.velocity[3 * i + 1], f.velocity[3 * i + 2], f.charge[i]);
       } else {
-        std::fprintf(out, "%zu 1 %.17g %.17g %.17g %d %d %d %.17g %.17g %.17g %.17g\n", i + 1, lo + f.position[3 * i],
-                     lo + f.position[3 * i + 1], lo + f.position[3 * i + 2], f.image[3 * i], f.image[3 * i + 1],
-                     f.image[3 * i + 2], f.velocity[3 * i], f.velocity[3 * i + 1], f.velocity[3 * i + 2], f.charge[i]);
+        std::fprintf(out, "%zu 1 %.17g %.17g %.17g %d %d %d %.17g %.17g %.17g %.17g\n", i + 1,
+                     lo + f.position[3 * i], lo + f.position[3 * i + 1], lo + f.position[3 * i + 2],
+                     f.image[3 * i], f.image[3 * i + 1], f.image[3 * i + 2], f.velocity[3 * i],
+                     f.velocity[3 * i + 1], f.velocity[3 * i + 2], f.charge[i]);
       }
       ++written;
     }
@@ -129,7 +144,8 @@ inline void writeLammps(const std::string& path, const std::vector<Frame>& frame
 
 /// A random gas of N particles in a box L moving ballistically with Maxwell velocities, with
 /// random charges, sampled at `times`; positions wrapped with image counts.
-inline std::vector<Frame> ballisticGas(std::size_t N, double L, const std::vector<double>& times, unsigned seed) {
+inline std::vector<Frame> ballisticGas(std::size_t N, double L, const std::vector<double>& times,
+                                       unsigned seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(0.0, L);
   std::normal_distribution<double> G(0.0, 1.0);

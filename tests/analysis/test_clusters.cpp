@@ -22,7 +22,8 @@ using Ns = std::map<std::uint64_t, std::uint64_t>;
 /// `count` particle centres inside grid cell (ix, iy, iz) of edge h, spread around its centre.
 void fillCell(std::vector<double>& pos, int ix, int iy, int iz, double h, int count) {
   for (int k = 0; k < count; ++k) {
-    const double off = -0.6 + 1.2 * k / std::max(1, count - 1);  // within +-0.6 of the centre (h = 2)
+    const double off =
+        -0.6 + 1.2 * k / std::max(1, count - 1);  // within +-0.6 of the centre (h = 2)
     pos.push_back((ix + 0.5) * h + off);
     pos.push_back((iy + 0.5) * h - off * 0.5);
     pos.push_back((iz + 0.5) * h + off * 0.25);
@@ -45,7 +46,8 @@ Ns bruteForceClusters(const std::vector<double>& pos, double L, double rc) {
     }
   Ns out;
   for (std::size_t i = 0; i < n; ++i)
-    if (uf.find(static_cast<std::uint32_t>(i)) == i) ++out[uf.rootSize(static_cast<std::uint32_t>(i))];
+    if (uf.find(static_cast<std::uint32_t>(i)) == i)
+      ++out[uf.rootSize(static_cast<std::uint32_t>(i))];
   return out;
 }
 
@@ -62,7 +64,8 @@ TEST_CASE("ClusterSizes gives N_s and S = sum s^2 N_s / sum s N_s", "[analysis][
   CHECK(c.samples() == std::vector<std::uint64_t>{1, 1, 1, 3, 4, 8});
 }
 
-TEST_CASE("grid clusters of built blobs wrapping faces, edges and corners are exact", "[analysis][clusters]") {
+TEST_CASE("grid clusters of built blobs wrapping faces, edges and corners are exact",
+          "[analysis][clusters]") {
   const double L = 20.0;  // 10 cells of h = 2 per side; threshold ceil(0.25 * 8 / (pi/6)) = 4
   std::vector<double> pos;
   // corner: the 2x2x2 block of cells {9, 0}^3 (wraps all three faces) -> 8 sites
@@ -104,7 +107,8 @@ TEST_CASE("grid clusters of built blobs wrapping faces, edges and corners are ex
   SECTION("translating everything by whole cells (with wrap) changes nothing") {
     for (const auto& shift : {std::vector<double>{2, 0, 0}, {0, 6, 0}, {0, 0, 14}, {4, 8, 18}}) {
       std::vector<double> moved = pos;
-      for (std::size_t j = 0; j < moved.size(); ++j) moved[j] = std::fmod(moved[j] + shift[j % 3], L);
+      for (std::size_t j = 0; j < moved.size(); ++j)
+        moved[j] = std::fmod(moved[j] + shift[j % 3], L);
       GridClusters g2;
       g2.compute(moved.data(), moved.size() / 3, L);
       CHECK(g2.result().n_s == expected);
@@ -118,7 +122,8 @@ TEST_CASE("grid clusters of built blobs wrapping faces, edges and corners are ex
   }
 }
 
-TEST_CASE("grid threshold is the integer count of filling fraction min_fill in the actual cell", "[analysis][clusters]") {
+TEST_CASE("grid threshold is the integer count of filling fraction min_fill in the actual cell",
+          "[analysis][clusters]") {
   GridClusters g;
   std::vector<double> one{0.5, 0.5, 0.5};
   g.compute(one.data(), 1, 23.97);  // the quick preset's box: 11 cells of h = 2.179
@@ -129,7 +134,8 @@ TEST_CASE("grid threshold is the integer count of filling fraction min_fill in t
   CHECK(std::isnan(g.result().S));
 }
 
-TEST_CASE("cloud-in-cell smoothing keeps the total weight and finds a dense blob", "[analysis][clusters]") {
+TEST_CASE("cloud-in-cell smoothing keeps the total weight and finds a dense blob",
+          "[analysis][clusters]") {
   GridClustersParams p;
   p.assignment = GridAssignment::CloudInCell;
   GridClusters g(p);
@@ -147,14 +153,19 @@ TEST_CASE("cloud-in-cell smoothing keeps the total weight and finds a dense blob
 }
 
 TEST_CASE("grid and particle clusters reject bad parameters", "[analysis][clusters]") {
-  CHECK_THROWS_AS(GridClusters(GridClustersParams{0.0, 0.25, 0, GridAssignment::Nearest}), std::invalid_argument);
-  CHECK_THROWS_AS(GridClusters(GridClustersParams{2.0, 1.5, 0, GridAssignment::Nearest}), std::invalid_argument);
-  CHECK_THROWS_AS(GridClusters(GridClustersParams{2.0, 0.25, -1, GridAssignment::Nearest}), std::invalid_argument);
+  CHECK_THROWS_AS(GridClusters(GridClustersParams{0.0, 0.25, 0, GridAssignment::Nearest}),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(GridClusters(GridClustersParams{2.0, 1.5, 0, GridAssignment::Nearest}),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(GridClusters(GridClustersParams{2.0, 0.25, -1, GridAssignment::Nearest}),
+                  std::invalid_argument);
   CHECK_THROWS_AS(ParticleClusters(ParticleClustersParams{-0.1}), std::invalid_argument);
-  CHECK_THROWS_WITH(ParticleClusters(ParticleClustersParams{std::nan("")}), Catch::Contains("tolerance"));
+  CHECK_THROWS_WITH(ParticleClusters(ParticleClustersParams{std::nan("")}),
+                    Catch::Contains("tolerance"));
 }
 
-TEST_CASE("particle clusters of built blobs wrapping faces, edges and corners are exact", "[analysis][clusters]") {
+TEST_CASE("particle clusters of built blobs wrapping faces, edges and corners are exact",
+          "[analysis][clusters]") {
   const double L = 20.0, a = 1.02;  // bond length 1.02 <= 1.05; diagonals 1.44 are not bonds
   std::vector<double> pos;
   auto add = [&](double x, double y, double z) {
@@ -184,14 +195,15 @@ TEST_CASE("particle clusters of built blobs wrapping faces, edges and corners ar
   const Ns expected{{1, 5}, {3, 1}, {4, 1}, {8, 1}};
   CHECK(pc.result().n_s == expected);
   CHECK(pc.result().S == Approx((5.0 + 9 + 16 + 64) / 20.0).epsilon(1e-15));
-  CHECK(pc.contacts()[0] == 3);   // a cube corner touches 3 neighbours
-  CHECK(pc.contacts()[9] == 2);   // middle of the chain
+  CHECK(pc.contacts()[0] == 3);  // a cube corner touches 3 neighbours
+  CHECK(pc.contacts()[9] == 2);  // middle of the chain
   CHECK(pc.bonds() == 12 + 2 + 4);
   CHECK(pc.labels()[0] != pc.labels()[8]);
   CHECK(pc.labels()[8] == pc.labels()[10]);
   CHECK(pc.result().n_s == bruteForceClusters(pos, L, 1.05));
 
-  SECTION("a small box (fewer than 3 cells per side) takes the all-pairs path with the same answer") {
+  SECTION(
+      "a small box (fewer than 3 cells per side) takes the all-pairs path with the same answer") {
     std::vector<double> small;
     const double Ls = 2.5;
     for (double x : {0.1, 1.1, 2.12})  // 2.12 -> 0.1 is 0.48 across the face: all bonded
@@ -206,7 +218,8 @@ TEST_CASE("particle clusters of built blobs wrapping faces, edges and corners ar
   }
 }
 
-TEST_CASE("particle clusters of a random dense gas match an O(N^2) reference", "[analysis][clusters]") {
+TEST_CASE("particle clusters of a random dense gas match an O(N^2) reference",
+          "[analysis][clusters]") {
   for (unsigned seed : {1u, 2u, 3u}) {
     std::mt19937_64 rng(seed);
     const double L = 9.0;  // 8 cells per side

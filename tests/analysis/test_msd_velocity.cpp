@@ -6,17 +6,19 @@
 #include <random>
 #include <vector>
 
+#include "TestTrajectories.h"
 #include "analysis/stats/ChargeStats.h"
 #include "analysis/stats/Msd.h"
 #include "analysis/stats/VelocityStats.h"
-#include "TestTrajectories.h"
 
 using namespace granagg::analysis;
 
-TEST_CASE("MSD of ballistic motion is <v^2> t^2 exactly, through the periodic wrap", "[analysis][msd]") {
+TEST_CASE("MSD of ballistic motion is <v^2> t^2 exactly, through the periodic wrap",
+          "[analysis][msd]") {
   std::vector<double> times;
   for (int k = 0; k < 30; ++k) times.push_back(0.5 * k);
-  const auto frames = testtraj::ballisticGas(200, 6.0, times, 3);  // particles cross the box many times
+  const auto frames =
+      testtraj::ballisticGas(200, 6.0, times, 3);  // particles cross the box many times
   double v2 = 0;
   for (double v : frames[0].velocity) v2 += v * v;
   v2 /= 200;
@@ -26,12 +28,14 @@ TEST_CASE("MSD of ballistic motion is <v^2> t^2 exactly, through the periodic wr
     m.accumulate(f);
     all.accumulate(f);
   }
-  for (std::size_t k = 0; k < times.size(); ++k) CHECK(m.msd()[k] == Approx(v2 * times[k] * times[k]).epsilon(1e-12).margin(1e-12));
+  for (std::size_t k = 0; k < times.size(); ++k)
+    CHECK(m.msd()[k] == Approx(v2 * times[k] * times[k]).epsilon(1e-12).margin(1e-12));
   REQUIRE(all.available());
   std::vector<double> lag;
   const auto ma = all.compute(lag);
   // every time origin sees the same ballistic displacement v * lag (FFT round-off ~1e-13 of x^2)
-  for (std::size_t k = 0; k < lag.size(); ++k) CHECK(ma[k] == Approx(v2 * lag[k] * lag[k]).epsilon(1e-9).margin(1e-9));
+  for (std::size_t k = 0; k < lag.size(); ++k)
+    CHECK(ma[k] == Approx(v2 * lag[k] * lag[k]).epsilon(1e-9).margin(1e-9));
 }
 
 TEST_CASE("MSD of a lattice random walk is 6 D t within its statistical error", "[analysis][msd]") {
@@ -72,7 +76,8 @@ TEST_CASE("MSD of a lattice random walk is 6 D t within its statistical error", 
   // all-origins (FFT) against the direct O(F^2) average for a few walkers, and against 3 lag
   std::vector<double> lag;
   const auto ma = all.compute(lag);
-  for (std::size_t n = 1; n <= 20; ++n) CHECK(std::fabs(ma[n] - 3.0 * n) < 4 * std::sqrt(3.0 * 2 * n * n / W));
+  for (std::size_t n = 1; n <= 20; ++n)
+    CHECK(std::fabs(ma[n] - 3.0 * n) < 4 * std::sqrt(3.0 * 2 * n * n / W));
 }
 
 TEST_CASE("all-origins MSD by FFT equals the direct average over origins", "[analysis][msd]") {
@@ -95,11 +100,13 @@ TEST_CASE("all-origins MSD by FFT equals the direct average over origins", "[ana
   std::vector<double> lag;
   const auto fft = all.compute(lag);
   const auto direct = msdAllOriginsDirect(walk);
-  for (std::size_t m = 0; m < F; ++m) CHECK(fft[m] == Approx(direct[m]).epsilon(1e-10).margin(1e-10));
+  for (std::size_t m = 0; m < F; ++m)
+    CHECK(fft[m] == Approx(direct[m]).epsilon(1e-10).margin(1e-10));
   CHECK(lag[4] == Approx(1.0));
 }
 
-TEST_CASE("all-origins MSD gives up on uneven frames, missing images or the memory budget", "[analysis][msd]") {
+TEST_CASE("all-origins MSD gives up on uneven frames, missing images or the memory budget",
+          "[analysis][msd]") {
   auto frameAt = [](double t, bool images) {
     Frame f;
     f.time = t;
@@ -124,17 +131,19 @@ TEST_CASE("all-origins MSD gives up on uneven frames, missing images or the memo
   CHECK_THROWS_AS(m.accumulate(frameAt(0, false)), std::invalid_argument);
 }
 
-TEST_CASE("Maxwell-sampled velocities give f(v~) on the Maxwellian and a2 = 0 within its error", "[analysis][velocity]") {
+TEST_CASE("Maxwell-sampled velocities give f(v~) on the Maxwellian and a2 = 0 within its error",
+          "[analysis][velocity]") {
   const std::size_t N = 200000;
   std::mt19937_64 rng(29);
   std::normal_distribution<double> G(0.0, 1.3);
   std::vector<double> v(3 * N);
-  for (std::size_t j = 0; j < v.size(); ++j) v[j] = G(rng) + (j % 3 == 0 ? 0.7 : 0.0);  // a drift to subtract
+  for (std::size_t j = 0; j < v.size(); ++j)
+    v[j] = G(rng) + (j % 3 == 0 ? 0.7 : 0.0);  // a drift to subtract
   const VelocityMoments m = velocityMoments(v);
   // T_g = sigma^2 = 1.69; its relative sd is sqrt(2/(3N)) = 1.8e-3
   CHECK(m.T_g == Approx(1.69).epsilon(4 * std::sqrt(2.0 / (3.0 * N))));
-  // a2: 3 standard errors (the delta-method error; for a Maxwellian it is close to sqrt(8/(15 N))... we only
-  // require it to be of the right size, then use it)
+  // a2: 3 standard errors (the delta-method error; for a Maxwellian it is close to sqrt(8/(15
+  // N))... we only require it to be of the right size, then use it)
   CHECK(m.a2_err > 0.5e-3);
   CHECK(m.a2_err < 5e-3);
   CHECK(std::fabs(m.a2) < 3 * m.a2_err);
@@ -150,7 +159,8 @@ TEST_CASE("Maxwell-sampled velocities give f(v~) on the Maxwellian and a2 = 0 wi
     const double expected = N * p, sd = std::sqrt(N * p * (1 - p));
     INFO("bin [" << lo << ", " << hi << ")");
     CHECK(std::fabs(h.counts()[static_cast<std::size_t>(k)] - expected) < 4.5 * sd + 1.0);
-    CHECK(dens[static_cast<std::size_t>(k)] * h.binWidth() == Approx(h.counts()[static_cast<std::size_t>(k)] / N));
+    CHECK(dens[static_cast<std::size_t>(k)] * h.binWidth() ==
+          Approx(h.counts()[static_cast<std::size_t>(k)] / N));
   }
   // the Maxwellian density integrates to its CDF
   double integral = 0;
@@ -192,6 +202,7 @@ TEST_CASE("charge moments, scaled charges, correlation and charging rate", "[ana
     mq.push_back(std::pow(t.back(), 0.25));
   }
   const auto [tm, rate] = chargingRate(t, mq);
-  for (std::size_t k = 0; k < tm.size(); ++k) CHECK(rate[k] == Approx(0.25 * std::pow(tm[k], -0.75)).epsilon(2e-3));
+  for (std::size_t k = 0; k < tm.size(); ++k)
+    CHECK(rate[k] == Approx(0.25 * std::pow(tm[k], -0.75)).epsilon(2e-3));
   CHECK(expectedChargingRateExponent(0.8) == Approx(-13.0 / 6.0));
 }

@@ -17,11 +17,14 @@ namespace {
 
 /// Exact inverse-CDF sample of p(x) = x^-tau / zeta(tau, xmin): the smallest x with
 /// P(X > x) = zeta(tau, x+1)/zeta(tau, xmin) < u, found by doubling then bisection.
-std::vector<std::uint64_t> samplePowerLaw(double tau, std::uint64_t xmin, std::size_t n, std::uint64_t seed) {
+std::vector<std::uint64_t> samplePowerLaw(double tau, std::uint64_t xmin, std::size_t n,
+                                          std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   const double z0 = gsl_sf_hzeta(tau, static_cast<double>(xmin));
-  auto tailAbove = [&](std::uint64_t x) { return gsl_sf_hzeta(tau, static_cast<double>(x + 1)) / z0; };
+  auto tailAbove = [&](std::uint64_t x) {
+    return gsl_sf_hzeta(tau, static_cast<double>(x + 1)) / z0;
+  };
   std::vector<std::uint64_t> out(n);
   for (auto& x : out) {
     double u = U(rng);
@@ -55,7 +58,8 @@ TEST_CASE("the sampler reproduces the discrete power law's probabilities", "[ana
   CHECK(ones / 20000 == Approx(1.0 / gsl_sf_hzeta(2.5, 1.0)).margin(4 * 0.0035));
 }
 
-TEST_CASE("the MLE recovers tau from synthetic discrete power-law samples within its interval", "[analysis][mle]") {
+TEST_CASE("the MLE recovers tau from synthetic discrete power-law samples within its interval",
+          "[analysis][mle]") {
   // n = 3000 tail samples give sigma ~ (tau - 1)/sqrt(n) ~ 0.01-0.04. We require |tau_hat - tau| <
   // 3 sigma: the MLE is asymptotically normal, so a correct estimator fails a case with probability
   // 0.3 %; the seeds are fixed, so the outcome is deterministic.
@@ -104,12 +108,14 @@ TEST_CASE("the KS choice of xmin finds where a power-law tail starts", "[analysi
 TEST_CASE("the MLE declines degenerate samples", "[analysis][mle]") {
   CHECK_FALSE(fitDiscretePowerLaw({}, 1).valid);
   CHECK_FALSE(fitDiscretePowerLaw({4, 4, 4, 4}, 1).valid);  // one value: no maximum in tau
-  CHECK_FALSE(fitDiscretePowerLawKs(std::vector<std::uint64_t>{1, 2, 3}, 10).valid);  // tail below min_tail
+  CHECK_FALSE(
+      fitDiscretePowerLawKs(std::vector<std::uint64_t>{1, 2, 3}, 10).valid);  // tail below min_tail
   CHECK(discretePowerLawCcdf(2.0, 1, 1) == 1.0);
   CHECK(discretePowerLawCcdf(2.0, 1, 2) == Approx(1.0 - 6.0 / (M_PI * M_PI)).epsilon(1e-12));
 }
 
-TEST_CASE("power-law fit of an exact power law returns its exponent with a zero-width interval", "[analysis][fit]") {
+TEST_CASE("power-law fit of an exact power law returns its exponent with a zero-width interval",
+          "[analysis][fit]") {
   std::vector<double> t, y;
   for (int k = 0; k <= 40; ++k) {
     t.push_back(std::pow(10.0, -1 + 3.0 * k / 40));
@@ -135,7 +141,8 @@ TEST_CASE("the fit's 95 % interval uses the Student t quantile", "[analysis][fit
   CHECK_FALSE(fitPowerLaw({1, 2}, {1, 2}, 0, 10).valid);
 }
 
-TEST_CASE("bootstrap over runs of exact power laws is exact; with noise it is reproducible", "[analysis][fit]") {
+TEST_CASE("bootstrap over runs of exact power laws is exact; with noise it is reproducible",
+          "[analysis][fit]") {
   std::vector<double> t;
   for (int k = 1; k <= 20; ++k) t.push_back(k * 5.0);
   std::vector<std::vector<double>> runs;
@@ -171,8 +178,10 @@ TEST_CASE("the local slope of an exact power law equals its exponent", "[analysi
     const auto z = localSlope(t, y, p);
     for (std::size_t k = 0; k < t.size(); ++k) {
       INFO("t = " << t[k] << ", p = " << p);
-      if (t[k] / p >= 0.3) CHECK(z[k] == Approx(1.37).epsilon(1e-12));
-      else CHECK(std::isnan(z[k]));
+      if (t[k] / p >= 0.3)
+        CHECK(z[k] == Approx(1.37).epsilon(1e-12));
+      else
+        CHECK(std::isnan(z[k]));
     }
   }
   CHECK_THROWS_AS(localSlope(t, y, 1.0), std::invalid_argument);

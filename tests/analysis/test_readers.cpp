@@ -2,18 +2,18 @@
 // truncated and malformed inputs give errors naming the file and the frame; --allow-partial.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
+#include "TestTrajectories.h"
 #include "analysis/io/H5mdTrajectory.h"
 #include "analysis/io/LammpsDump.h"
 #include "analysis/io/TrajectoryReader.h"
 #include "analysis/pipeline/RunAnalyzer.h"
-#include "TestTrajectories.h"
 
 #include "TestUtil.h"
 
@@ -27,7 +27,8 @@ namespace {
 /// A small dense gas (so that clusters exist) at log-spaced times.
 std::vector<Frame> sampleFrames(std::size_t count = 8) {
   std::vector<double> times{0.0};
-  for (std::size_t k = 1; k < count; ++k) times.push_back(0.05 * std::pow(1.6, static_cast<double>(k)));
+  for (std::size_t k = 1; k < count; ++k)
+    times.push_back(0.05 * std::pow(1.6, static_cast<double>(k)));
   return testtraj::ballisticGas(400, 8.0, times, 9);  // phi = 0.41: many contacts
 }
 
@@ -44,8 +45,10 @@ void requireSameTables(const RunResult& a, const RunResult& b) {
       for (std::size_t c = 0; c < ta.rows[r].size(); ++c) {
         INFO("row " << r << ", column " << ta.columns[c]);
         // charge_speed lists particle ids: LAMMPS ids start at 1, H5MD indices at 0
-        if (ta.name == "charge_speed" && ta.columns[c] == "id") CHECK(tb.rows[r][c] == ta.rows[r][c] + 1);
-        else CHECK(sameValue(ta.rows[r][c], tb.rows[r][c]));
+        if (ta.name == "charge_speed" && ta.columns[c] == "id")
+          CHECK(tb.rows[r][c] == ta.rows[r][c] + 1);
+        else
+          CHECK(sameValue(ta.rows[r][c], tb.rows[r][c]));
       }
   }
 }
@@ -58,7 +61,8 @@ AnalysisOptions fastOptions() {
 
 }  // namespace
 
-TEST_CASE("H5MD and LAMMPS dump of the same frames give identical frames and results", "[analysis][io]") {
+TEST_CASE("H5MD and LAMMPS dump of the same frames give identical frames and results",
+          "[analysis][io]") {
   const fs::path dir = tempDir("same");
   const auto frames = sampleFrames();
   const std::string h5 = (dir / "t.h5").string(), dump = (dir / "t.dump").string();
@@ -94,7 +98,9 @@ TEST_CASE("H5MD and LAMMPS dump of the same frames give identical frames and res
   // the gas is dense: clusters exist and S > 1
   CHECK(ra.table("S_t").rows.back()[ra.table("S_t").column("S_particle")] > 1.0);
 
-  SECTION("a dump with unwrapped xu yu zu and a shifted box origin gives the same frames to round-off") {
+  SECTION(
+      "a dump with unwrapped xu yu zu and a shifted box origin gives the same frames to "
+      "round-off") {
     const std::string dump2 = (dir / "t2.dump").string();
     testtraj::writeLammps(dump2, frames, -4.0, -1, true);
     auto r3 = openTrajectory(dump2);
@@ -102,7 +108,8 @@ TEST_CASE("H5MD and LAMMPS dump of the same frames give identical frames and res
     std::size_t k = 0;
     while (r3->next(c)) {
       for (std::size_t i = 0; i < c.size(); ++i)
-        for (int d = 0; d < 3; ++d) CHECK(c.unwrapped(i, d) == Approx(frames[k].unwrapped(i, d)).margin(1e-9));
+        for (int d = 0; d < 3; ++d)
+          CHECK(c.unwrapped(i, d) == Approx(frames[k].unwrapped(i, d)).margin(1e-9));
       ++k;
     }
     CHECK(k == frames.size());
@@ -129,7 +136,9 @@ TEST_CASE("H5MD and LAMMPS dump of the same frames give identical frames and res
   fs::remove_all(dir);
 }
 
-TEST_CASE("a LAMMPS dump cut mid-frame names the file and frame; --allow-partial keeps the frames before", "[analysis][io]") {
+TEST_CASE(
+    "a LAMMPS dump cut mid-frame names the file and frame; --allow-partial keeps the frames before",
+    "[analysis][io]") {
   const fs::path dir = tempDir("cut");
   const auto frames = sampleFrames(5);
   const std::string dump = (dir / "cut.dump").string();
@@ -139,7 +148,8 @@ TEST_CASE("a LAMMPS dump cut mid-frame names the file and frame; --allow-partial
     FAIL("no error for a truncated dump");
   } catch (const TrajectoryError& e) {
     CHECK(e.frame() == 4);
-    CHECK_THAT(e.what(), Catch::Contains("cut.dump") && Catch::Contains("frame 4") && Catch::Contains("123 of 400"));
+    CHECK_THAT(e.what(), Catch::Contains("cut.dump") && Catch::Contains("frame 4") &&
+                             Catch::Contains("123 of 400"));
   }
   AnalysisOptions o = fastOptions();
   o.allow_partial = true;
@@ -154,22 +164,29 @@ TEST_CASE("a LAMMPS dump cut mid-frame names the file and frame; --allow-partial
       const std::string p = (dir / "bad.dump").string();
       std::ofstream(p) << text;
       INFO(text);
-      CHECK_THROWS_WITH(analyzeRun(p, fastOptions()), Catch::Contains("bad.dump") && Catch::Contains(says));
+      CHECK_THROWS_WITH(analyzeRun(p, fastOptions()),
+                        Catch::Contains("bad.dump") && Catch::Contains(says));
     };
-    const std::string head = "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 5\n0 5\n0 5\n";
+    const std::string head =
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 5\n0 5\n0 5\n";
     expectError(head + "ITEM: ATOMS id x y z\n1 1 1 1\n2 2 2 x\n", "values");
     expectError(head + "ITEM: ATOMS id vx vy vz\n1 1 1 1\n2 2 2 2\n", "no positions");
-    expectError("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff pp pp\n0 5\n0 5\n0 5\nITEM: ATOMS id x y z\n",
-                "not periodic");
-    expectError("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 5\n0 6\n0 5\nITEM: ATOMS id x y z\n",
-                "not cubic");
+    expectError(
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff pp pp\n0 5\n0 5\n0 "
+        "5\nITEM: ATOMS id x y z\n",
+        "not periodic");
+    expectError(
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 5\n0 6\n0 "
+        "5\nITEM: ATOMS id x y z\n",
+        "not cubic");
     expectError(head + "ITEM: ATOMS id x y z\n1 1 1 1\n1 2 2 2\n", "appears twice");
     expectError("ITEM: TIMESTEP\n0\nITEM: NUMBER OF", "frame 0");
   }
   fs::remove_all(dir);
 }
 
-TEST_CASE("truncated and malformed H5MD files give errors naming the file and the frame", "[analysis][io]") {
+TEST_CASE("truncated and malformed H5MD files give errors naming the file and the frame",
+          "[analysis][io]") {
   const fs::path dir = tempDir("h5bad");
   const auto frames = sampleFrames(4);
   SECTION("a file cut short cannot be opened: the error says so") {
@@ -178,7 +195,8 @@ TEST_CASE("truncated and malformed H5MD files give errors naming the file and th
     const auto size = fs::file_size(full);
     fs::copy_file(full, cut);
     fs::resize_file(cut, size / 2);
-    CHECK_THROWS_WITH(analyzeRun(cut, fastOptions()), Catch::Contains("cut.h5") && Catch::Contains("frame 0") &&
+    CHECK_THROWS_WITH(analyzeRun(cut, fastOptions()), Catch::Contains("cut.h5") &&
+                                                          Catch::Contains("frame 0") &&
                                                           Catch::Contains("cannot open"));
     AnalysisOptions o = fastOptions();
     o.allow_partial = true;  // nothing before frame 0: still an error
@@ -189,17 +207,22 @@ TEST_CASE("truncated and malformed H5MD files give errors naming the file and th
     lay.box = false;
     const std::string p = (dir / "nobox.h5").string();
     testtraj::writeH5md(p, frames, lay);
-    CHECK_THROWS_WITH(analyzeRun(p, fastOptions()), Catch::Contains("nobox.h5") && Catch::Contains("box"));
+    CHECK_THROWS_WITH(analyzeRun(p, fastOptions()),
+                      Catch::Contains("nobox.h5") && Catch::Contains("box"));
   }
   SECTION("missing position") {
     const std::string p = (dir / "nopos.h5").string();
     {
-      granagg::analysis::h5::Handle f(H5Fcreate(p.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+      granagg::analysis::h5::Handle f(
+          H5Fcreate(p.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
       granagg::analysis::h5::createGroup(f.get(), "particles/all/box", "test");
     }
-    CHECK_THROWS_WITH(analyzeRun(p, fastOptions()), Catch::Contains("nopos.h5") && Catch::Contains("position"));
+    CHECK_THROWS_WITH(analyzeRun(p, fastOptions()),
+                      Catch::Contains("nopos.h5") && Catch::Contains("position"));
   }
-  SECTION("an element with fewer rows than frames fails at the first missing frame; --allow-partial stops there") {
+  SECTION(
+      "an element with fewer rows than frames fails at the first missing frame; --allow-partial "
+      "stops there") {
     testtraj::H5mdLayout lay;
     lay.velocity_rows = 2;
     const std::string p = (dir / "short.h5").string();
@@ -209,7 +232,8 @@ TEST_CASE("truncated and malformed H5MD files give errors naming the file and th
       FAIL("no error");
     } catch (const TrajectoryError& e) {
       CHECK(e.frame() == 2);
-      CHECK_THAT(e.what(), Catch::Contains("short.h5") && Catch::Contains("frame 2") && Catch::Contains("velocity"));
+      CHECK_THAT(e.what(), Catch::Contains("short.h5") && Catch::Contains("frame 2") &&
+                               Catch::Contains("velocity"));
     }
     AnalysisOptions o = fastOptions();
     o.allow_partial = true;
@@ -222,7 +246,8 @@ TEST_CASE("truncated and malformed H5MD files give errors naming the file and th
     bad[3].position[7] = std::nan("");
     const std::string p = (dir / "nan.h5").string();
     testtraj::writeH5md(p, bad);
-    CHECK_THROWS_WITH(analyzeRun(p, fastOptions()), Catch::Contains("nan.h5") && Catch::Contains("frame 3"));
+    CHECK_THROWS_WITH(analyzeRun(p, fastOptions()),
+                      Catch::Contains("nan.h5") && Catch::Contains("frame 3"));
   }
   SECTION("no velocities or charges: those observables are skipped with a note") {
     testtraj::H5mdLayout lay;
@@ -266,7 +291,8 @@ TEST_CASE("ensemble tables average runs with standard errors", "[analysis][ensem
   CHECK(s.rows[4][0] == 1.0);
 }
 
-TEST_CASE("ensemble of runs: per-run tables, means and a bootstrap growth exponent", "[analysis][ensemble]") {
+TEST_CASE("ensemble of runs: per-run tables, means and a bootstrap growth exponent",
+          "[analysis][ensemble]") {
   const fs::path dir = tempDir("ens");
   std::vector<RunResult> runs;
   for (unsigned seed : {1u, 2u, 3u}) {
@@ -284,7 +310,8 @@ TEST_CASE("ensemble of runs: per-run tables, means and a bootstrap growth expone
       CHECK(t.rows.size() == 5);
       CHECK(t.rows[0][t.column("n_runs")] == 3.0);
       double mean = 0;
-      for (const auto& r : runs) mean += r.table("S_t").rows[2][r.table("S_t").column("S_particle")];
+      for (const auto& r : runs)
+        mean += r.table("S_t").rows[2][r.table("S_t").column("S_particle")];
       CHECK(t.rows[2][t.column("S_particle_mean")] == Approx(mean / 3));
     }
     if (t.name == "fits") {
@@ -298,7 +325,8 @@ TEST_CASE("ensemble of runs: per-run tables, means and a bootstrap growth expone
   fs::remove_all(dir);
 }
 
-TEST_CASE("the charging-rate fit recovers the exponent of d<|q|>/dt; kappa comes from /parameters", "[analysis][charge]") {
+TEST_CASE("the charging-rate fit recovers the exponent of d<|q|>/dt; kappa comes from /parameters",
+          "[analysis][charge]") {
   // <|q|>(t) = 2 - t^-1.2 exactly: d<|q|>/dt = 1.2 t^-2.2. Frames 20 per decade on [1, 100]; the
   // finite-difference rate at the geometric mid-time carries a relative error O((ln 10 / 20)^2)
   // that is nearly constant in t, so the fitted exponent is -2.2 to ~1e-4.
@@ -307,7 +335,8 @@ TEST_CASE("the charging-rate fit recovers the exponent of d<|q|>/dt; kappa comes
   for (int k = 0; k <= 40; ++k) times.push_back(std::pow(10.0, k / 20.0));
   auto frames = testtraj::ballisticGas(100, 10.0, times, 4);
   for (auto& f : frames)
-    for (std::size_t i = 0; i < f.size(); ++i) f.charge[i] = (i % 2 ? 1.0 : -1.0) * (2.0 - std::pow(f.time, -1.2));
+    for (std::size_t i = 0; i < f.size(); ++i)
+      f.charge[i] = (i % 2 ? 1.0 : -1.0) * (2.0 - std::pow(f.time, -1.2));
   testtraj::H5mdLayout lay;
   lay.parameters = {{"charging.kappa", "0.8"}};
   const std::string p = (dir / "q.h5").string();

@@ -1,10 +1,10 @@
 #pragma once
 // Runs a shell command for the CLI tests: exit status and stdout+stderr together.
+#include <sys/wait.h>
 #include <array>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
-#include <sys/wait.h>
 
 struct Run {
   int status;          ///< exit status (-1 if killed by a signal)
@@ -23,4 +23,6 @@ inline Run sh(const std::string& cmd) {
 }
 
 /// The granagg binary under test (GRANAGG_BINARY, set by CMake) with `args`.
-inline Run runGranagg(const std::string& args) { return sh(std::string(GRANAGG_BINARY) + " " + args); }
+inline Run runGranagg(const std::string& args) {
+  return sh(std::string(GRANAGG_BINARY) + " " + args);
+}

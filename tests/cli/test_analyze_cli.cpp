@@ -5,10 +5,10 @@
 
 #include "RunCommand.h"
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "common/Csv.h"
 
@@ -25,7 +25,8 @@ fs::path mdRun(const fs::path& dir, const std::string& name, int seed) {
   std::ofstream(cfg) << "[input]\nversion = 1\n[system]\nN = 300\nseed = " << seed
                      << "\n[run]\nt_end = 1.0\n[output]\nframes_per_decade = 10\n";
   const fs::path out = dir / name;
-  const Run r = runGranagg("md --config " + cfg.string() + " --out " + out.string() + " -q --threads 1");
+  const Run r =
+      runGranagg("md --config " + cfg.string() + " --out " + out.string() + " -q --threads 1");
   INFO(r.output);
   REQUIRE(r.status == 0);
   return out;
@@ -36,7 +37,8 @@ std::string tinyDump(const fs::path& dir, bool cut) {
   const fs::path p = dir / (cut ? "cut.dump" : "ok.dump");
   std::ofstream out(p);
   for (int k = 0; k < 2; ++k) {
-    out << "ITEM: TIMESTEP\n" << 10 * k << "\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS pp pp pp\n0 6\n0 6\n0 6\n"
+    out << "ITEM: TIMESTEP\n"
+        << 10 * k << "\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS pp pp pp\n0 6\n0 6\n0 6\n"
         << "ITEM: ATOMS id x y z ix iy iz vx vy vz q\n";
     out << "1 1 1 1 0 0 0 0.1 0 0 0.01\n";
     if (cut && k == 1) break;
@@ -46,14 +48,16 @@ std::string tinyDump(const fs::path& dir, bool cut) {
 }
 }  // namespace
 
-TEST_CASE("analyze rejects bad input with exit status 2 and a message naming it", "[cli][analyze]") {
+TEST_CASE("analyze rejects bad input with exit status 2 and a message naming it",
+          "[cli][analyze]") {
   const fs::path dir = tempDir("bad");
   const std::string dump = tinyDump(dir, false);
   const std::string out = " --out " + (dir / "o").string();
   struct Case {
     std::string args, says;
   };
-  for (const Case& c : {Case{"analyze" + out, "runs"}, Case{"analyze " + (dir / "nosuch.h5").string() + out, "nosuch.h5"},
+  for (const Case& c : {Case{"analyze" + out, "runs"},
+                        Case{"analyze " + (dir / "nosuch.h5").string() + out, "nosuch.h5"},
                         Case{"analyze " + dump + out + " --grid-spacing -1", "spacing"},
                         Case{"analyze " + dump + out + " --grid-min-fill 2", "min_fill"},
                         Case{"analyze " + dump + out + " --tolerance -0.5", "tolerance"},
@@ -73,14 +77,17 @@ TEST_CASE("analyze rejects bad input with exit status 2 and a message naming it"
   fs::remove_all(dir);
 }
 
-TEST_CASE("analyze of a truncated dump fails naming file and frame; --allow-partial analyses the rest", "[cli][analyze]") {
+TEST_CASE(
+    "analyze of a truncated dump fails naming file and frame; --allow-partial analyses the rest",
+    "[cli][analyze]") {
   const fs::path dir = tempDir("cut");
   const std::string dump = tinyDump(dir, true);
   const Run r = runGranagg("analyze " + dump + " --out " + (dir / "o1").string() + " -q");
   CHECK(r.status == 1);
   CHECK_THAT(r.output, Catch::Contains("cut.dump") && Catch::Contains("frame 1"));
   CHECK_FALSE(fs::exists(dir / "o1" / "analysis.h5"));  // no half-written output left behind
-  const Run p = runGranagg("analyze " + dump + " --out " + (dir / "o2").string() + " --allow-partial");
+  const Run p =
+      runGranagg("analyze " + dump + " --out " + (dir / "o2").string() + " --allow-partial");
   INFO(p.output);
   CHECK(p.status == 0);
   CHECK_THAT(p.output, Catch::Contains("PARTIAL"));
@@ -90,32 +97,35 @@ TEST_CASE("analyze of a truncated dump fails naming file and frame; --allow-part
   const fs::path cut = dir / "cut.h5";
   fs::copy_file(run / "traj.h5", cut);
   fs::resize_file(cut, fs::file_size(cut) / 2);
-  const Run h = runGranagg("analyze " + cut.string() + " --out " + (dir / "o3").string() + " -q --allow-partial");
+  const Run h = runGranagg("analyze " + cut.string() + " --out " + (dir / "o3").string() +
+                           " -q --allow-partial");
   CHECK(h.status == 1);
   CHECK_THAT(h.output, Catch::Contains("cut.h5") && Catch::Contains("frame 0"));
   fs::remove_all(dir);
 }
 
-TEST_CASE("analyze of an md ensemble writes ensemble and per-run tables and analysis.h5", "[cli][analyze]") {
+TEST_CASE("analyze of an md ensemble writes ensemble and per-run tables and analysis.h5",
+          "[cli][analyze]") {
   const fs::path dir = tempDir("ens");
   const fs::path a = mdRun(dir, "a", 1), b = mdRun(dir, "b", 2);
   const fs::path out = dir / "out";
-  const std::string cmd = "analyze " + a.string() + " " + (b / "traj.h5").string() + " --out " + out.string() +
-                          " --write-grid --bootstrap 100 --threads 1";
+  const std::string cmd = "analyze " + a.string() + " " + (b / "traj.h5").string() + " --out " +
+                          out.string() + " --write-grid --bootstrap 100 --threads 1";
   const Run r = runGranagg(cmd);
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK_THAT(r.output, Catch::Contains("z (grid)") && Catch::Contains("bootstrap"));
-  for (const char* f : {"S_t.csv", "N_s_grid.csv", "N_s_particle.csv", "fisher.csv", "fisher_pooled.csv", "thermo.csv",
-                        "msd.csv", "speed_dist.csv", "nstick.csv", "fits.csv", "analysis.h5", "per_run/S_t.csv",
-                        "per_run/charge_speed.csv", "per_run/fits.csv"}) {
+  for (const char* f :
+       {"S_t.csv", "N_s_grid.csv", "N_s_particle.csv", "fisher.csv", "fisher_pooled.csv",
+        "thermo.csv", "msd.csv", "speed_dist.csv", "nstick.csv", "fits.csv", "analysis.h5",
+        "per_run/S_t.csv", "per_run/charge_speed.csv", "per_run/fits.csv"}) {
     INFO(f);
     CHECK(fs::exists(out / f));
   }
   const auto S = granagg::common::readCsv((out / "S_t.csv").string());
   const auto per_run = granagg::common::readCsv((out / "per_run" / "S_t.csv").string());
-  for (const char* c : {"t", "S_grid_mean", "S_grid_se", "S_particle_mean", "S_particle_se", "n_runs",
-                        "z_local_particle_of_mean"})
+  for (const char* c : {"t", "S_grid_mean", "S_grid_se", "S_particle_mean", "S_particle_se",
+                        "n_runs", "z_local_particle_of_mean"})
     CHECK_NOTHROW(S.column(c));
   CHECK(per_run.rows.size() == 2 * S.rows.size());  // same frame times in both runs
   CHECK(per_run.columns.front() == "run");
@@ -135,11 +145,12 @@ TEST_CASE("analyze of an md ensemble writes ensemble and per-run tables and anal
   CHECK(runGranagg(cmd + " -q --force").status == 0);
 
   if (sh("/usr/bin/python3 -c 'import h5py'").status == 0) {
-    const Run py = sh("/usr/bin/python3 -c \"import h5py; f = h5py.File('" + (out / "analysis.h5").string() +
-                      "'); g = f['runs/0/grid']; n = g.attrs['cells_per_side']; "
-                      "assert g['labels'].shape[1:] == (n, n, n), g['labels'].shape; "
-                      "assert g['labels'].shape[0] == len(f['runs/0/S_t/t']); "
-                      "assert 'S_grid_mean' in f['ensemble/S_t']; print('ok')\"");
+    const Run py =
+        sh("/usr/bin/python3 -c \"import h5py; f = h5py.File('" + (out / "analysis.h5").string() +
+           "'); g = f['runs/0/grid']; n = g.attrs['cells_per_side']; "
+           "assert g['labels'].shape[1:] == (n, n, n), g['labels'].shape; "
+           "assert g['labels'].shape[0] == len(f['runs/0/S_t/t']); "
+           "assert 'S_grid_mean' in f['ensemble/S_t']; print('ok')\"");
     INFO(py.output);
     CHECK(py.status == 0);
   } else {

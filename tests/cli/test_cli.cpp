@@ -4,13 +4,13 @@
 
 #include "RunCommand.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <array>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "TestUtil.h"
 
@@ -41,13 +41,15 @@ TEST_CASE("bad input gives one line naming the option and exit status 2", "[cli]
     const char* args;
     const char* says;
   };
-  for (const Case& c : {Case{"smol --beta -1", "--beta"}, Case{"smol --beta 0", "--beta"},
-                        Case{"smol --t-min -1", "--t-min"}, Case{"smol --t-end -5", "--t-end"},
-                        Case{"smol --method discrete --M 1", "--M"}, Case{"smol --kernel gaussian", "unknown kernel"},
-                        Case{"smol --method euler", "--method"}, Case{"smol --ratio 1", "--ratio"},
-                        Case{"smol --kernel multiplicative --t-end 2", "gel time"},
-                        Case{"smol zbeta --count 0", "--count"}, Case{"smol zbeta --beta-min -2", "--beta-min"},
-                        Case{"smol --no-such-option", "no-such-option"}, Case{"frobnicate", "frobnicate"}}) {
+  for (const Case& c :
+       {Case{"smol --beta -1", "--beta"}, Case{"smol --beta 0", "--beta"},
+        Case{"smol --t-min -1", "--t-min"}, Case{"smol --t-end -5", "--t-end"},
+        Case{"smol --method discrete --M 1", "--M"},
+        Case{"smol --kernel gaussian", "unknown kernel"}, Case{"smol --method euler", "--method"},
+        Case{"smol --ratio 1", "--ratio"},
+        Case{"smol --kernel multiplicative --t-end 2", "gel time"},
+        Case{"smol zbeta --count 0", "--count"}, Case{"smol zbeta --beta-min -2", "--beta-min"},
+        Case{"smol --no-such-option", "no-such-option"}, Case{"frobnicate", "frobnicate"}}) {
     INFO(c.args);
     const Run r = runGranagg(c.args);
     CHECK(r.status == 2);

@@ -3,14 +3,14 @@
 
 #include "RunCommand.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "md/io/H5mdReader.h"
 
@@ -44,7 +44,8 @@ TEST_CASE("md rejects bad configurations with a message naming the key, exit 2",
     CHECK(r.status == 2);
     CHECK_THAT(r.output, Catch::Contains(c.says));
   }
-  const Run unknown = runGranagg("md --config " + writeConfig(dir, "[system]\nN = 100\nNn = 5\n") + " -q");
+  const Run unknown =
+      runGranagg("md --config " + writeConfig(dir, "[system]\nN = 100\nNn = 5\n") + " -q");
   CHECK_THAT(unknown.output, Catch::Contains("run.toml:3"));
   CHECK(runGranagg("md --preset nosuch -q").status == 2);
   CHECK(runGranagg("md -q").status == 2);  // neither --config nor --preset
@@ -72,8 +73,8 @@ TEST_CASE("md writes a readable trajectory and refuses to overwrite it", "[cli][
   CHECK(again.status == 2);
   CHECK_THAT(again.output, Catch::Contains("--force"));
   if (fs::exists("/usr/bin/python3") && sh("/usr/bin/python3 -c 'import h5py'").status == 0) {
-    const Run check = sh("/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) + "/scripts/check_h5md.py " +
-                         (out / "traj.h5").string());
+    const Run check = sh("/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) +
+                         "/scripts/check_h5md.py " + (out / "traj.h5").string());
     INFO(check.output);
     CHECK(check.status == 0);
   } else {
@@ -88,11 +89,14 @@ TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   // uninterrupted to t = 1
   REQUIRE(runGranagg("md --config " + cfg + " --out " + (dir / "a").string() + " -q").status == 0);
   // interrupted at t = 0.5, then continued to t = 1
-  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.5 --out " + (dir / "b").string() + " -q").status == 0);
+  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.5 --out " + (dir / "b").string() +
+                     " -q")
+              .status == 0);
   const Run r = runGranagg("md --restart " + (dir / "b").string() + " --set run.t_end=1.0 -q");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()), rb((dir / "b" / "traj.h5").string());
+  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()),
+      rb((dir / "b" / "traj.h5").string());
   const auto fa = ra.readFrame(ra.frames() - 1), fb = rb.readFrame(rb.frames() - 1);
   CHECK(fa.step == fb.step);
   CHECK(fa.x == fb.x);
@@ -103,12 +107,15 @@ TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   fs::remove_all(dir);
 }
 
-TEST_CASE("md stops at a deep overlap naming step and particles and keeps the last checkpoint", "[cli][md]") {
+TEST_CASE("md stops at a deep overlap naming step and particles and keeps the last checkpoint",
+          "[cli][md]") {
   const fs::path dir = tempDir("abort");
   // max_overlap = 0.03 is reached by any impact faster than ~0.5 (xi_max ~ (5 v^2/(8E))^{2/5}):
   // the guard must fire within t = 1, after at least one step-based checkpoint
   const std::string cfg = writeConfig(
-      dir, std::string(SMALL) + "max_overlap = 0.03\n[output]\ncheckpoint_interval = 5\ncheckpoint_wall_seconds = 0.0\n");
+      dir,
+      std::string(SMALL) +
+          "max_overlap = 0.03\n[output]\ncheckpoint_interval = 5\ncheckpoint_wall_seconds = 0.0\n");
   const Run r = runGranagg("md --config " + cfg + " --out " + (dir / "o").string() + " -q");
   INFO(r.output);
   CHECK(r.status == 1);
@@ -120,17 +127,22 @@ TEST_CASE("md stops at a deep overlap naming step and particles and keeps the la
   fs::remove_all(dir);
 }
 
-TEST_CASE("md --restart continues bit for bit with charging and PPPM, and writes forces on request", "[cli][md]") {
+TEST_CASE("md --restart continues bit for bit with charging and PPPM, and writes forces on request",
+          "[cli][md]") {
   const fs::path dir = tempDir("restart_charged");
-  const std::string cfg = writeConfig(dir, std::string(SMALL) +
-                                               "[charging]\nmode = \"exchange\"\nQ = 0.1\n[coulomb]\nK = 1.0\n"
-                                               "[output]\nwrite_forces = true\n");
+  const std::string cfg =
+      writeConfig(dir, std::string(SMALL) +
+                           "[charging]\nmode = \"exchange\"\nQ = 0.1\n[coulomb]\nK = 1.0\n"
+                           "[output]\nwrite_forces = true\n");
   REQUIRE(runGranagg("md --config " + cfg + " --out " + (dir / "a").string() + " -q").status == 0);
-  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.5 --out " + (dir / "b").string() + " -q").status == 0);
+  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.5 --out " + (dir / "b").string() +
+                     " -q")
+              .status == 0);
   const Run r = runGranagg("md --restart " + (dir / "b").string() + " --set run.t_end=1.0 -q");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()), rb((dir / "b" / "traj.h5").string());
+  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()),
+      rb((dir / "b" / "traj.h5").string());
   const auto fa = ra.readFrame(ra.frames() - 1), fb = rb.readFrame(rb.frames() - 1);
   CHECK(fa.step == fb.step);
   CHECK(fa.x == fb.x);
@@ -141,11 +153,13 @@ TEST_CASE("md --restart continues bit for bit with charging and PPPM, and writes
   CHECK(q_abs > 0.0);  // charges were exchanged (and compared above)
   // per-particle forces in every frame, summing to zero (Newton's third law, mesh part included)
   if (fs::exists("/usr/bin/python3") && sh("/usr/bin/python3 -c 'import h5py'").status == 0) {
-    const Run check = sh("/usr/bin/python3 -c \"import h5py, numpy as np; f = h5py.File('" + (dir / "a" / "traj.h5").string() +
-                         "', 'r'); F = f['particles/all/force/value'][:]; P = f['particles/all/position/value']; "
-                         "assert F.shape == P.shape, (F.shape, P.shape); "
-                         "s = np.abs(F.sum(axis=1)).max() / max(np.abs(F).max(), 1e-300); assert s < 1e-9, s; "
-                         "assert np.abs(F[-1]).max() > 0; print('forces ok')\"");
+    const Run check =
+        sh("/usr/bin/python3 -c \"import h5py, numpy as np; f = h5py.File('" +
+           (dir / "a" / "traj.h5").string() +
+           "', 'r'); F = f['particles/all/force/value'][:]; P = f['particles/all/position/value']; "
+           "assert F.shape == P.shape, (F.shape, P.shape); "
+           "s = np.abs(F.sum(axis=1)).max() / max(np.abs(F).max(), 1e-300); assert s < 1e-9, s; "
+           "assert np.abs(F[-1]).max() > 0; print('forces ok')\"");
     INFO(check.output);
     CHECK(check.status == 0);
   }
@@ -157,9 +171,11 @@ TEST_CASE("md --threads sets the OpenMP thread count", "[cli][md]") {
   // through the runtime (an environment variable set later would be ignored).
   const fs::path dir = tempDir("threads");
   const std::string cfg = writeConfig(dir, SMALL);
-  const Run r = runGranagg("md --config " + cfg + " --set run.t_end=0.05 --threads 1 --out " + (dir / "a").string());
+  const Run r = runGranagg("md --config " + cfg + " --set run.t_end=0.05 --threads 1 --out " +
+                           (dir / "a").string());
   INFO(r.output);
   REQUIRE(r.status == 0);
-  if (r.output.find("OpenMP backend") != std::string::npos) CHECK_THAT(r.output, Catch::Contains("1 thread(s)"));
+  if (r.output.find("OpenMP backend") != std::string::npos)
+    CHECK_THAT(r.output, Catch::Contains("1 thread(s)"));
   fs::remove_all(dir);
 }

@@ -5,6 +5,7 @@
 
 #include "RunCommand.h"
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -14,7 +15,6 @@
 #include <random>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "analysis/io/Hdf5Lite.h"
@@ -22,16 +22,16 @@
 
 #include "TestUtil.h"
 
-using granagg::test::tempDir;
 using granagg::test::slurp;
+using granagg::test::tempDir;
 
 namespace fs = std::filesystem;
 
 namespace {
 
 /// Writes a CSV: header row, then rows.
-void writeCsv(const fs::path& p, const std::string& header, const std::vector<std::vector<double>>& rows,
-              const std::string& comment = "") {
+void writeCsv(const fs::path& p, const std::string& header,
+              const std::vector<std::vector<double>>& rows, const std::string& comment = "") {
   std::ofstream o(p);
   if (!comment.empty()) o << "# " << comment << "\n";
   o << header << "\n";
@@ -68,7 +68,8 @@ std::map<std::string, double> readRow(const fs::path& p) {
 std::vector<std::pair<double, double>> smolCurve(const fs::path& dir, double beta) {
   const fs::path out = dir / "smol.csv";
   const Run r = runGranagg("smol --beta " + granagg::common::formatReal(beta) +
-                           " --t-min 0.05 --t-end 1e6 --per-decade 20 --s-end 2000 -q --force -o " + out.string());
+                           " --t-min 0.05 --t-end 1e6 --per-decade 20 --s-end 2000 -q --force -o " +
+                           out.string());
   INFO(r.output);
   REQUIRE(r.status == 0);
   const auto t = granagg::common::readCsv(out.string());
@@ -79,13 +80,15 @@ std::vector<std::pair<double, double>> smolCurve(const fs::path& dir, double bet
 
 }  // namespace
 
-TEST_CASE("fit-beta rejects bad input with exit status 2 and a one-line message", "[cli][fitbeta]") {
+TEST_CASE("fit-beta rejects bad input with exit status 2 and a one-line message",
+          "[cli][fitbeta]") {
   const fs::path dir = tempDir("bad");
   std::vector<std::vector<double>> good;
   for (int i = 1; i <= 20; ++i) good.push_back({0.5 * i, std::pow(0.5 * i, 1.3)});
   writeCsv(dir / "good.csv", "t,S", good);
   writeCsv(dir / "no_t.csv", "time,S", good);
-  writeCsv(dir / "two.csv", "t,A,B", {{1, 1, 1}, {2, 2, 2}, {3, 3, 3}, {4, 4, 4}, {5, 5, 5}, {6, 6, 6}});
+  writeCsv(dir / "two.csv", "t,A,B",
+           {{1, 1, 1}, {2, 2, 2}, {3, 3, 3}, {4, 4, 4}, {5, 5, 5}, {6, 6, 6}});
   auto bad = good;
   bad[7][0] = bad[6][0];
   writeCsv(dir / "tie.csv", "t,S", bad);
@@ -149,7 +152,8 @@ TEST_CASE("fit-beta recovers z of an exact power law exactly", "[cli][fitbeta]")
     rows.push_back({t, 2.0 * std::pow(t, 1.3)});
   }
   writeCsv(dir / "S.csv", "t,S", rows);
-  const Run r = runGranagg("fit-beta " + (dir / "S.csv").string() + " --no-curve-fit --out " + (dir / "o").string());
+  const Run r = runGranagg("fit-beta " + (dir / "S.csv").string() + " --no-curve-fit --out " +
+                           (dir / "o").string());
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK_THAT(r.output, Catch::Contains("paper: 1.21 +- 0.04 neutral, 1.49 +- 0.012 charged"));
@@ -160,7 +164,8 @@ TEST_CASE("fit-beta recovers z of an exact power law exactly", "[cli][fitbeta]")
   CHECK(1.3 <= row.at("z_high"));
   CHECK(row.at("n_points") == 41);
   CHECK(row.at("t0") == Approx(1.0));
-  CHECK(row.at("beta_from_z") > 1.5);  // S = 2..800: the mean field's z over that range is 1.3 near beta = 3.5
+  CHECK(row.at("beta_from_z") >
+        1.5);  // S = 2..800: the mean field's z over that range is 1.3 near beta = 3.5
   CHECK(row.at("beta_from_z") < 6.0);
   CHECK(std::isnan(row.at("beta_fit")));  // --no-curve-fit
   CHECK_FALSE(fs::exists(dir / "o" / "fit_curve.csv"));
@@ -168,13 +173,17 @@ TEST_CASE("fit-beta recovers z of an exact power law exactly", "[cli][fitbeta]")
   CHECK_THAT(json, Catch::Contains("\"beta_fit\": null"));
   CHECK_THAT(json, Catch::Contains("\"z_interval_method\": \"student-t\""));
   // the same folder again: refused without --force, accepted with it
-  CHECK(runGranagg("fit-beta " + (dir / "S.csv").string() + " -q --no-curve-fit --out " + (dir / "o").string()).status == 2);
-  CHECK(runGranagg("fit-beta " + (dir / "S.csv").string() + " -q --no-curve-fit --force --out " + (dir / "o").string())
+  CHECK(runGranagg("fit-beta " + (dir / "S.csv").string() + " -q --no-curve-fit --out " +
+                   (dir / "o").string())
+            .status == 2);
+  CHECK(runGranagg("fit-beta " + (dir / "S.csv").string() + " -q --no-curve-fit --force --out " +
+                   (dir / "o").string())
             .status == 0);
   fs::remove_all(dir);
 }
 
-TEST_CASE("fit-beta recovers beta = 2.5 from noisy mean-field S(t) given as CSV", "[cli][fitbeta]") {
+TEST_CASE("fit-beta recovers beta = 2.5 from noisy mean-field S(t) given as CSV",
+          "[cli][fitbeta]") {
   // S = S_c S_MF(t / tau_c; 2.5) exp(0.03 eps), S_c = 1.4, tau_c = 6: the curve fit's interval
   // contains 2.5, S_c and tau_c; fit_curve.csv holds the fitted curve beside the data.
   const fs::path dir = tempDir("recover");
@@ -183,7 +192,8 @@ TEST_CASE("fit-beta recovers beta = 2.5 from noisy mean-field S(t) given as CSV"
   std::vector<std::vector<double>> rows;
   for (const auto& [t, S] : c) rows.push_back({6.0 * t, 1.4 * S * std::exp(0.03 * eps())});
   writeCsv(dir / "S.csv", "t,S_md", rows, "made by test_fit_beta_cli from granagg smol --beta 2.5");
-  const Run r = runGranagg("fit-beta " + (dir / "S.csv").string() + " --out " + (dir / "o").string());
+  const Run r =
+      runGranagg("fit-beta " + (dir / "S.csv").string() + " --out " + (dir / "o").string());
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK_THAT(r.output, Catch::Contains("beta from the curve fit"));
@@ -197,26 +207,29 @@ TEST_CASE("fit-beta recovers beta = 2.5 from noisy mean-field S(t) given as CSV"
   CHECK(row.at("tau_c_low") <= 6.0);
   CHECK(6.0 <= row.at("tau_c_high"));
   CHECK(row.at("chi2_dof") == Approx(0.03 * 0.03).epsilon(0.5));
-  // beta from z at the data's S: biased low here, since S_c = 1.4 puts the mean field's S range 1.4x
-  // higher than the data's; at S / S_c it is consistent.
+  // beta from z at the data's S: biased low here, since S_c = 1.4 puts the mean field's S
+  // range 1.4x higher than the data's; at S / S_c it is consistent.
   CHECK(row.at("beta_from_z") == Approx(2.5).margin(0.3));
-  INFO("beta_from_z_scaled " << row.at("beta_from_z_scaled") << " [" << row.at("beta_from_z_scaled_low") << ", "
+  INFO("beta_from_z_scaled " << row.at("beta_from_z_scaled") << " ["
+                             << row.at("beta_from_z_scaled_low") << ", "
                              << row.at("beta_from_z_scaled_high") << "]");
   CHECK(row.at("beta_from_z_scaled_low") <= 2.5);
   CHECK(2.5 <= row.at("beta_from_z_scaled_high"));
   const auto curve = granagg::common::readCsv((dir / "o" / "fit_curve.csv").string());
-  CHECK(curve.columns == std::vector<std::string>{"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"});
+  CHECK(curve.columns ==
+        std::vector<std::string>{"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"});
   REQUIRE(curve.rows.size() == rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     CHECK(curve.rows[i][1] == Approx(rows[i][1]).epsilon(1e-12));
-    CHECK(std::fabs(std::log(curve.rows[i][2] / rows[i][1])) < 0.15);  // within 5 sigma of the noise
+    CHECK(std::fabs(std::log(curve.rows[i][2] / rows[i][1])) <
+          0.15);  // within 5 sigma of the noise
   }
   // beta = 2 grows more slowly, beta = 3 faster, than the fitted 2.5 at late times
   CHECK(curve.rows.back()[3] < curve.rows.back()[2]);
   CHECK(curve.rows.back()[4] > curve.rows.back()[2]);
   const std::string json = slurp(dir / "o" / "fit_beta.json");
-  for (const char* key : {"\"z\":", "\"beta_from_z\":", "\"beta_fit\":", "\"S_c\":", "\"tau_c\":", "\"chi2_dof\":",
-                          "\"window_rule\":", "\"paper_z_charged\": 1.49"})
+  for (const char* key : {"\"z\":", "\"beta_from_z\":", "\"beta_fit\":", "\"S_c\":", "\"tau_c\":",
+                          "\"chi2_dof\":", "\"window_rule\":", "\"paper_z_charged\": 1.49"})
     CHECK_THAT(json, Catch::Contains(key));
   fs::remove_all(dir);
 }
@@ -252,10 +265,12 @@ TEST_CASE("fit-beta reads run columns, analyze folders and analysis.h5", "[cli][
   fs::create_directories(dir / "an" / "per_run");
   std::vector<std::vector<double>> ens{{0.0, 1.0, 0.0, R}}, per;
   for (std::size_t i = 0; i < t.size(); ++i) ens.push_back({t[i], mean[i], 0.1, R});
-  writeCsv(dir / "an" / "S_t.csv", "t,S_grid_mean,S_grid_se,n_runs", ens, "command = granagg analyze");
+  writeCsv(dir / "an" / "S_t.csv", "t,S_grid_mean,S_grid_se,n_runs", ens,
+           "command = granagg analyze");
   for (int r = 0; r < R; ++r) {
     per.push_back({static_cast<double>(r), 0.0, 1.0});
-    for (std::size_t i = 0; i < t.size(); ++i) per.push_back({static_cast<double>(r), t[i], runs[r][i]});
+    for (std::size_t i = 0; i < t.size(); ++i)
+      per.push_back({static_cast<double>(r), t[i], runs[r][i]});
   }
   writeCsv(dir / "an" / "per_run" / "S_t.csv", "run,t,S_grid", per);
   // (c)
@@ -268,21 +283,24 @@ TEST_CASE("fit-beta reads run columns, analyze folders and analysis.h5", "[cli][
     {
       h5::Handle g = h5::createGroup(f.get(), "/ensemble/S_t", "test");
       h5::writeDataset(g.get(), "t", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, t.data(), "test");
-      h5::writeDataset(g.get(), "S_grid_mean", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, mean.data(), "test");
+      h5::writeDataset(g.get(), "S_grid_mean", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, mean.data(),
+                       "test");
     }
     for (int r = 0; r < R; ++r) {
       h5::Handle g = h5::createGroup(f.get(), "/runs/" + std::to_string(r) + "/S_t", "test");
       h5::writeDataset(g.get(), "t", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, t.data(), "test");
-      h5::writeDataset(g.get(), "S_grid", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, runs[r].data(), "test");
+      h5::writeDataset(g.get(), "S_grid", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, runs[r].data(),
+                       "test");
     }
   }
 
   std::map<std::string, std::map<std::string, double>> results;
-  for (const auto& [name, input] : std::map<std::string, std::string>{{"a", (dir / "wide.csv").string() + " --column S_run"},
-                                                                       {"b", (dir / "an").string()},
-                                                                       {"c", (dir / "analysis.h5").string()}}) {
-    const Run r = runGranagg("fit-beta " + input + (name == "a" ? "" : " --no-curve-fit") + " --out " +
-                             (dir / ("o" + name)).string());
+  for (const auto& [name, input] :
+       std::map<std::string, std::string>{{"a", (dir / "wide.csv").string() + " --column S_run"},
+                                          {"b", (dir / "an").string()},
+                                          {"c", (dir / "analysis.h5").string()}}) {
+    const Run r = runGranagg("fit-beta " + input + (name == "a" ? "" : " --no-curve-fit") +
+                             " --out " + (dir / ("o" + name)).string());
     INFO(name << ": " << r.output);
     REQUIRE(r.status == 0);
     CHECK_THAT(r.output, Catch::Contains("5 runs"));
@@ -290,13 +308,15 @@ TEST_CASE("fit-beta reads run columns, analyze folders and analysis.h5", "[cli][
     results[name] = readRow(dir / ("o" + name) / "fit_beta.csv");
     CHECK(results[name].at("n_runs") == R);
   }
-  for (const char* key : {"z", "z_low", "z_high", "t0", "t1", "beta_from_z", "beta_from_z_low", "beta_from_z_high"}) {
+  for (const char* key :
+       {"z", "z_low", "z_high", "t0", "t1", "beta_from_z", "beta_from_z_low", "beta_from_z_high"}) {
     INFO(key);
     CHECK(results["b"].at(key) == Approx(results["a"].at(key)).epsilon(1e-12));
     CHECK(results["c"].at(key) == Approx(results["a"].at(key)).epsilon(1e-12));
   }
   const auto& a = results["a"];
-  INFO("beta_fit " << a.at("beta_fit") << " [" << a.at("beta_fit_low") << ", " << a.at("beta_fit_high") << "]");
+  INFO("beta_fit " << a.at("beta_fit") << " [" << a.at("beta_fit_low") << ", "
+                   << a.at("beta_fit_high") << "]");
   CHECK(a.at("beta_fit_low") <= 3.0);
   CHECK(3.0 <= a.at("beta_fit_high"));
   CHECK(a.at("beta_fit_high") - a.at("beta_fit_low") < 0.3);

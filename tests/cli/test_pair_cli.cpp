@@ -6,39 +6,45 @@
 
 #include "RunCommand.h"
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include "TestUtil.h"
 
-using granagg::test::tempDir;
 using granagg::test::slurp;
+using granagg::test::tempDir;
 
 namespace fs = std::filesystem;
 
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("pair rejects bad input with exit status 2 and a message naming it", "[cli][pair]") {
   const fs::path dir = tempDir("bad");
   const fs::path cfg = dir / "bad.toml";
-  std::ofstream(cfg) << "[input]\nversion = 1\n[pair]\nK = [0.0]\nrunz = 2\n[md]\npreset = \"quick\"\n";
+  std::ofstream(cfg)
+      << "[input]\nversion = 1\n[pair]\nK = [0.0]\nrunz = 2\n[md]\npreset = \"quick\"\n";
   const fs::path nomd = dir / "nomd.toml";
   std::ofstream(nomd) << "[pair]\nK = [0.0]\n";
   const std::string out = " --out " + (dir / "o").string();
   struct Case {
     std::string args, says;
   };
-  for (const Case& c : {Case{"pair --preset nosuch" + out, "nosuch"}, Case{"pair --preset tiny --runs 0" + out, "--runs"},
-                        Case{"pair --preset tiny --K -1" + out, "--K"}, Case{"pair --preset tiny --K 0,abc" + out, "--K"},
-                        Case{"pair --preset tiny --K 5,5" + out, "twice"}, Case{"pair --preset tiny --jobs -2" + out, "--jobs"},
-                        Case{"pair --preset tiny --emit-batch pbs" + out, "--emit-batch"}, Case{"pair" + out, "--preset"},
-                        Case{"pair --preset tiny --config " + cfg.string() + out, "--preset"},
-                        Case{"pair --config " + cfg.string() + out, "runz"}, Case{"pair --config " + nomd.string() + out, "[md]"},
-                        Case{"pair --config " + (dir / "missing.toml").string() + out, "missing.toml"}}) {
+  for (const Case& c :
+       {Case{"pair --preset nosuch" + out, "nosuch"},
+        Case{"pair --preset tiny --runs 0" + out, "--runs"},
+        Case{"pair --preset tiny --K -1" + out, "--K"},
+        Case{"pair --preset tiny --K 0,abc" + out, "--K"},
+        Case{"pair --preset tiny --K 5,5" + out, "twice"},
+        Case{"pair --preset tiny --jobs -2" + out, "--jobs"},
+        Case{"pair --preset tiny --emit-batch pbs" + out, "--emit-batch"},
+        Case{"pair" + out, "--preset"},
+        Case{"pair --preset tiny --config " + cfg.string() + out, "--preset"},
+        Case{"pair --config " + cfg.string() + out, "runz"},
+        Case{"pair --config " + nomd.string() + out, "[md]"},
+        Case{"pair --config " + (dir / "missing.toml").string() + out, "missing.toml"}}) {
     INFO(c.args);
     const Run r = runGranagg(c.args + " -q");
     CHECK(r.status == 2);
@@ -61,21 +67,23 @@ TEST_CASE("pair --emit-batch slurm writes a job-array script and runs nothing", 
   INFO(r.output);
   REQUIRE(r.status == 0);
   const std::string s = slurp(out / "batch.slurm");
-  CHECK_THAT(s, Catch::Contains("#SBATCH --array=0-5"));      // 2 values of K x 3 runs
-  CHECK_THAT(s, Catch::Contains("--run-index"));              // each task runs one run
-  CHECK_THAT(s, Catch::Contains("--dependency=afterok"));     // then the follow-up job
+  CHECK_THAT(s, Catch::Contains("#SBATCH --array=0-5"));   // 2 values of K x 3 runs
+  CHECK_THAT(s, Catch::Contains("--run-index"));           // each task runs one run
+  CHECK_THAT(s, Catch::Contains("--dependency=afterok"));  // then the follow-up job
   CHECK_THAT(s, Catch::Contains((out / "config" / "pair.toml").string()));
   CHECK(fs::exists(out / "config" / "md_K0.toml"));
   CHECK(fs::exists(out / "config" / "md_K5.toml"));
   CHECK_FALSE(fs::exists(out / "runs"));
   // The resolved configuration reads back (what resume and the batch tasks use).
-  const Run again = runGranagg("pair --config " + (out / "config" / "pair.toml").string() + " --emit-batch slurm -q --out " + out.string());
+  const Run again = runGranagg("pair --config " + (out / "config" / "pair.toml").string() +
+                               " --emit-batch slurm -q --out " + out.string());
   INFO(again.output);
   CHECK(again.status == 0);
   fs::remove_all(dir);
 }
 
-TEST_CASE("pair on the tiny preset makes every output and resumes without redoing finished runs", "[cli][pair]") {
+TEST_CASE("pair on the tiny preset makes every output and resumes without redoing finished runs",
+          "[cli][pair]") {
   const fs::path dir = tempDir("e2e");
   const fs::path out = dir / "study";
   const std::string cmd = "pair --preset tiny --jobs 2 --out " + out.string();
@@ -90,15 +98,16 @@ TEST_CASE("pair on the tiny preset makes every output and resumes without redoin
       CHECK(fs::exists(rd / "traj.h5"));
       CHECK(fs::exists(rd / "done.json"));
     }
-    for (const char* t : {"S_t", "N_s_grid", "N_s_particle", "fisher", "thermo", "msd", "speed_dist", "nstick", "fits"})
+    for (const char* t : {"S_t", "N_s_grid", "N_s_particle", "fisher", "thermo", "msd",
+                          "speed_dist", "nstick", "fits"})
       CHECK(fs::exists(out / "analysis" / k / (std::string(t) + ".csv")));
     CHECK(fs::exists(out / "analysis" / k / "per_run" / "charge_speed.csv"));
     CHECK(fs::exists(out / "analysis" / k / "analysis.h5"));
   }
   for (const char* t : {"S_beta2.csv", "S_beta3.csv", "zbeta.csv", "cooling.csv", "charging.csv"})
     CHECK(fs::exists(out / "meanfield" / t));
-  for (const char* f : {"fig1_temperature", "fig2_snapshots", "fig3_nstick", "fig4_charge", "fig5_growth", "fig6_meanfield",
-                        "fig7_speed", "fig8_charge_speed"}) {
+  for (const char* f : {"fig1_temperature", "fig2_snapshots", "fig3_nstick", "fig4_charge",
+                        "fig5_growth", "fig6_meanfield", "fig7_speed", "fig8_charge_speed"}) {
     CHECK(fs::exists(out / "figures" / (std::string(f) + ".png")));
     CHECK(fs::exists(out / "figures" / (std::string(f) + ".pdf")));
   }
@@ -106,16 +115,20 @@ TEST_CASE("pair on the tiny preset makes every output and resumes without redoin
   CHECK_THAT(report, Catch::Contains("data:image/png;base64,"));
   CHECK_THAT(report, Catch::Contains("granagg md --config"));
   const std::string summary = slurp(out / "summary.json");
-  for (const char* key : {"\"z_analyze\"", "\"beta_fit\"", "\"z_neutral\": 1.21", "\"z_charged\": 1.49", "\"z_meanfield_beta2\": 1.19",
-                          "\"timings_s\"", "\"commands\"", "\"K\": 5"})
+  for (const char* key :
+       {"\"z_analyze\"", "\"beta_fit\"", "\"z_neutral\": 1.21", "\"z_charged\": 1.49",
+        "\"z_meanfield_beta2\": 1.19", "\"timings_s\"", "\"commands\"", "\"K\": 5"})
     CHECK_THAT(summary, Catch::Contains(key));
   // fit-beta either fitted (its outputs are there) or said why these data allow no fit.
-  if (!fs::exists(out / "fit" / "K0" / "fit_beta.json")) CHECK_THAT(summary, Catch::Contains("fit"));
+  if (!fs::exists(out / "fit" / "K0" / "fit_beta.json"))
+    CHECK_THAT(summary, Catch::Contains("fit"));
   CHECK_THAT(r.output, Catch::Contains("paper: 1.21 +- 0.04"));
 
   // Interrupt: one run lost its completion marker (killed after the last checkpoint), another
   // run's folder is gone (killed before anything was written).
-  const auto mtime = [&](const char* k, int run) { return fs::last_write_time(out / "runs" / k / ("run" + std::to_string(run)) / "traj.h5"); };
+  const auto mtime = [&](const char* k, int run) {
+    return fs::last_write_time(out / "runs" / k / ("run" + std::to_string(run)) / "traj.h5");
+  };
   const auto t_k0r0 = mtime("K0", 0), t_k5r0 = mtime("K5", 0);
   fs::remove(out / "runs" / "K0" / "run1" / "done.json");
   fs::remove_all(out / "runs" / "K5" / "run1");

@@ -10,7 +10,8 @@
 
 using granagg::common::Box;
 
-TEST_CASE("minimumImageWrapped equals minimumImage for differences of wrapped coordinates", "[box]") {
+TEST_CASE("minimumImageWrapped equals minimumImage for differences of wrapped coordinates",
+          "[box]") {
   const Box box{34.62};
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, box.L);
@@ -27,7 +28,10 @@ TEST_CASE("minimumImageWrapped equals minimumImage for differences of wrapped co
   CHECK(std::abs(box.minimumImageWrapped(0.5 * box.L)) == 0.5 * box.L);
 }
 
-TEST_CASE("the branchless minimum image and the three-coordinate inside test agree with their plain forms", "[box]") {
+TEST_CASE(
+    "the branchless minimum image and the three-coordinate inside test agree with their plain "
+    "forms",
+    "[box]") {
   const Box box{34.62};
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> u(0.0, box.L), wide(-0.1 * box.L, 1.1 * box.L);
@@ -41,7 +45,8 @@ TEST_CASE("the branchless minimum image and the three-coordinate inside test agr
   const double top = std::nextafter(box.L, 0.0), tiny = -std::numeric_limits<double>::denorm_min();
   for (double dx : {top, -top, 0.5 * box.L, -0.5 * box.L, 0.0})
     CHECK(box.minimumImageWrappedBranchless(dx) == box.minimumImageWrapped(dx));
-  // the faces: L and anything below 0 are outside; 0 itself is left to the full path (reported outside)
+  // the faces: L and anything below 0 are outside; 0 itself is left to the full path (reported
+  // outside)
   CHECK(box.insideAll(top, top, top));
   CHECK_FALSE(box.insideAll(box.L, 1.0, 1.0));
   CHECK_FALSE(box.insideAll(1.0, tiny, 1.0));
@@ -49,7 +54,8 @@ TEST_CASE("the branchless minimum image and the three-coordinate inside test agr
   CHECK_FALSE(box.insideAll(0.0, 1.0, 1.0));
 }
 
-TEST_CASE("wrap returns a coordinate in [0, L) and the image shift, fast path and general case", "[box]") {
+TEST_CASE("wrap returns a coordinate in [0, L) and the image shift, fast path and general case",
+          "[box]") {
   const Box box{10.0};
   struct Case {
     double x;
@@ -57,8 +63,9 @@ TEST_CASE("wrap returns a coordinate in [0, L) and the image shift, fast path an
     int images;
   };
   const double tiny = 1e-17;
-  for (const Case c : {Case{3.5, 3.5, 0}, Case{0.0, 0.0, 0}, Case{10.0, 0.0, 1}, Case{12.5, 2.5, 1}, Case{-0.5, 9.5, -1},
-                       Case{-10.0, 0.0, -1}, Case{25.0, 5.0, 2}, Case{-25.0, 5.0, -3}, Case{-tiny, 0.0, 0}}) {
+  for (const Case c : {Case{3.5, 3.5, 0}, Case{0.0, 0.0, 0}, Case{10.0, 0.0, 1}, Case{12.5, 2.5, 1},
+                       Case{-0.5, 9.5, -1}, Case{-10.0, 0.0, -1}, Case{25.0, 5.0, 2},
+                       Case{-25.0, 5.0, -3}, Case{-tiny, 0.0, 0}}) {
     double x = c.x;
     const int n = box.wrap(x);
     INFO("x = " << c.x);

@@ -1,10 +1,10 @@
 // CSV tables with provenance: round trip, refusal to overwrite, clear errors on malformed input.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
 #include <cstdio>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "common/Csv.h"
 #include "common/Version.h"
@@ -15,8 +15,7 @@ using granagg::test::tempPath;
 
 using namespace granagg::common;
 
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("CSV round trip keeps provenance, columns and exact values", "[common][csv]") {
   const std::string path = tempPath("roundtrip.csv");
@@ -58,12 +57,14 @@ TEST_CASE("malformed CSV input names the file and line", "[common][csv]") {
     std::ofstream f(path);
     f << "# comment\nt,S\n1,2\n2,abc\n";
   }
-  CHECK_THROWS_WITH(readCsv(path), Catch::Contains(path + ":4") && Catch::Contains("'abc' is not a number"));
+  CHECK_THROWS_WITH(readCsv(path),
+                    Catch::Contains(path + ":4") && Catch::Contains("'abc' is not a number"));
   {
     std::ofstream f(path);
     f << "t,S\n1,2,3\n";
   }
-  CHECK_THROWS_WITH(readCsv(path), Catch::Contains(path + ":2") && Catch::Contains("expected 2 fields"));
+  CHECK_THROWS_WITH(readCsv(path),
+                    Catch::Contains(path + ":2") && Catch::Contains("expected 2 fields"));
   std::remove(path.c_str());
   CHECK_THROWS_WITH(readCsv(path), Catch::Contains("cannot open"));
 }

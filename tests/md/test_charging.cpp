@@ -31,8 +31,10 @@ double meanMagnitude(const ChargeExchange::Params& p, double v) {
 }
 }  // namespace
 
-TEST_CASE("charge exchange reproduces the formula's mean and range and is antisymmetric", "[md][charging]") {
-  ChargeExchange::Params p;  // defaults: Q = 1, kappa = 0.83, Psi1 in [0.1, 3.1623], Psi2 in +-0.05 kappa
+TEST_CASE("charge exchange reproduces the formula's mean and range and is antisymmetric",
+          "[md][charging]") {
+  ChargeExchange::Params
+      p;  // defaults: Q = 1, kappa = 0.83, Psi1 in [0.1, 3.1623], Psi2 in +-0.05 kappa
   p.seed = 42;
   for (double v : {0.05, 0.3, 1.0, 3.0}) {
     INFO("impact speed " << v);
@@ -83,7 +85,10 @@ MdConfig chargedGas(int N, std::uint64_t seed) {
 }
 }  // namespace
 
-TEST_CASE("charged gas: total charge zero, charges independent of the thread count, growth then saturation", "[md][charging]") {
+TEST_CASE(
+    "charged gas: total charge zero, charges independent of the thread count, growth then "
+    "saturation",
+    "[md][charging]") {
   const MdConfig c = chargedGas(1000, 5);
   const Frame init = Engine::randomInitialState(c);
   const int threads = omp_get_max_threads();
@@ -115,22 +120,24 @@ TEST_CASE("charged gas: total charge zero, charges independent of the thread cou
   for (std::size_t k = 1; k < q_mark.size(); ++k) CHECK(q_mark[k] > q_mark[k - 1]);
   // saturation: as the gas cools both the collision rate (~T^{1/2}) and |dq| (~T^kappa) fall, so
   // the increment over a doubling of time shrinks; the rate law d<|q|>/dt ~ t^{-5/6 - 5 kappa/3}
-  // (design.md) makes each doubling's increment ~2^{-1.2} of the previous one, ~0.08 after three doublings. Required here: the
-  // last doubling adds less than a quarter of what the first did (a gas at constant temperature would
-  // add ~2^{1/2} times more, random-walk growth).
+  // (design.md) makes each doubling's increment ~2^{-1.2} of the previous one, ~0.08 after three
+  // doublings. Required here: the last doubling adds less than a quarter of what the first did (a
+  // gas at constant temperature would add ~2^{1/2} times more, random-walk growth).
   const double first = q_mark[1] - q_mark[0], last = q_mark[4] - q_mark[3];
-  UNSCOPED_INFO("mean |q|: " << q_mark[0] << " " << q_mark[1] << " " << q_mark[2] << " " << q_mark[3] << " " << q_mark[4]);
+  UNSCOPED_INFO("mean |q|: " << q_mark[0] << " " << q_mark[1] << " " << q_mark[2] << " "
+                             << q_mark[3] << " " << q_mark[4]);
   CHECK(last < 0.25 * first);  // measured (seed 5): 0.024 against 0.68
 }
 
-
-TEST_CASE("initial charges: monopolar, bipolar with zero net charge, fixed mode keeps them", "[md][charging]") {
+TEST_CASE("initial charges: monopolar, bipolar with zero net charge, fixed mode keeps them",
+          "[md][charging]") {
   MdConfig c = chargedGas(501, 3);
   c.charging.initial = "bipolar";
   c.charging.q0 = 2.0;
   const Frame f = Engine::randomInitialState(c);
   int plus = 0, minus = 0, zero = 0;
-  for (double q : f.charge) (q == 2.0 ? plus : q == -2.0 ? minus : zero) += (q == 0.0 || std::fabs(q) == 2.0);
+  for (double q : f.charge)
+    (q == 2.0 ? plus : q == -2.0 ? minus : zero) += (q == 0.0 || std::fabs(q) == 2.0);
   CHECK(plus == 250);
   CHECK(minus == 250);
   CHECK(zero == 1);
@@ -145,8 +152,10 @@ TEST_CASE("initial charges: monopolar, bipolar with zero net charge, fixed mode 
   CHECK(std::all_of(h.charge.begin(), h.charge.end(), [](double q) { return q == 2.0; }));
 }
 
-TEST_CASE("a charging gas depends on K and Q only through K Q^2: (K, Q) and (K/4, 2Q) give one "
-          "trajectory", "[md][charging][coulomb]") {
+TEST_CASE(
+    "a charging gas depends on K and Q only through K Q^2: (K, Q) and (K/4, 2Q) give one "
+    "trajectory",
+    "[md][charging][coulomb]") {
   // Charges start at zero and every exchange is Q times a draw that does not involve Q
   // (ChargeExchange.h), so doubling Q doubles every charge; the Coulomb force K q_i q_j ... is then
   // unchanged at K/4. Both scalings are by powers of 2, exact in floating point, so the symmetry

@@ -2,6 +2,8 @@
 // checkpoint), and clear errors for truncated, corrupted and foreign files.
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -10,18 +12,16 @@
 #include <limits>
 #include <random>
 #include <string>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "md/io/Checkpoint.h"
 #include "md/io/H5mdWriter.h"
 
 #include "TestUtil.h"
 
-using granagg::test::tempPath;
 using granagg::test::sameBits;
 using granagg::test::slurp;
 using granagg::test::spit;
+using granagg::test::tempPath;
 
 using namespace granagg::md;
 
@@ -69,15 +69,18 @@ Checkpoint makeCheckpoint(std::size_t n, unsigned seed) {
 bool sameCheckpoint(const Checkpoint& a, const Checkpoint& b) {
   const Frame &s = a.state, &t = b.state;
   const CheckpointExtra &e = a.extra, &f = b.extra;
-  return s.step == t.step && sameBits(s.time, t.time) && sameBits(s.box, t.box) && sameBits(s.x, t.x) &&
-         sameBits(s.y, t.y) && sameBits(s.z, t.z) && sameBits(s.vx, t.vx) && sameBits(s.vy, t.vy) &&
-         sameBits(s.vz, t.vz) && sameBits(s.charge, t.charge) && sameBits(s.ix, t.ix) && sameBits(s.iy, t.iy) &&
-         sameBits(s.iz, t.iz) && sameBits(e.fx, f.fx) && sameBits(e.fy, f.fy) && sameBits(e.fz, f.fz) &&
+  return s.step == t.step && sameBits(s.time, t.time) && sameBits(s.box, t.box) &&
+         sameBits(s.x, t.x) && sameBits(s.y, t.y) && sameBits(s.z, t.z) && sameBits(s.vx, t.vx) &&
+         sameBits(s.vy, t.vy) && sameBits(s.vz, t.vz) && sameBits(s.charge, t.charge) &&
+         sameBits(s.ix, t.ix) && sameBits(s.iy, t.iy) && sameBits(s.iz, t.iz) &&
+         sameBits(e.fx, f.fx) && sameBits(e.fy, f.fy) && sameBits(e.fz, f.fz) &&
          sameBits(e.dt, f.dt) && e.config_toml == f.config_toml && e.seed == f.seed &&
          e.frames_written == f.frames_written && e.next_frame_index == f.next_frame_index &&
          e.int_scalars == f.int_scalars && e.real_scalars.size() == f.real_scalars.size() &&
          std::equal(e.real_scalars.begin(), e.real_scalars.end(), f.real_scalars.begin(),
-                    [](const auto& p, const auto& q) { return p.first == q.first && sameBits(p.second, q.second); });
+                    [](const auto& p, const auto& q) {
+                      return p.first == q.first && sameBits(p.second, q.second);
+                    });
 }
 
 bool fileExists(const std::string& p) {
@@ -128,10 +131,12 @@ TEST_CASE("checkpoint arguments are validated", "[md][io]") {
   Checkpoint c = makeCheckpoint(10, 3);
   Checkpoint bad = c;
   bad.extra.fy.pop_back();
-  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra), Catch::Contains("fy has 9 entries, expected N = 10"));
+  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra),
+                    Catch::Contains("fy has 9 entries, expected N = 10"));
   bad = c;
   bad.extra.dt = 0.0;
-  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra), Catch::Contains("dt must be positive"));
+  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra),
+                    Catch::Contains("dt must be positive"));
   bad = c;
   bad.state.charge.clear();
   CHECK_THROWS_AS(writeCheckpoint(path, bad.state, bad.extra), std::invalid_argument);
@@ -142,7 +147,8 @@ TEST_CASE("corrupt or foreign checkpoints give clear errors", "[md][io]") {
   const std::string path = tempPath("corrupt.h5");
   Checkpoint c = makeCheckpoint(4096, 4);
   // a recognisable pattern in x to locate its bytes in the file
-  for (std::size_t i = 0; i < c.state.x.size(); ++i) c.state.x[i] = 1.0 + 1e-9 * static_cast<double>(i);
+  for (std::size_t i = 0; i < c.state.x.size(); ++i)
+    c.state.x[i] = 1.0 + 1e-9 * static_cast<double>(i);
   writeCheckpoint(path, c.state, c.extra);
   const std::string bytes = slurp(path);
 
@@ -168,7 +174,8 @@ TEST_CASE("corrupt or foreign checkpoints give clear errors", "[md][io]") {
   SECTION("not HDF5, missing, not a checkpoint") {
     const std::string text = tempPath("text.h5");
     spit(text, "not a checkpoint\n");
-    CHECK_THROWS_WITH(readCheckpoint(text), Catch::Contains(text) && Catch::Contains("not an HDF5 file"));
+    CHECK_THROWS_WITH(readCheckpoint(text),
+                      Catch::Contains(text) && Catch::Contains("not an HDF5 file"));
     std::remove(text.c_str());
     CHECK_THROWS_WITH(readCheckpoint(tempPath("missing.h5")), Catch::Contains("does not exist"));
     const std::string traj = tempPath("traj.h5");

@@ -124,8 +124,10 @@ TEST_CASE("bad configs are rejected with the key and the allowed range", "[md][c
   const std::vector<BadCase> cases = {
       {"input.version", "2", [](MdConfig& c) { c.input_version = 2; },
        "input.version = 2 is not supported: this granagg reads version 1"},
-      {"system.N", "1", [](MdConfig& c) { c.system.N = 1; }, "system.N = 1 is invalid: must be >= 2"},
-      {"system.N", "-5", [](MdConfig& c) { c.system.N = -5; }, "system.N = -5 is invalid: must be >= 2"},
+      {"system.N", "1", [](MdConfig& c) { c.system.N = 1; },
+       "system.N = 1 is invalid: must be >= 2"},
+      {"system.N", "-5", [](MdConfig& c) { c.system.N = -5; },
+       "system.N = -5 is invalid: must be >= 2"},
       {"system.phi", "0", [](MdConfig& c) { c.system.phi = 0; },
        "system.phi = 0 is invalid: must lie in (0, 0.6)"},
       {"system.phi", "-0.1", [](MdConfig& c) { c.system.phi = -0.1; },
@@ -143,7 +145,8 @@ TEST_CASE("bad configs are rejected with the key and the allowed range", "[md][c
       {"system.initial", "\"\"", [](MdConfig& c) { c.system.initial = ""; },
        "system.initial = \"\" is invalid: must be \"random\" or a file path"},
       {"contact.model", "\"hooke\"", [](MdConfig& c) { c.contact.model = "hooke"; },
-       "contact.model = \"hooke\" is invalid: must be one of \"hertz\", \"spring_dashpot\" (unknown contact "
+       "contact.model = \"hooke\" is invalid: must be one of \"hertz\", \"spring_dashpot\" "
+       "(unknown contact "
        "model)"},
       {"contact.E", "-1", [](MdConfig& c) { c.contact.E = -1; },
        "contact.E = -1 is invalid: must be >= 0 and finite"},
@@ -163,7 +166,8 @@ TEST_CASE("bad configs are rejected with the key and the allowed range", "[md][c
        "integrator.impact_speed_max = 0 is invalid: must be > 0 or \"auto\""},
       {"integrator.impact_speed_max", "-2", [](MdConfig& c) { c.integrator.impact_speed_max = -2; },
        "integrator.impact_speed_max = -2 is invalid: must be > 0 or \"auto\""},
-      {"integrator.steps_per_contact", "4.9", [](MdConfig& c) { c.integrator.steps_per_contact = 4.9; },
+      {"integrator.steps_per_contact", "4.9",
+       [](MdConfig& c) { c.integrator.steps_per_contact = 4.9; },
        "integrator.steps_per_contact = 4.9 is invalid: must be >= 5 and finite"},
       {"neighbor.skin", "0", [](MdConfig& c) { c.neighbor.skin = 0; },
        "neighbor.skin = 0 is invalid: must lie in (0, 2]"},
@@ -183,7 +187,8 @@ TEST_CASE("bad configs are rejected with the key and the allowed range", "[md][c
        "output.observable_interval = 0 is invalid: must be >= 1"},
       {"output.checkpoint_interval", "-1", [](MdConfig& c) { c.output.checkpoint_interval = -1; },
        "output.checkpoint_interval = -1 is invalid: must be >= 0"},
-      {"output.checkpoint_wall_seconds", "-1", [](MdConfig& c) { c.output.checkpoint_wall_seconds = -1; },
+      {"output.checkpoint_wall_seconds", "-1",
+       [](MdConfig& c) { c.output.checkpoint_wall_seconds = -1; },
        "output.checkpoint_wall_seconds = -1 is invalid: must be >= 0 and finite"},
   };
   for (const auto& bad : cases) {
@@ -198,7 +203,8 @@ TEST_CASE("bad configs are rejected with the key and the allowed range", "[md][c
 
     // As an override of a good file.
     const std::string set = bad.key + "=" + bad.value;
-    CHECK(errorOf([&] { parseConfigString("", "good.toml", {set}); }) == "--set " + set + ": " + bad.message);
+    CHECK(errorOf([&] { parseConfigString("", "good.toml", {set}); }) ==
+          "--set " + set + ": " + bad.message);
 
     // On the struct; the exception is an std::invalid_argument and knows its key.
     if (bad.mutate) {
@@ -225,8 +231,10 @@ TEST_CASE("values of the wrong type name the key and the expected type", "[md][c
       {"[system]\nN = \"many\"\n", "t.toml:2:5: system.N must be an integer, got string \"many\""},
       {"[system]\nN = 3000000000\n",
        "t.toml:2:5: system.N = 3000000000 is out of range for a 32-bit integer"},
-      {"[system]\nphi = \"dense\"\n", "t.toml:2:7: system.phi must be a number, got string \"dense\""},
-      {"[system]\nseed = -1\n", "t.toml:2:8: system.seed must be a non-negative integer, got integer -1"},
+      {"[system]\nphi = \"dense\"\n",
+       "t.toml:2:7: system.phi must be a number, got string \"dense\""},
+      {"[system]\nseed = -1\n",
+       "t.toml:2:8: system.seed must be a non-negative integer, got integer -1"},
       {"[system]\nseed = \"0x10\"\n",
        "t.toml:2:8: system.seed must be a non-negative integer (below 2^64), got string \"0x10\""},
       {"[system]\ninitial = 3\n", "t.toml:2:11: system.initial must be a string, got integer 3"},
@@ -235,7 +243,8 @@ TEST_CASE("values of the wrong type name the key and the expected type", "[md][c
       {"[contact]\nE = [1, 2]\n", "t.toml:2:5: contact.E must be a number, got an array"},
       {"[integrator]\ndt = \"fast\"\n",
        "t.toml:2:6: integrator.dt must be a number or \"auto\", got string \"fast\""},
-      {"[input]\nversion = \"1\"\n", "t.toml:2:11: input.version must be an integer, got string \"1\""},
+      {"[input]\nversion = \"1\"\n",
+       "t.toml:2:11: input.version must be an integer, got string \"1\""},
       {"system = 3\n", "t.toml:1:1: 'system' must be a table ([system]), got integer 3"},
       {"[system]\nN = \n", "t.toml:2:5: invalid TOML"},
   };
@@ -255,25 +264,27 @@ TEST_CASE("unknown keys and sections are reported with file:line:col", "[md][con
       "N = 2000\n"
       "Nn = 2\n";
   CHECK(errorOf([&] { parseConfigString(text, "run.toml"); }) ==
-        "run.toml:6:1: unknown key 'system.Nn' (known keys in [system]: N, phi, seed, temperature, initial); "
+        "run.toml:6:1: unknown key 'system.Nn' (known keys in [system]: N, phi, seed, temperature, "
+        "initial); "
         "did you mean 'system.N'?");
 
-  CHECK(errorOf([&] { parseConfigString("[sytem]\nN = 2\n", "run.toml"); }) ==
-        "run.toml:1:2: unknown section 'sytem' (known sections: input, system, contact, integrator, "
-        "neighbor, charging, coulomb, run, "
-        "output); did you mean 'system'?");
   CHECK(
-      errorOf([&] { parseConfigString("N = 2\n", "run.toml"); }) ==
-      "run.toml:1:1: unknown key 'N' at top level (keys belong in a section; known sections: input, system, "
-      "contact, integrator, neighbor, charging, coulomb, run, output); did you mean 'system.N'?");
+      errorOf([&] { parseConfigString("[sytem]\nN = 2\n", "run.toml"); }) ==
+      "run.toml:1:2: unknown section 'sytem' (known sections: input, system, contact, integrator, "
+      "neighbor, charging, coulomb, run, "
+      "output); did you mean 'system'?");
+  CHECK(errorOf([&] { parseConfigString("N = 2\n", "run.toml"); }) ==
+        "run.toml:1:1: unknown key 'N' at top level (keys belong in a section; known sections: "
+        "input, system, "
+        "contact, integrator, neighbor, charging, coulomb, run, output); did you mean 'system.N'?");
   // A nested table is an unknown key of its section.
   CHECK(errorOf([&] {
           parseConfigString("[system.extra]\nx = 1\n", "run.toml");
         }).find("unknown key 'system.extra' (known keys in [system]:") != std::string::npos);
 
   // All problems of a file at once, in file order (toml::table iterates keys alphabetically).
-  const std::string several =
-      errorOf([&] { parseConfigString("[run]\nzzz = 1\n[contact]\naaa = 2\nE = \"x\"\n", "run.toml"); });
+  const std::string several = errorOf(
+      [&] { parseConfigString("[run]\nzzz = 1\n[contact]\naaa = 2\nE = \"x\"\n", "run.toml"); });
   const auto a = several.find("run.toml:2:1: unknown key 'run.zzz'");
   const auto b = several.find("run.toml:4:1: unknown key 'contact.aaa'");
   const auto c = several.find("run.toml:5:5: contact.E must be a number");
@@ -291,7 +302,8 @@ TEST_CASE("unknown keys and sections are reported with file:line:col", "[md][con
   }
   CHECK(errorOf([&] { parseConfigFile(path); }) ==
         path +
-            ":3:1: unknown key 'contact.clmap' (known keys in [contact]: model, E, D, clamp, stiffness, "
+            ":3:1: unknown key 'contact.clmap' (known keys in [contact]: model, E, D, clamp, "
+            "stiffness, "
             "restitution); did you mean 'contact.clamp'?");
   std::remove(path.c_str());
   CHECK(errorOf([&] { parseConfigFile("no/such/file.toml"); }) ==
@@ -299,13 +311,14 @@ TEST_CASE("unknown keys and sections are reported with file:line:col", "[md][con
 }
 
 TEST_CASE("overrides (--set key=value) apply after the file and are validated", "[md][config]") {
-  const std::string file = "[system]\nN = 1000\n[integrator]\ndt = 0.001\n[contact]\nclamp = true\n";
+  const std::string file =
+      "[system]\nN = 1000\n[integrator]\ndt = 0.001\n[contact]\nclamp = true\n";
   const MdConfig c = parseConfigString(
       file, "run.toml",
       {"system.N=2000", "integrator.dt=auto", "contact.clamp=false", "contact.model=spring_dashpot",
        " system.phi = 0.1 ", "system.initial=data/start 1.csv", "system.seed=18446744073709551615",
-       "contact.E=300", "run.t_end=1e3", "output.write_velocities=false", "integrator.impact_speed_max=2.5",
-       "system.N=3000"});
+       "contact.E=300", "run.t_end=1e3", "output.write_velocities=false",
+       "integrator.impact_speed_max=2.5", "system.N=3000"});
   CHECK(c.system.N == 3000);  // later overrides win
   CHECK(c.integrator.dt == 0.0);
   CHECK_FALSE(c.contact.clamp);
@@ -320,37 +333,46 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
 
   // String keys: quoted TOML strings, and unquoted text taken literally even if it looks like a
   // number or date.
-  CHECK(parseConfigString("", "r", {"system.initial=\"a \\\"q\\\".csv\""}).system.initial == "a \"q\".csv");
-  CHECK(parseConfigString("", "r", {"system.initial=2024-01-01.h5"}).system.initial == "2024-01-01.h5");
+  CHECK(parseConfigString("", "r", {"system.initial=\"a \\\"q\\\".csv\""}).system.initial ==
+        "a \"q\".csv");
+  CHECK(parseConfigString("", "r", {"system.initial=2024-01-01.h5"}).system.initial ==
+        "2024-01-01.h5");
   CHECK(parseConfigString("", "r", {"system.initial=2000"}).system.initial == "2000");
 
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"system.Nn=2",
-       "--set system.Nn=2: unknown key 'system.Nn' (known keys in [system]: N, phi, seed, temperature, "
+       "--set system.Nn=2: unknown key 'system.Nn' (known keys in [system]: N, phi, seed, "
+       "temperature, "
        "initial); "
        "did you mean 'system.N'?"},
       {"sytem.N=2",
-       "--set sytem.N=2: unknown section 'sytem' (known sections: input, system, contact, integrator, "
+       "--set sytem.N=2: unknown section 'sytem' (known sections: input, system, contact, "
+       "integrator, "
        "neighbor, charging, coulomb, run, output); did you mean 'system'?"},
       {"N=2", "--set N=2: unknown key 'N' at top level"},
       {"system.N", "--set system.N: expected section.key=value"},
       {"system.N=abc", "--set system.N=abc: system.N must be an integer, got string \"abc\""},
       {"system.N=2e3", "--set system.N=2e3: system.N must be an integer, got float 2000"},
-      {"system.phi=1.0e", "--set system.phi=1.0e: system.phi must be a number, got string \"1.0e\""},
+      {"system.phi=1.0e",
+       "--set system.phi=1.0e: system.phi must be a number, got string \"1.0e\""},
       {"contact.clamp=yes",
-       "--set contact.clamp=yes: contact.clamp must be a boolean (true or false), got string \"yes\""},
-      {"integrator.dt=0", "--set integrator.dt=0: integrator.dt = 0 is invalid: must be > 0 or \"auto\""},
+       "--set contact.clamp=yes: contact.clamp must be a boolean (true or false), got string "
+       "\"yes\""},
+      {"integrator.dt=0",
+       "--set integrator.dt=0: integrator.dt = 0 is invalid: must be > 0 or \"auto\""},
       {"integrator.dt=Auto",
        "--set integrator.dt=Auto: integrator.dt must be a number or \"auto\", got string \"Auto\""},
       {"system.phi=0.7", "--set system.phi=0.7: system.phi = 0.7 is invalid: must lie in (0, 0.6)"},
       {"contact.model=hooke", "--set contact.model=hooke: contact.model = \"hooke\" is invalid"},
       {"charging.mode=static", "--set charging.mode=static: charging.mode = \"static\" is invalid"},
-      {"charging.initial=file", "--set charging.initial=file: charging.initial = \"file\" is invalid: must be used with"},
+      {"charging.initial=file",
+       "--set charging.initial=file: charging.initial = \"file\" is invalid: must be used with"},
       {"charging.kappa=0", "--set charging.kappa=0: charging.kappa = 0 is invalid: must be > 0"},
       {"coulomb.K=-1", "--set coulomb.K=-1: coulomb.K = -1 is invalid: must be >= 0"},
       {"coulomb.accuracy=0.5", "--set coulomb.accuracy=0.5: coulomb.accuracy = 0.5 is invalid"},
       {"coulomb.method=p3m", "--set coulomb.method=p3m: coulomb.method = \"p3m\" is invalid"},
-      {"coulomb.mesh=0", "--set coulomb.mesh=0: coulomb.mesh = 0 is invalid: must be > 0 or \"auto\""},
+      {"coulomb.mesh=0",
+       "--set coulomb.mesh=0: coulomb.mesh = 0 is invalid: must be > 0 or \"auto\""},
       {"coulomb.order=9", "--set coulomb.order=9: coulomb.order = 9 is invalid: must lie in 2..7"},
       {"coulomb.every_max=2000",
        "--set coulomb.every_max=2000: coulomb.every_max = 2000 is invalid: must lie in 1..1000"},
@@ -383,7 +405,7 @@ TEST_CASE("toToml round-trips exactly through parseConfigString", "[md][config]"
   SECTION("every key changed, awkward values") {
     MdConfig c;
     c.system.N = 123457;
-    c.system.phi = 0.1 + 0.2;                                   // 0.30000000000000004 needs 17 digits
+    c.system.phi = 0.1 + 0.2;  // 0.30000000000000004 needs 17 digits
     c.system.seed = std::numeric_limits<std::uint64_t>::max();  // beyond TOML's int64
     c.system.temperature = 1.0 / 3.0;
     c.system.initial = "dir with space/\"quoted\"\\x\ttab\u00e9.csv";

@@ -18,23 +18,29 @@
 using namespace granagg;
 using namespace granagg::md;
 
-TEST_CASE("contact potentials: force is -dV/dxi, clamping, spring-dashpot restitution", "[md][potential]") {
+TEST_CASE("contact potentials: force is -dV/dxi, clamping, spring-dashpot restitution",
+          "[md][potential]") {
   const HertzViscoelastic::Params h{278.6, 0.0, true};
   for (double xi : {1e-4, 1e-3, 0.01, 0.05}) {
     const double dx = 1e-6 * xi;
-    const double dV = (HertzViscoelastic::elasticEnergy(xi + dx, h) - HertzViscoelastic::elasticEnergy(xi - dx, h)) / (2 * dx);
+    const double dV = (HertzViscoelastic::elasticEnergy(xi + dx, h) -
+                       HertzViscoelastic::elasticEnergy(xi - dx, h)) /
+                      (2 * dx);
     CHECK(HertzViscoelastic::normalForce(xi, 0.0, h) == Approx(dV).epsilon(1e-8));
-    CHECK(HertzViscoelastic::normalForce(xi, 0.0, h) == Approx(278.6 * std::pow(xi, 1.5)).epsilon(1e-14));
+    CHECK(HertzViscoelastic::normalForce(xi, 0.0, h) ==
+          Approx(278.6 * std::pow(xi, 1.5)).epsilon(1e-14));
   }
   const HertzViscoelastic::Params hc{278.6, 27.7, true}, hu{278.6, 27.7, false};
   // receding fast near the end of the contact: E xi^{3/2} + D xi^{1/2} xi' < 0
   CHECK(HertzViscoelastic::normalForce(1e-4, -1.0, hc) == 0.0);
-  CHECK(HertzViscoelastic::normalForce(1e-4, -1.0, hu) == Approx(std::sqrt(1e-4) * (278.6e-4 - 27.7)).epsilon(1e-14));
+  CHECK(HertzViscoelastic::normalForce(1e-4, -1.0, hu) ==
+        Approx(std::sqrt(1e-4) * (278.6e-4 - 27.7)).epsilon(1e-14));
   // design.md: t_c = 0.23 for v = 1.6 at the defaults
   CHECK(HertzViscoelastic::contactTime(1.6, hc) == Approx(0.233).margin(0.001));
 
   const auto sd = SpringDashpot::makeParams(1e4, 0.9, false);
-  // closed form epsilon = exp(-pi zeta / omega) with zeta = gamma/(2 m_eff), omega^2 = k/m_eff - zeta^2
+  // closed form epsilon = exp(-pi zeta / omega) with zeta = gamma/(2 m_eff), omega^2 = k/m_eff -
+  // zeta^2
   const double zeta = sd.gamma, omega = std::sqrt(2 * sd.k - zeta * zeta);
   CHECK(std::exp(-M_PI * zeta / omega) == Approx(0.9).epsilon(1e-14));
   CHECK(SpringDashpot::contactTime(sd) == Approx(M_PI / omega).epsilon(1e-14));
@@ -82,12 +88,13 @@ void bruteForce(const std::vector<double>& pos, const std::vector<double>& vel, 
     }
 }
 
-void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L, bool flat,
-                           std::vector<double>& out);
+void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L,
+                           bool flat, std::vector<double>& out);
 
 /// Both force passes (per-row loops, and one loop over the compressed list per block) against
 /// the reference, and against each other to the bit.
-void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L) {
+void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel,
+                           double L) {
   std::vector<double> forces[2];
   for (bool flat : {false, true}) {
     INFO((flat ? "compressed-list pass" : "per-row pass"));
@@ -96,8 +103,8 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   CHECK(forces[0] == forces[1]);
 }
 
-void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L, bool flat,
-                           std::vector<double>& out) {
+void compareWithBruteForce(const std::vector<double>& pos, const std::vector<double>& vel, double L,
+                           bool flat, std::vector<double>& out) {
   const HertzViscoelastic::Params prm{278.6, 27.7, true};
   ParticleData p = makeParticles(pos, vel);
   common::Box box{L};
@@ -107,7 +114,8 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   REQUIRE(nl.hasPairs() == flat);
   ContactWork w;
   // dt = 0: a state at full step, so the predicted velocities equal v, as in the reference. Overlap
-  // bound 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite force.
+  // bound 1 (no bound: random placements overlap deeply), so a flag can only mean a non-finite
+  // force.
   ContactStep st;
   st.dt = 0.0;
   st.max_overlap = 1.0;
@@ -170,7 +178,8 @@ TEST_CASE("neighbour-list forces equal brute force on a random configuration", "
   compareWithBruteForce(pos, vel, L);
 }
 
-TEST_CASE("neighbour-list forces equal brute force in dense clusters across the boundary", "[md][neighbor]") {
+TEST_CASE("neighbour-list forces equal brute force in dense clusters across the boundary",
+          "[md][neighbor]") {
   // Dense blobs (many neighbours per particle, exercising row-capacity growth) centred on a corner
   // and on a face, so that contacts wrap across faces, edges and the corner.
   std::mt19937_64 rng(5);
@@ -189,7 +198,8 @@ TEST_CASE("neighbour-list forces equal brute force in dense clusters across the 
   compareWithBruteForce(pos, vel, L);
 }
 
-TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and charging included", "[md][neighbor]") {
+TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and charging included",
+          "[md][neighbor]") {
   // The compressed pair form computes each contact once and hands the owner's force, negated, to
   // the partner; the per-row pass computes every contact from both sides. Both must give the same
   // forces, collision count and exchanged charges to the last bit (the contact arithmetic is
@@ -236,10 +246,14 @@ TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and
     magnitude += std::fabs(q);
   }
   CHECK(charged > 20);
-  CHECK(std::fabs(total) <= 1e-14 * magnitude);  // every transfer leaves one partner and reaches the other
+  CHECK(std::fabs(total) <=
+        1e-14 * magnitude);  // every transfer leaves one partner and reaches the other
 }
 
-TEST_CASE("a non-finite contact force is flagged by every pass shape, and an advancing pass then moves nothing", "[md][neighbor]") {
+TEST_CASE(
+    "a non-finite contact force is flagged by every pass shape, and an advancing pass then moves "
+    "nothing",
+    "[md][neighbor]") {
   // Two particles at the same point: r = 0, so the unit vector and the force are NaN. The pair-form
   // passes check the finiteness of the contact forces where they compute them, the per-row pass
   // that of every force and position; all must flag it.
@@ -266,7 +280,8 @@ TEST_CASE("a non-finite contact force is flagged by every pass shape, and an adv
     CHECK(r.worst == 1);
     const std::vector<Scalar4> after(p.pos.begin(), p.pos.end());
     bool unchanged = true;
-    for (std::size_t i = 0; i < after.size(); ++i) unchanged = unchanged && after[i].x == before[i].x;
+    for (std::size_t i = 0; i < after.size(); ++i)
+      unchanged = unchanged && after[i].x == before[i].x;
     CHECK(unchanged);
     const std::vector<Vec3> f(p.force.begin(), p.force.end());
     CHECK(std::isnan(f[3].x + f[3].y + f[3].z));
@@ -274,14 +289,15 @@ TEST_CASE("a non-finite contact force is flagged by every pass shape, and an adv
   }
 }
 
-TEST_CASE("pairs screened only once the displacement bound allows a contact: no contact is missed", "[md][neighbor]") {
+TEST_CASE("pairs screened only once the displacement bound allows a contact: no contact is missed",
+          "[md][neighbor]") {
   // With ContactStep::displacement_bound the pair-form pass skips a pair until the bound has grown
   // by half its gap to contact. Every particle moves at the same speed v0 in a random direction,
-  // so head-on pairs close at nearly 2 v0, the rate the factor 1/2 is there for. The particles drift
-  // freely (no forces applied: the screening, not the physics, is under test) and pass through one
-  // another, so contacts start and end all the time. At every step the pass with the bound must
-  // give exactly the forces and collisions of the pass that screens every pair; the list is rebuilt
-  // whenever the bound reaches skin / 2, as in the engine.
+  // so head-on pairs close at nearly 2 v0, the rate the factor 1/2 is there for. The particles
+  // drift freely (no forces applied: the screening, not the physics, is under test) and pass
+  // through one another, so contacts start and end all the time. At every step the pass with the
+  // bound must give exactly the forces and collisions of the pass that screens every pair; the list
+  // is rebuilt whenever the bound reaches skin / 2, as in the engine.
   const double L = 14.5, v0 = 2.0, dt = 0.01, skin = 0.4;
   std::vector<double> pos, vel;
   randomGas(29, 600, L, pos, vel);
@@ -298,7 +314,8 @@ TEST_CASE("pairs screened only once the displacement bound allows a contact: no 
   NeighborList nl(1.0, skin);
   nl.keepPairs(true);
   ContactWork w_screened, w_every;
-  const double rounding = 2.0 * (std::nextafter(L, 2.0 * L) - L);  // as the engine's bound (Engine.cpp)
+  const double rounding =
+      2.0 * (std::nextafter(L, 2.0 * L) - L);  // as the engine's bound (Engine.cpp)
   double bound = 0.0;
   std::int64_t collisions = 0;
   int builds = 0;
@@ -312,14 +329,18 @@ TEST_CASE("pairs screened only once the displacement bound allows a contact: no 
     st.dt = step == 0 ? 0.0 : dt;
     st.max_overlap = 2.0;  // free flight overlaps deeply
     st.displacement_bound = bound;
-    const ContactStepResult a = computeContactForces<HertzViscoelastic>(screened, nl, box, prm, st, w_screened);
+    const ContactStepResult a =
+        computeContactForces<HertzViscoelastic>(screened, nl, box, prm, st, w_screened);
     st.displacement_bound = -1.0;
-    const ContactStepResult b = computeContactForces<HertzViscoelastic>(every, nl, box, prm, st, w_every);
+    const ContactStepResult b =
+        computeContactForces<HertzViscoelastic>(every, nl, box, prm, st, w_every);
     REQUIRE(a.worst == 0);
     REQUIRE(a.collisions == b.collisions);
-    const std::vector<Vec3> fa(screened.force.begin(), screened.force.end()), fb(every.force.begin(), every.force.end());
+    const std::vector<Vec3> fa(screened.force.begin(), screened.force.end()),
+        fb(every.force.begin(), every.force.end());
     bool same = true;
-    for (std::size_t i = 0; i < fa.size(); ++i) same = same && fa[i].x == fb[i].x && fa[i].y == fb[i].y && fa[i].z == fb[i].z;
+    for (std::size_t i = 0; i < fa.size(); ++i)
+      same = same && fa[i].x == fb[i].x && fa[i].y == fb[i].y && fa[i].z == fb[i].z;
     INFO("step " << step);
     REQUIRE(same);
     collisions += a.collisions;
@@ -336,7 +357,8 @@ TEST_CASE("pairs screened only once the displacement bound allows a contact: no 
   CHECK(builds > 10);
 }
 
-TEST_CASE("the build on cell-sorted storage (the engine's) finds exactly the pairs within range", "[md][neighbor]") {
+TEST_CASE("the build on cell-sorted storage (the engine's) finds exactly the pairs within range",
+          "[md][neighbor]") {
   // The engine stores particles in cell order and builds with buildSorted, whose cell search reads
   // candidates from consecutive slots and skips the minimum image for particles away from the
   // faces. Rows are compared, in particle ids, with an O(N^2) search; a gas plus blobs at a corner
@@ -365,8 +387,10 @@ TEST_CASE("the build on cell-sorted storage (the engine's) finds exactly the pai
   p.id.assign(order.begin(), order.end());
   nl.buildSorted(p, box);
   std::vector<int> rows(n * nl.capacity()), counts(n);
-  thrust::copy(thrust::device_pointer_cast(nl.rows()), thrust::device_pointer_cast(nl.rows()) + rows.size(), rows.begin());
-  thrust::copy(thrust::device_pointer_cast(nl.counts()), thrust::device_pointer_cast(nl.counts()) + n, counts.begin());
+  thrust::copy(thrust::device_pointer_cast(nl.rows()),
+               thrust::device_pointer_cast(nl.rows()) + rows.size(), rows.begin());
+  thrust::copy(thrust::device_pointer_cast(nl.counts()),
+               thrust::device_pointer_cast(nl.counts()) + n, counts.begin());
   std::size_t entries = 0;
   for (std::size_t s = 0; s < n; ++s) {
     const int i = order[s];
@@ -394,10 +418,12 @@ TEST_CASE("the build on cell-sorted storage (the engine's) finds exactly the pai
 TEST_CASE("a box too small for the neighbour range is refused", "[md][neighbor]") {
   ParticleData p = makeParticles({0.1, 0.1, 0.1, 1.5, 0.1, 0.1}, {0, 0, 0, 0, 0, 0});
   NeighborList nl(1.0, 0.3);
-  CHECK_THROWS_WITH(nl.build(p, common::Box{2.4}), Catch::Contains("smaller than twice the neighbour range"));
+  CHECK_THROWS_WITH(nl.build(p, common::Box{2.4}),
+                    Catch::Contains("smaller than twice the neighbour range"));
 }
 
-TEST_CASE("neighbour rows hold exactly the pairs within range across capacity shrinks and growth", "[md][neighbor]") {
+TEST_CASE("neighbour rows hold exactly the pairs within range across capacity shrinks and growth",
+          "[md][neighbor]") {
   // Rows are checked entry by entry against an O(N^2) pair search, on one list object that first
   // sees a sparse gas (its row capacity shrinks after the first build, which must only affect the
   // next build's layout), then a dense blob (capacity grows).
@@ -411,10 +437,13 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
     nl.build(p, box);
     const std::size_t n = pos.size() / 3;
     std::vector<int> rows(n * nl.capacity()), counts(n);
-    thrust::copy(thrust::device_pointer_cast(nl.rows()), thrust::device_pointer_cast(nl.rows()) + rows.size(), rows.begin());
-    thrust::copy(thrust::device_pointer_cast(nl.counts()), thrust::device_pointer_cast(nl.counts()) + n, counts.begin());
+    thrust::copy(thrust::device_pointer_cast(nl.rows()),
+                 thrust::device_pointer_cast(nl.rows()) + rows.size(), rows.begin());
+    thrust::copy(thrust::device_pointer_cast(nl.counts()),
+                 thrust::device_pointer_cast(nl.counts()) + n, counts.begin());
     for (std::size_t i = 0; i < n; ++i) {
-      std::vector<int> expected, got(rows.begin() + i * nl.capacity(), rows.begin() + i * nl.capacity() + counts[i]);
+      std::vector<int> expected,
+          got(rows.begin() + i * nl.capacity(), rows.begin() + i * nl.capacity() + counts[i]);
       for (std::size_t j = 0; j < n; ++j) {
         if (j == i) continue;
         double r2 = 0.0;
@@ -433,14 +462,18 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
     REQUIRE(nl.hasPairs());
     auto fetch = [](const int* d, std::size_t count) {
       std::vector<int> h(count);
-      thrust::copy(thrust::device_pointer_cast(d), thrust::device_pointer_cast(d) + count, h.begin());
+      thrust::copy(thrust::device_pointer_cast(d), thrust::device_pointer_cast(d) + count,
+                   h.begin());
       return h;
     };
-    const std::vector<int> eoff = fetch(nl.entryOffsets(), n + 1), poff = fetch(nl.pairOffsets(), n + 1);
+    const std::vector<int> eoff = fetch(nl.entryOffsets(), n + 1),
+                           poff = fetch(nl.pairOffsets(), n + 1);
     REQUIRE(eoff[n] == 2 * poff[n]);
     REQUIRE(nl.pairCount() == static_cast<std::size_t>(poff[n]));
-    const std::vector<int> eowners = fetch(nl.entryOwners(), eoff[n]), epairs = fetch(nl.entryPairs(), eoff[n]);
-    const std::vector<int> powners = fetch(nl.pairOwners(), poff[n]), ppartners = fetch(nl.pairPartners(), poff[n]);
+    const std::vector<int> eowners = fetch(nl.entryOwners(), eoff[n]),
+                           epairs = fetch(nl.entryPairs(), eoff[n]);
+    const std::vector<int> powners = fetch(nl.pairOwners(), poff[n]),
+                           ppartners = fetch(nl.pairPartners(), poff[n]);
     const std::vector<int> pentries = fetch(nl.pairEntries(), 2 * poff[n]);
     std::vector<int> seen(poff[n], 0);
     for (std::size_t i = 0; i < n; ++i) {
@@ -472,7 +505,7 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
   std::normal_distribution<double> g(5.0, 0.8);
   std::vector<double> dense = sparse;
   for (int k = 0; k < 3 * 200; ++k) dense.push_back(std::fmod(g(rng) + L, L));
-  check(dense);   // overflow: capacity grows, list rebuilt
+  check(dense);  // overflow: capacity grows, list rebuilt
   check(sparse);
   // A row filled exactly to the capacity, with candidates out of range scanned after its last
   // entry: the cell search appends without branching (a miss is written past the entries and not

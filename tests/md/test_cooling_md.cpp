@@ -33,7 +33,8 @@ std::vector<Sample> mdCooling(const MdConfig& c, const std::vector<double>& time
   for (double t : times) {
     e.run(static_cast<std::int64_t>(std::llround(t / e.dt())) - e.step());
     const auto o = e.observables();
-    out.push_back({o.time, o.temperature, 2.0 * o.collisions / c.system.N, o.contacts_per_particle});
+    out.push_back(
+        {o.time, o.temperature, 2.0 * o.collisions / c.system.N, o.contacts_per_particle});
   }
   return out;
 }
@@ -42,11 +43,12 @@ std::vector<Sample> mdCooling(const MdConfig& c, const std::vector<double>& time
 double temperatureAtCollisions(const meanfield::RestitutionFunction& e, double tau) {
   using namespace boost::numeric::odeint;
   std::vector<double> T{1.0};
-  integrate_adaptive(make_controlled<runge_kutta_dopri5<std::vector<double>>>(1e-10, 1e-10),
-                     [&](const std::vector<double>& y, std::vector<double>& dy, double) {
-                       dy[0] = -y[0] * meanfield::energyLossFactor(e, y[0], 1e-10) / 3.0;
-                     },
-                     T, 0.0, tau, 0.01);
+  integrate_adaptive(
+      make_controlled<runge_kutta_dopri5<std::vector<double>>>(1e-10, 1e-10),
+      [&](const std::vector<double>& y, std::vector<double>& dy, double) {
+        dy[0] = -y[0] * meanfield::energyLossFactor(e, y[0], 1e-10) / 3.0;
+      },
+      T, 0.0, tau, 0.01);
   return T[0];
 }
 }  // namespace
@@ -77,7 +79,8 @@ TEST_CASE("constant-restitution gas follows Haff's law while homogeneous", "[md]
   CHECK(s.back().T < 0.6);  // it does cool; a test that ignored dissipation would fail here
 }
 
-TEST_CASE("viscoelastic gas follows the kinetic-theory cooling built on the exact e(v)", "[md][cooling]") {
+TEST_CASE("viscoelastic gas follows the kinetic-theory cooling built on the exact e(v)",
+          "[md][cooling]") {
   // Hertz E = 278.6, D = 27.7, clamped; N = 2000. Early times (T >~ 0.4, about 2-3 collisions per
   // particle): the theory assumes a Maxwellian (a2 = 0), the correction it neglects grows as the
   // strongly dissipative collisions (e ~ 0.3-0.5) distort f(v); 5 % covers it and 3 sigma of T_g.
@@ -91,11 +94,13 @@ TEST_CASE("viscoelastic gas follows the kinetic-theory cooling built on the exac
     // A collision is counted when it starts; the ~0.2 contacts per particle in progress are on
     // average half done, so the collisions whose dissipation has happened are tau - contacts/2.
     const double theory = temperatureAtCollisions(e, x.tau - 0.5 * x.contacts);
-    INFO("t = " << x.t << ", " << x.tau << " collisions per particle: MD " << x.T << ", kinetic theory " << theory);
+    INFO("t = " << x.t << ", " << x.tau << " collisions per particle: MD " << x.T
+                << ", kinetic theory " << theory);
     CHECK(x.T == Approx(theory).epsilon(0.05));
   }
   // and in time, the MD gas cools more slowly than the hard-sphere collision rate predicts, by
   // the contact-duration effect described above (a check that the clock difference is real)
-  const auto theory_t = meanfield::solveViscoelasticCooling({c.contact.E, c.contact.D, true}, {2.0});
+  const auto theory_t =
+      meanfield::solveViscoelasticCooling({c.contact.E, c.contact.D, true}, {2.0});
   CHECK(s.back().T > theory_t[0].T);
 }

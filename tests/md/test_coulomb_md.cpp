@@ -28,7 +28,9 @@ MdConfig chargedConfig(int N, std::uint64_t seed, double K, const std::string& m
   c.coulomb.method = method;
   return c;
 }
-double totalEnergy(const Observables& o) { return o.kinetic_energy + o.elastic_energy + o.coulomb_energy; }
+double totalEnergy(const Observables& o) {
+  return o.kinetic_energy + o.elastic_energy + o.coulomb_energy;
+}
 }  // namespace
 
 TEST_CASE("engine forces with PPPM equal converged plain Ewald plus contacts", "[md][coulomb]") {
@@ -48,7 +50,8 @@ TEST_CASE("engine forces with PPPM equal converged plain Ewald plus contacts", "
   const CoulombResult r = ref.compute(init.x, init.y, init.z, init.charge);
   double err2 = 0.0;
   for (std::size_t i = 0; i < N; ++i) {
-    const double d[3] = {f[i] - f0[i] - r.fx[i], f[N + i] - f0[N + i] - r.fy[i], f[2 * N + i] - f0[2 * N + i] - r.fz[i]};
+    const double d[3] = {f[i] - f0[i] - r.fx[i], f[N + i] - f0[N + i] - r.fy[i],
+                         f[2 * N + i] - f0[2 * N + i] - r.fz[i]};
     err2 += d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
   }
   // relative accuracy as defined in docs/coulomb.md: RMS |dF| over K (the force of two unit charges
@@ -60,7 +63,8 @@ TEST_CASE("engine forces with PPPM equal converged plain Ewald plus contacts", "
   CHECK(pppm.observables().coulomb_energy == Approx(r.energy).epsilon(1e-3));
 }
 
-TEST_CASE("fixed charges and elastic contacts: energy drift below 1e-4 over 1e4 steps", "[md][coulomb]") {
+TEST_CASE("fixed charges and elastic contacts: energy drift below 1e-4 over 1e4 steps",
+          "[md][coulomb]") {
   // PPPM (production) over 1e4 steps; plain Ewald (the O(N^2) reference, slow) over 2e3 steps.
   for (const std::string method : {"pppm", "ewald"}) {
     INFO("method " << method);
@@ -79,10 +83,11 @@ TEST_CASE("fixed charges and elastic contacts: energy drift below 1e-4 over 1e4 
       worst = std::max(worst, std::fabs(totalEnergy(e.observables()) - E0) / scale);
     }
     const auto o = e.observables();
-    INFO("collisions " << o.collisions << ", Coulomb energy " << o0.coulomb_energy << " -> " << o.coulomb_energy
-                       << ", max |E - E0| / E_kin(0) = " << worst);
+    INFO("collisions " << o.collisions << ", Coulomb energy " << o0.coulomb_energy << " -> "
+                       << o.coulomb_energy << ", max |E - E0| / E_kin(0) = " << worst);
     CHECK(o.collisions > 100);
-    CHECK(std::fabs(o.coulomb_energy - o0.coulomb_energy) > 1e-3 * scale);  // the Coulomb term does work
+    CHECK(std::fabs(o.coulomb_energy - o0.coulomb_energy) >
+          1e-3 * scale);  // the Coulomb term does work
     CHECK(worst < 1e-4);
   }
 }
@@ -119,7 +124,9 @@ TEST_CASE("monopolar charges cool more slowly than Haff's law", "[md][coulomb]")
   CHECK(T1 > 1.5 * T0);
 }
 
-TEST_CASE("an oppositely charged pair settles at the equilibrium overlap of Coulomb and Hertz forces", "[md][coulomb]") {
+TEST_CASE(
+    "an oppositely charged pair settles at the equilibrium overlap of Coulomb and Hertz forces",
+    "[md][coulomb]") {
   // Two particles, charges +1 and -1, released near contact in a large box, K = 5 (the paper's
   // strongest coupling), default Hertz E and D, auto dt: they collide, the damping takes the energy
   // out, and the pair comes to rest where E xi^{3/2} balances the attraction. That balance is the
@@ -129,7 +136,7 @@ TEST_CASE("an oppositely charged pair settles at the equilibrium overlap of Coul
   c.system.N = 2;
   c.charging.mode = "fixed";  // the frame's charges are kept
   c.coulomb.K = 5.0;
-  c.coulomb.method = "ewald";   // exact up to its accuracy; two charges: cheap
+  c.coulomb.method = "ewald";  // exact up to its accuracy; two charges: cheap
   c.coulomb.accuracy = 1e-6;
   Frame f;
   f.box = 40.0;
@@ -147,24 +154,31 @@ TEST_CASE("an oppositely charged pair settles at the equilibrium overlap of Coul
     max_overlap = std::max(max_overlap, e.observables().max_overlap);
   }
   const double overlap = e.observables().max_overlap;
-  auto g = [&](double xi) { return c.contact.E * std::pow(xi, 1.5) - c.coulomb.K / ((1 - xi) * (1 - xi)); };
+  auto g = [&](double xi) {
+    return c.contact.E * std::pow(xi, 1.5) - c.coulomb.K / ((1 - xi) * (1 - xi));
+  };
   double lo = 1e-6, hi = 3.0 / 7.0;  // g(lo) < 0 < g(hi) for K < 0.0916 E
   REQUIRE(g(lo) < 0.0);
   REQUIRE(g(hi) > 0.0);
   for (int it = 0; it < 200; ++it) (g(0.5 * (lo + hi)) < 0.0 ? lo : hi) = 0.5 * (lo + hi);
-  INFO("equilibrium overlap " << lo << ", MD " << overlap << ", largest during the approach " << max_overlap);
+  INFO("equilibrium overlap " << lo << ", MD " << overlap << ", largest during the approach "
+                              << max_overlap);
   CHECK(overlap == Approx(lo).epsilon(1e-3));
-  CHECK(max_overlap < 0.5);                         // stable at the default dt
-  CHECK(e.observables().temperature < 1e-8);        // at rest
+  CHECK(max_overlap < 0.5);                   // stable at the default dt
+  CHECK(e.observables().temperature < 1e-8);  // at rest
 }
 
-TEST_CASE("multiple time stepping: the fast and slow pair forces sum to the Ewald real-space force, and their tables are accurate", "[md][coulomb]") {
+TEST_CASE(
+    "multiple time stepping: the fast and slow pair forces sum to the Ewald real-space force, and "
+    "their tables are accurate",
+    "[md][coulomb]") {
   const double alpha = 0.58, rc = 5.0;
   const RealSpaceSwitch sw{2.5, 3.5};
   // the split is exact: S K/r^2 + (Ewald real - S K/r^2) = Ewald real (per unit K q_i q_j, over r)
   for (double r = 1.0; r < rc; r += 0.0137) {
     const double total = ewaldRealForceOverR(1.0, r, alpha, 1.0);
-    CHECK(slowPairForceOverR(r, alpha, sw) + fastPairForceOverR(r, sw) == Approx(total).epsilon(1e-12).margin(1e-15));
+    CHECK(slowPairForceOverR(r, alpha, sw) + fastPairForceOverR(r, sw) ==
+          Approx(total).epsilon(1e-12).margin(1e-15));
   }
   // the switch: 1 inside, 0 outside, continuous with zero slope at both ends
   CHECK(sw.fastFraction(2.4) == 1.0);
@@ -172,9 +186,12 @@ TEST_CASE("multiple time stepping: the fast and slow pair forces sum to the Ewal
   CHECK(sw.fastFraction(3.0) == Approx(0.5).epsilon(1e-14));
   CHECK(std::fabs(sw.fastFraction(2.5 + 1e-6) - 1.0) < 1e-14);  // 10 x^3: flat to third order
   CHECK(std::fabs(sw.fastFraction(3.5 - 1e-6)) < 1e-14);
-  // the slow part is smooth at short range: minus the pair's erf part, -4 alpha^3 / (3 sqrt pi) at 0
-  CHECK(slowPairForceOverR(1e-5, alpha, sw) == Approx(-4.0 * alpha * alpha * alpha / (3.0 * std::sqrt(M_PI))).epsilon(1e-9));
-  CHECK(slowPairForceOverR(0.01, alpha, sw) == Approx(slowPairForceOverR(0.000999, alpha, sw)).epsilon(1e-3));
+  // the slow part is smooth at short range: minus the pair's erf part, -4 alpha^3 / (3 sqrt pi) at
+  // 0
+  CHECK(slowPairForceOverR(1e-5, alpha, sw) ==
+        Approx(-4.0 * alpha * alpha * alpha / (3.0 * std::sqrt(M_PI))).epsilon(1e-9));
+  CHECK(slowPairForceOverR(0.01, alpha, sw) ==
+        Approx(slowPairForceOverR(0.000999, alpha, sw)).epsilon(1e-3));
   // the tables the engine interpolates (piecewise cubic in r^2, SLOW/FAST_PAIR_TABLE_INTERVALS):
   // force errors against the functions, relative to K (the force of two unit charges at distance
   // 1), for pairs from deep overlap (r = 0.6). The bounds are ~4x the errors measured when the
@@ -190,8 +207,8 @@ TEST_CASE("multiple time stepping: the fast and slow pair forces sum to the Ewal
     worst_fast = std::max(worst_fast, e);
     if (r >= 1.0) worst_fast_apart = std::max(worst_fast_apart, e);
   }
-  INFO("largest table force error / K: slow " << worst_slow << ", fast " << worst_fast << " (from r = 1: "
-                                               << worst_fast_apart << ")");
+  INFO("largest table force error / K: slow " << worst_slow << ", fast " << worst_fast
+                                              << " (from r = 1: " << worst_fast_apart << ")");
   CHECK(worst_slow < 2e-8);
   CHECK(worst_fast < 6e-6);        // the steep 1/r^2 at an overlap of 0.4 (deeper aborts a run)
   CHECK(worst_fast_apart < 4e-8);  // pairs not in contact
@@ -209,7 +226,10 @@ TEST_CASE("multiple time stepping: the fast and slow pair forces sum to the Ewal
   CHECK(std::fabs(tf(sw.r2 * sw.r2)) < 1e-12);  // beyond r_fast: no fast force
 }
 
-TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5, and a restart between evaluations", "[md][coulomb]") {
+TEST_CASE(
+    "multiple time stepping: physical forces, energy conservation at K = 5, and a restart between "
+    "evaluations",
+    "[md][coulomb]") {
   // (a) the engine's physical force (contact + fast + slow) equals contacts + converged Ewald,
   // with the default coulomb.every = 8 (the split must lose nothing)
   {
@@ -234,7 +254,8 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
       const double want = i < N ? r.fx[i] : (i < 2 * N ? r.fy[i - N] : r.fz[i - 2 * N]);
       err2 += (f[i] - f0[i] - want) * (f[i] - f0[i] - want);
       ref2 += want * want;
-      impulse2 += (fi[i] - f[i]) * (fi[i] - f[i]);  // integrator force at an evaluation step: 7 more slow parts
+      impulse2 += (fi[i] - f[i]) *
+                  (fi[i] - f[i]);  // integrator force at an evaluation step: 7 more slow parts
     }
     INFO("RMS force error / K = " << std::sqrt(err2 / N) / c.coulomb.K);
     CHECK(std::sqrt(err2 / N) / c.coulomb.K <= c.coulomb.accuracy);
@@ -243,7 +264,8 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
   }
   // (b) energy: elastic contacts, fixed +-1 charges at the paper's strongest coupling K = 5 (bound
   // pairs form; the Coulomb energy falls by a factor ~2.8), 1e4 steps: drift below 1e-4 of the
-  // initial kinetic energy with the default multiple time stepping (every 8 steps), as with every = 1
+  // initial kinetic energy with the default multiple time stepping (every 8 steps), as with every =
+  // 1
   for (int every : {0, 1}) {
     INFO("coulomb.every = " << every);
     MdConfig c = chargedConfig(250, 11, 5.0, "pppm");
@@ -255,12 +277,14 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
     const auto o0 = e.observables();
     const double E0 = totalEnergy(o0), scale = o0.kinetic_energy;
     double worst = 0.0;
-    for (int s = 0; s < 10000; s += 80) {  // observables at evaluation steps and between (80 = 10 x 8)
+    for (int s = 0; s < 10000;
+         s += 80) {  // observables at evaluation steps and between (80 = 10 x 8)
       e.run(s % 160 == 0 ? 77 : 83);
       worst = std::max(worst, std::fabs(totalEnergy(e.observables()) - E0) / scale);
     }
     const auto o = e.observables();
-    INFO("max |E - E0| / E_kin(0) = " << worst << ", Coulomb energy " << o0.coulomb_energy << " -> " << o.coulomb_energy);
+    INFO("max |E - E0| / E_kin(0) = " << worst << ", Coulomb energy " << o0.coulomb_energy << " -> "
+                                      << o.coulomb_energy);
     CHECK(o.coulomb_energy < 2.0 * o0.coulomb_energy);  // strongly coupled: pairs bind
     CHECK(worst < 1e-4);
     if (every == 1) break;
@@ -278,7 +302,7 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
     one.run(403);
     Engine first(c, init);
     REQUIRE(first.coulombSetup()->every == 4);  // "auto" at the automatic dt = 0.00344
-    first.run(203);  // 203 = 50 x 4 + 3
+    first.run(203);                             // 203 = 50 x 4 + 3
     const Frame mid = first.frame();
     Engine resumed(c, mid, /*allow_contacts=*/true);
     resumed.restore(mid, first.forces(), first.observables().collisions, first.extraState());
@@ -287,14 +311,16 @@ TEST_CASE("multiple time stepping: physical forces, energy conservation at K = 5
     CHECK(a.x == b.x);
     CHECK(a.vz == b.vz);
     CHECK(a.charge == b.charge);
-    // without the slow force the restart is refused (it cannot be reconstructed between evaluations)
+    // without the slow force the restart is refused (it cannot be reconstructed between
+    // evaluations)
     Engine bare(c, mid, true);
     CHECK_THROWS_AS(bare.restore(mid, first.forces(), 0), std::invalid_argument);
   }
 }
 
-TEST_CASE("multiple time stepping that follows the gas: bounded interval, energy, restart bit for bit",
-          "[md][coulomb]") {
+TEST_CASE(
+    "multiple time stepping that follows the gas: bounded interval, energy, restart bit for bit",
+    "[md][coulomb]") {
   // coulomb.every_max > every: at each evaluation the next interval is floor(k_base v_ref / (2
   // max|u|)) within [k_base, every_max] (Engine.h). impact_speed_max = v_ref = 16 (the time step
   // is fixed, so it sets only this reference) makes the interval vary between 8 and 16 steps in a
@@ -325,7 +351,7 @@ TEST_CASE("multiple time stepping that follows the gas: bounded interval, energy
       k_max = std::max(k_max, e.slowInterval());
     }
     INFO("max |E - E0| / E_kin(0) = " << worst << "; intervals " << k_min << ".." << k_max << ", "
-                                       << e.slowEvaluations() << " evaluations in 1e4 steps");
+                                      << e.slowEvaluations() << " evaluations in 1e4 steps");
     CHECK(k_min >= 8);
     CHECK(k_max <= 16);
     CHECK(k_max > k_min);  // the interval did vary
@@ -353,8 +379,8 @@ TEST_CASE("multiple time stepping that follows the gas: bounded interval, energy
     resumed.restore(mid, first.forces(), first.observables().collisions, first.extraState());
     CHECK(resumed.slowInterval() == k_mid);
     resumed.run(500);
-    INFO("interval at the restart " << k_mid << " (base " << first.coulombSetup()->every << "), at the end "
-                                    << one.slowInterval());
+    INFO("interval at the restart " << k_mid << " (base " << first.coulombSetup()->every
+                                    << "), at the end " << one.slowInterval());
     CHECK(k_mid > first.coulombSetup()->every);
     const Frame a = one.frame(), b = resumed.frame();
     CHECK(a.x == b.x);

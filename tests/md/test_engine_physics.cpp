@@ -50,8 +50,8 @@ MdConfig gasConfig(int N, double D, std::uint64_t seed) {
 }
 
 bool identical(const Frame& a, const Frame& b) {
-  return a.x == b.x && a.y == b.y && a.z == b.z && a.vx == b.vx && a.vy == b.vy && a.vz == b.vz && a.ix == b.ix &&
-         a.iy == b.iy && a.iz == b.iz && a.step == b.step && a.charge == b.charge;
+  return a.x == b.x && a.y == b.y && a.z == b.z && a.vx == b.vx && a.vy == b.vy && a.vz == b.vz &&
+         a.ix == b.ix && a.iy == b.iy && a.iz == b.iz && a.step == b.step && a.charge == b.charge;
 }
 }  // namespace
 
@@ -63,7 +63,8 @@ TEST_CASE("two-body restitution equals the independent contact-ODE integration",
     for (double v : {0.05, 0.1, 0.3, 1.0, 2.0, 3.0}) {
       const double e_md = collide(cfg, v);
       const double e_ref = reference.restitution(v);
-      INFO((clamp ? "clamped" : "unclamped") << " v = " << v << ": MD " << e_md << ", Odeint " << e_ref);
+      INFO((clamp ? "clamped" : "unclamped")
+           << " v = " << v << ": MD " << e_md << ", Odeint " << e_ref);
       // issue 3 acceptance: 1e-3 at the default (auto) time step, >= 50 steps per contact
       CHECK(e_md == Approx(e_ref).margin(1e-3));
     }
@@ -122,7 +123,8 @@ TEST_CASE("momentum is conserved and elastic energy does not drift", "[md][physi
   }
 }
 
-TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart", "[md][determinism]") {
+TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart",
+          "[md][determinism]") {
   MdConfig c = gasConfig(1500, 27.7, 9);
   const Frame init = Engine::randomInitialState(c);
   const int threads = omp_get_max_threads();
@@ -154,7 +156,10 @@ TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart"
   CHECK_FALSE(other.frame().x == one.frame().x);
 }
 
-TEST_CASE("random initial state has T = 1 exactly and zero momentum and no overlaps and overlapping input is refused", "[md][init]") {
+TEST_CASE(
+    "random initial state has T = 1 exactly and zero momentum and no overlaps and overlapping "
+    "input is refused",
+    "[md][init]") {
   MdConfig c = gasConfig(3000, 27.7, 1);
   const Frame f = Engine::randomInitialState(c);
   double p[3] = {0, 0, 0}, s2 = 0;

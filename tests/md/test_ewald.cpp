@@ -54,18 +54,23 @@ constexpr double XI_SC = -2.837297479481;  // single charge + background, E = xi
 TEST_CASE("Ewald real-space pair term: closed form and F = -dE/dr", "[md][coulomb]") {
   const double K = 2.5, alpha = 0.7;
   for (double r : {0.3, 1.0, 2.2, 4.0}) {
-    // erfc(alpha r) via the complementary series-free identity erfc = 1 - erf (independent of ::erfc)
+    // erfc(alpha r) via the complementary series-free identity erfc = 1 - erf (independent of
+    // ::erfc)
     const double e_expected = K * -2.0 * (1.0 - std::erf(alpha * r)) / r;
     CHECK(ewaldRealEnergy(-2.0, r, alpha, K) == Approx(e_expected).epsilon(1e-12));
     const double dr = 1e-6 * r;
-    const double dEdr = (ewaldRealEnergy(-2.0, r + dr, alpha, K) - ewaldRealEnergy(-2.0, r - dr, alpha, K)) / (2 * dr);
+    const double dEdr =
+        (ewaldRealEnergy(-2.0, r + dr, alpha, K) - ewaldRealEnergy(-2.0, r - dr, alpha, K)) /
+        (2 * dr);
     CHECK(ewaldRealForceOverR(-2.0, r, alpha, K) * r == Approx(-dEdr).epsilon(1e-7));
   }
   // alpha -> 0: the bare Coulomb force K q q / r^2 (repulsive for like charges)
   CHECK(ewaldRealForceOverR(1.0, 2.0, 1e-12, 3.0) * 2.0 == Approx(3.0 / 4.0).epsilon(1e-12));
 }
 
-TEST_CASE("fast real-space force (Abramowitz-Stegun erfc) within 1.5e-7 K qq / r^2 of the exact one", "[md][coulomb]") {
+TEST_CASE(
+    "fast real-space force (Abramowitz-Stegun erfc) within 1.5e-7 K qq / r^2 of the exact one",
+    "[md][coulomb]") {
   // A&S 7.1.26 bounds the absolute erfc error by 1.5e-7; the force term erfc(alpha r) / r^2 then
   // errs by at most 1.5e-7 / r^2 per unit K qq.
   const double K = 5.0;
@@ -78,13 +83,15 @@ TEST_CASE("fast real-space force (Abramowitz-Stegun erfc) within 1.5e-7 K qq / r
     }
 }
 
-TEST_CASE("Ewald parameter choice meets the requested estimate and rejects unphysical input", "[md][coulomb]") {
+TEST_CASE("Ewald parameter choice meets the requested estimate and rejects unphysical input",
+          "[md][coulomb]") {
   for (double acc : {1e-3, 1e-5, 1e-8}) {
     const EwaldParams p = chooseEwaldParams(acc, 1000, 19.0, 1000.0);
     CHECK(p.r_cut == 9.5);
     CHECK(p.estimated_error_real == Approx(acc / std::sqrt(2.0)).epsilon(1e-9));
     CHECK(p.estimated_error_kspace <= acc / std::sqrt(2.0));
-    CHECK(ewaldKspaceError(p.alpha, p.k_max - 1, 1000, 19.0, 1000.0) > acc / std::sqrt(2.0));  // smallest k_max
+    CHECK(ewaldKspaceError(p.alpha, p.k_max - 1, 1000, 19.0, 1000.0) >
+          acc / std::sqrt(2.0));  // smallest k_max
     CHECK(p.estimatedError() <= acc * (1 + 1e-12));
   }
   CHECK(fftFriendlySize(7) == 8);
@@ -144,7 +151,8 @@ TEST_CASE("Ewald reference: total energy and forces do not depend on alpha", "[m
     for (double rc_over_L : {0.3, 0.4, 0.8, 1.2}) {
       const EwaldParams p = chooseEwaldParams(1e-11, c.x.size(), c.L, c.sumQ2(), rc_over_L * c.L);
       const CoulombResult r = EwaldReference(p, c.L, 1.0).compute(c.x, c.y, c.z, c.q);
-      INFO("neutral " << neutral << ", alpha " << p.alpha << ", r_cut " << p.r_cut << ", k_max " << p.k_max);
+      INFO("neutral " << neutral << ", alpha " << p.alpha << ", r_cut " << p.r_cut << ", k_max "
+                      << p.k_max);
       CHECK(r.energy == Approx(r0.energy).epsilon(1e-9));
       CHECK(rmsDifference(r, r0) < 1e-9);
       // the pieces do depend on alpha (otherwise this test would prove nothing)
@@ -155,7 +163,8 @@ TEST_CASE("Ewald reference: total energy and forces do not depend on alpha", "[m
 
 TEST_CASE("Ewald reference: forces are minus the gradient of the energy", "[md][coulomb]") {
   Charges c = randomCharges(20, 5.0, false, 3);
-  c.q = {1, -2, 0.5, 1, 1, -1, 3, -0.25, 1, 1, -1, 2, 1, -1, 0.5, 1, -3, 1, 1, -1};  // non-neutral, mixed
+  c.q = {1,  -2, 0.5, 1,  1,   -1, 3,  -0.25, 1, 1,
+         -1, 2,  1,   -1, 0.5, 1,  -3, 1,     1, -1};  // non-neutral, mixed
   const EwaldParams p = chooseEwaldParams(1e-12, c.x.size(), c.L, c.sumQ2());
   const EwaldReference ew(p, c.L, 1.7);
   const CoulombResult r = ew.compute(c.x, c.y, c.z, c.q);
@@ -169,7 +178,8 @@ TEST_CASE("Ewald reference: forces are minus the gradient of the energy", "[md][
       std::vector<double>* pm[3] = {&cm.x, &cm.y, &cm.z};
       (*pp[dim])[i] = (*pos[dim])[i] + d;
       (*pm[dim])[i] = (*pos[dim])[i] - d;
-      const double ep = ew.compute(cp.x, cp.y, cp.z, cp.q).energy, em = ew.compute(cm.x, cm.y, cm.z, cm.q).energy;
+      const double ep = ew.compute(cp.x, cp.y, cp.z, cp.q).energy,
+                   em = ew.compute(cm.x, cm.y, cm.z, cm.q).energy;
       CHECK(f[dim] == Approx(-(ep - em) / (2 * d)).margin(1e-6 * (1.0 + std::abs(f[dim]))));
     }
   }
@@ -196,8 +206,8 @@ TEST_CASE("Kolafa-Perram estimates predict the measured Ewald force error", "[md
       const EwaldParams p = chooseEwaldParams(acc, n, L, c.sumQ2(), rc);
       const CoulombResult r = EwaldReference(p, L, 1.0).compute(c.x, c.y, c.z, c.q);
       const double err = rmsDifference(r, ref);
-      INFO("accuracy " << acc << ", r_cut " << rc << ": measured " << err << ", estimated " << p.estimatedError()
-                       << ", alpha " << p.alpha << ", k_max " << p.k_max);
+      INFO("accuracy " << acc << ", r_cut " << rc << ": measured " << err << ", estimated "
+                       << p.estimatedError() << ", alpha " << p.alpha << ", k_max " << p.k_max);
       CHECK(err <= acc);
       CHECK(err > p.estimatedError() / 3.0);
       CHECK(err < p.estimatedError() * 3.0);

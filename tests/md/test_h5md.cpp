@@ -4,8 +4,11 @@
 // scripts/check_h5md.py checker.
 #include <catch2/catch.hpp>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -15,9 +18,6 @@
 #include <random>
 #include <sstream>
 #include <string>
-#include <csignal>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "md/io/H5mdReader.h"
 #include "md/io/H5mdWriter.h"
@@ -25,9 +25,9 @@
 
 #include "TestUtil.h"
 
-using granagg::test::tempPath;
 using granagg::test::sameBits;
 using granagg::test::slurp;
+using granagg::test::tempPath;
 
 using namespace granagg::md;
 namespace h5 = granagg::md::h5;
@@ -71,23 +71,28 @@ Frame makeFrame(std::size_t n, std::int64_t step, unsigned seed, double L = 7.5)
 bool sameFrame(const Frame& a, const Frame& b) {
   return a.step == b.step && std::memcmp(&a.time, &b.time, sizeof(double)) == 0 && a.box == b.box &&
          sameBits(a.x, b.x) && sameBits(a.y, b.y) && sameBits(a.z, b.z) && sameBits(a.vx, b.vx) &&
-         sameBits(a.vy, b.vy) && sameBits(a.vz, b.vz) && sameBits(a.charge, b.charge) && sameBits(a.ix, b.ix) &&
-         sameBits(a.iy, b.iy) && sameBits(a.iz, b.iz);
+         sameBits(a.vy, b.vy) && sameBits(a.vz, b.vz) && sameBits(a.charge, b.charge) &&
+         sameBits(a.ix, b.ix) && sameBits(a.iy, b.iy) && sameBits(a.iz, b.iz);
 }
 
 const std::vector<std::pair<std::string, std::string>> PARAMS = {
-    {"command", "granagg md --config run.toml"}, {"seed", "42"}, {"version", "granagg test"}, {"system.N", "16"}};
+    {"command", "granagg md --config run.toml"},
+    {"seed", "42"},
+    {"version", "granagg test"},
+    {"system.N", "16"}};
 const std::string TOML = "[input]\nversion = 1\n\n[system]\nN = 16\nseed = 42\n";
 
 /// Writes `frames` frames of n particles (steps 0, 100, 200, ...) plus observables every 25 steps.
-std::vector<Frame> writeTrajectory(const std::string& path, std::size_t n, int frames, bool velocities = true) {
+std::vector<Frame> writeTrajectory(const std::string& path, std::size_t n, int frames,
+                                   bool velocities = true) {
   removeTrajectory(path);
   std::vector<Frame> written;
   H5mdWriter w(path, n, PARAMS, TOML, /*overwrite=*/false, velocities);
   for (int k = 0; k < frames; ++k) {
     for (int s = 0; s < 4; ++s) {
       const std::int64_t step = 100 * k + 25 * s;
-      w.writeObservables(step, 1e-3 * step, {{"kinetic_energy", 1.5 + step}, {"temperature", 1.0 / (1 + step)}});
+      w.writeObservables(step, 1e-3 * step,
+                         {{"kinetic_energy", 1.5 + step}, {"temperature", 1.0 / (1 + step)}});
     }
     written.push_back(makeFrame(n, 100 * k, 1000u + static_cast<unsigned>(k)));
     w.writeFrame(written.back());
@@ -108,7 +113,8 @@ unsigned linkCount(hid_t file, const std::string& path) {
   return info.rc;
 }
 
-std::vector<hsize_t> dimsOf(hid_t file, const std::string& path, std::vector<hsize_t>* maxdims = nullptr) {
+std::vector<hsize_t> dimsOf(hid_t file, const std::string& path,
+                            std::vector<hsize_t>* maxdims = nullptr) {
   h5::Handle d(H5Dopen2(file, path.c_str(), H5P_DEFAULT));
   REQUIRE(d.valid());
   h5::Handle s(H5Dget_space(d.get()));
@@ -166,7 +172,8 @@ TEST_CASE("H5MD frames read back bit for bit", "[md][io]") {
   CHECK(ke.time[5] == 1e-3 * 125);
   CHECK(ke.value[5] == 1.5 + 125);
   CHECK(r.readObservable("temperature").value[11] == 1.0 / (1 + 275));  // last sample: step 275
-  CHECK_THROWS_WITH(r.readObservable("pressure"), Catch::Contains("no observable named 'pressure'"));
+  CHECK_THROWS_WITH(r.readObservable("pressure"),
+                    Catch::Contains("no observable named 'pressure'"));
   r = H5mdReader(tempPath("roundtrip.h5"));  // move assignment closes the previous file
   removeTrajectory(path);
 }
@@ -205,7 +212,8 @@ TEST_CASE("H5MD layout follows the H5MD 1.1 specification and MDAnalysis' reader
     REQUIRE(a.valid());
     h5::Handle t(H5Aget_type(a.get()));
     CHECK(H5Tget_class(t.get()) == H5T_INTEGER);
-    CHECK(h5::readNumericAttribute<std::int64_t>(a.get(), H5T_NATIVE_INT64, "version") == std::vector<std::int64_t>{1, 1});
+    CHECK(h5::readNumericAttribute<std::int64_t>(a.get(), H5T_NATIVE_INT64, "version") ==
+          std::vector<std::int64_t>{1, 1});
     h5::Handle author(H5Gopen2(f, "/h5md/author", H5P_DEFAULT));
     h5::Handle aname = h5::openAttribute(author.get(), "name");
     REQUIRE(aname.valid());
@@ -224,10 +232,12 @@ TEST_CASE("H5MD layout follows the H5MD 1.1 specification and MDAnalysis' reader
     REQUIRE(box.valid());
     h5::Handle dim = h5::openAttribute(box.get(), "dimension");
     REQUIRE(dim.valid());
-    CHECK(h5::readNumericAttribute<std::int64_t>(dim.get(), H5T_NATIVE_INT64, "dimension") == std::vector<std::int64_t>{3});
+    CHECK(h5::readNumericAttribute<std::int64_t>(dim.get(), H5T_NATIVE_INT64, "dimension") ==
+          std::vector<std::int64_t>{3});
     h5::Handle bnd = h5::openAttribute(box.get(), "boundary");
     REQUIRE(bnd.valid());
-    CHECK(h5::readStringArrayAttribute(bnd.get(), "boundary") == std::vector<std::string>{"periodic", "periodic", "periodic"});
+    CHECK(h5::readStringArrayAttribute(bnd.get(), "boundary") ==
+          std::vector<std::string>{"periodic", "periodic", "periodic"});
     CHECK(dimsOf(f, "/particles/all/box/edges/value") == std::vector<hsize_t>{2, 3, 3});
     h5::Handle e(H5Dopen2(f, "/particles/all/box/edges/value", H5P_DEFAULT));
     const auto edges = h5::readAll<double>(e.get(), H5T_NATIVE_DOUBLE, "edges");
@@ -287,7 +297,8 @@ TEST_CASE("H5mdWriter never overwrites silently", "[md][io]") {
   removeTrajectory(path);
   { H5mdWriter w(path, 4, {}, "", false); }
   CHECK_THROWS_AS(H5mdWriter(path, 4, {}, "", false), std::invalid_argument);
-  CHECK_THROWS_WITH(H5mdWriter(path, 4, {}, "", false), Catch::Contains(path) && Catch::Contains("already exists"));
+  CHECK_THROWS_WITH(H5mdWriter(path, 4, {}, "", false),
+                    Catch::Contains(path) && Catch::Contains("already exists"));
   CHECK_NOTHROW(H5mdWriter(path, 4, {}, "", /*overwrite=*/true));
   removeTrajectory(path);
 }
@@ -296,7 +307,8 @@ TEST_CASE("H5mdWriter rejects bad arguments and frames", "[md][io]") {
   const std::string path = tempPath("bad.h5");
   removeTrajectory(path);
   CHECK_THROWS_WITH(H5mdWriter(path, 0, {}, "", false), Catch::Contains("N >= 1"));
-  CHECK_THROWS_WITH(H5mdWriter(path, 3, {{"seed", "1"}, {"seed", "2"}}, "", false), Catch::Contains("'seed' is given twice"));
+  CHECK_THROWS_WITH(H5mdWriter(path, 3, {{"seed", "1"}, {"seed", "2"}}, "", false),
+                    Catch::Contains("'seed' is given twice"));
   H5mdWriter w(path, 3, {}, "", true);
   Frame f = makeFrame(3, 10, 1);
   Frame small = makeFrame(2, 10, 1);
@@ -310,7 +322,8 @@ TEST_CASE("H5mdWriter rejects bad arguments and frames", "[md][io]") {
   w.writeFrame(f);
   CHECK_THROWS_WITH(w.writeFrame(f), Catch::Contains("steps must increase"));
   w.writeObservables(1, 0.1, {{"a", 1.0}});
-  CHECK_THROWS_WITH(w.writeObservables(2, 0.2, {{"b", 1.0}}), Catch::Contains("unknown observable 'b'"));
+  CHECK_THROWS_WITH(w.writeObservables(2, 0.2, {{"b", 1.0}}),
+                    Catch::Contains("unknown observable 'b'"));
   CHECK_THROWS_WITH(w.writeObservables(1, 0.2, {{"a", 1.0}}), Catch::Contains("must increase"));
   CHECK(w.frames() == 1);
   w.close();
@@ -322,13 +335,13 @@ TEST_CASE("H5mdWriter wraps stray positions and keeps unwrapped coordinates", "[
   const std::string path = tempPath("wrap.h5");
   removeTrajectory(path);
   Frame f = makeFrame(4, 0, 3, 10.0);
-  f.x[1] = 10.0;          // exactly L: engine round-off
-  f.y[2] = -0.25;         // just outside
-  f.z[3] = 35.5;          // several boxes away
+  f.x[1] = 10.0;   // exactly L: engine round-off
+  f.y[2] = -0.25;  // just outside
+  f.z[3] = 35.5;   // several boxes away
   f.ix[1] = 2;
   f.iy[2] = 0;
   f.iz[3] = -1;
-  f.charge.clear();       // neutral gas: written as zeros
+  f.charge.clear();  // neutral gas: written as zeros
   {
     H5mdWriter w(path, 4, {}, "", true);
     w.writeFrame(f);
@@ -366,8 +379,9 @@ TEST_CASE("H5MD reader errors name the file: truncated, not HDF5, missing", "[md
   }
   CHECK_THROWS_WITH(H5mdReader(text), Catch::Contains(text) && Catch::Contains("not an HDF5 file"));
   CHECK_THROWS_WITH(H5mdReader(tempPath("nonexistent.h5")), Catch::Contains("does not exist"));
-  CHECK_THROWS_WITH(H5mdReader(path, "solvent"), Catch::Contains("no particle group '/particles/solvent'") &&
-                                                     Catch::Contains("available: all"));
+  CHECK_THROWS_WITH(H5mdReader(path, "solvent"),
+                    Catch::Contains("no particle group '/particles/solvent'") &&
+                        Catch::Contains("available: all"));
   std::remove(half.c_str());
   std::remove(text.c_str());
   removeTrajectory(path);
@@ -399,36 +413,43 @@ TEST_CASE("H5MD reader accepts another engine's file and names bad datasets", "[
                                      {{0.75f, 1.f, 1.5f}, {4.25f, -0.5f, 2.f}, {3.f, 3.f, -2.f}}};
     const hsize_t dims[3] = {frames, n, 3};
     h5::Handle space(H5Screate_simple(3, dims, nullptr));
-    h5::Handle d(H5Dcreate2(pos.get(), "value", H5T_IEEE_F32LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    h5::Handle d(H5Dcreate2(pos.get(), "value", H5T_IEEE_F32LE, space.get(), H5P_DEFAULT,
+                            H5P_DEFAULT, H5P_DEFAULT));
     H5Dwrite(d.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, xyz);
     h5::Handle scalar(H5Screate(H5S_SCALAR));
     const std::int64_t inc = 50;
-    h5::Handle st(H5Dcreate2(pos.get(), "step", H5T_STD_I64LE, scalar.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    h5::Handle st(H5Dcreate2(pos.get(), "step", H5T_STD_I64LE, scalar.get(), H5P_DEFAULT,
+                             H5P_DEFAULT, H5P_DEFAULT));
     H5Dwrite(st.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, &inc);
     h5::writeAttribute(st.get(), "offset", std::int64_t{1000}, "t");
     const double dtime = 0.5;
-    h5::Handle tm(H5Dcreate2(pos.get(), "time", H5T_IEEE_F64LE, scalar.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    h5::Handle tm(H5Dcreate2(pos.get(), "time", H5T_IEEE_F64LE, scalar.get(), H5P_DEFAULT,
+                             H5P_DEFAULT, H5P_DEFAULT));
     H5Dwrite(tm.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &dtime);
     if (with_box) {
       h5::Handle box = h5::createGroup(f, "particles/atoms/box", "t");
       const int dim = 3;
       h5::writeAttribute(box.get(), "dimension", H5T_STD_I32LE, H5T_NATIVE_INT, &dim, {}, "t");
-      h5::writeFixedStringArrayAttribute(box.get(), "boundary", {"periodic", "periodic", "periodic"}, "t");
+      h5::writeFixedStringArrayAttribute(box.get(), "boundary",
+                                         {"periodic", "periodic", "periodic"}, "t");
       const double e[3] = {L, L, L};
       const hsize_t d3[1] = {3};
       h5::Handle s3(H5Screate_simple(1, d3, nullptr));
-      h5::Handle ed(H5Dcreate2(box.get(), "edges", H5T_IEEE_F64LE, s3.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+      h5::Handle ed(H5Dcreate2(box.get(), "edges", H5T_IEEE_F64LE, s3.get(), H5P_DEFAULT,
+                               H5P_DEFAULT, H5P_DEFAULT));
       H5Dwrite(ed.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, e);
     }
     if (bad_velocity) {
       h5::Handle vel = h5::createGroup(f, "particles/atoms/velocity", "t");
       const hsize_t vd[3] = {frames, n + 1, 3};
       h5::Handle vs(H5Screate_simple(3, vd, nullptr));
-      h5::Handle vv(H5Dcreate2(vel.get(), "value", H5T_IEEE_F64LE, vs.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+      h5::Handle vv(H5Dcreate2(vel.get(), "value", H5T_IEEE_F64LE, vs.get(), H5P_DEFAULT,
+                               H5P_DEFAULT, H5P_DEFAULT));
       const std::int64_t steps[frames] = {1000, 1050};
       const hsize_t fd[1] = {frames};
       h5::Handle ss(H5Screate_simple(1, fd, nullptr));
-      h5::Handle vst(H5Dcreate2(vel.get(), "step", H5T_STD_I64LE, ss.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+      h5::Handle vst(H5Dcreate2(vel.get(), "step", H5T_STD_I64LE, ss.get(), H5P_DEFAULT,
+                                H5P_DEFAULT, H5P_DEFAULT));
       H5Dwrite(vst.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps);
     }
   };
@@ -459,9 +480,11 @@ TEST_CASE("H5MD reader accepts another engine's file and names bad datasets", "[
     CHECK(r.readFrame(0).iz[2] == 2);
   }
   build(false, false);
-  CHECK_THROWS_WITH(H5mdReader(path), Catch::Contains(path) && Catch::Contains("particles/atoms/box"));
+  CHECK_THROWS_WITH(H5mdReader(path),
+                    Catch::Contains(path) && Catch::Contains("particles/atoms/box"));
   build(true, true);
-  CHECK_THROWS_WITH(H5mdReader(path), Catch::Contains(path) && Catch::Contains("particles/atoms/velocity/value") &&
+  CHECK_THROWS_WITH(H5mdReader(path), Catch::Contains(path) &&
+                                          Catch::Contains("particles/atoms/velocity/value") &&
                                           Catch::Contains("shape [2,4,3]"));
   std::remove(path.c_str());
 }
@@ -522,8 +545,8 @@ TEST_CASE("Reopening for a restart drops what followed the checkpoint", "[md][io
   const auto written = writeTrajectory(path, 8, 4);  // frames at steps 0..300, observables every 25
   {
     H5mdWriter w = H5mdWriter::reopen(path, 8, /*restart_step=*/150);
-    CHECK(w.frames() == 2);               // steps 0 and 100 kept
-    CHECK(w.observableSamples() == 7);    // steps 0..150
+    CHECK(w.frames() == 2);                                            // steps 0 and 100 kept
+    CHECK(w.observableSamples() == 7);                                 // steps 0..150
     CHECK_THROWS_AS(w.writeFrame(written[1]), std::invalid_argument);  // step 100 already there
     w.writeObservables(175, 0.175, {{"temperature", 0.5}, {"kinetic_energy", 2.0}});
     w.writeFrame(written[2]);
@@ -554,7 +577,8 @@ TEST_CASE("XDMF sidecar describes every frame as a Polyvertex point cloud", "[md
   const std::string text = slurp(xdmf);
   REQUIRE_FALSE(text.empty());
   std::size_t grids = 0;
-  for (std::size_t p = text.find("<Grid Name=\"frame"); p != std::string::npos; p = text.find("<Grid Name=\"frame", p + 1))
+  for (std::size_t p = text.find("<Grid Name=\"frame"); p != std::string::npos;
+       p = text.find("<Grid Name=\"frame", p + 1))
     ++grids;
   CHECK(grids == 3);
   CHECK(text.find("TopologyType=\"Polyvertex\" NumberOfElements=\"7\"") != std::string::npos);
@@ -577,7 +601,8 @@ TEST_CASE("scripts/check_h5md.py accepts our trajectories and rejects broken one
   const std::string path = tempPath("check.h5");
   writeTrajectory(path, 9, 3);
   const std::string out = tempPath("check.txt");
-  const int rc = std::system(("/usr/bin/python3 " + script + " " + path + " > " + out + " 2>&1").c_str());
+  const int rc =
+      std::system(("/usr/bin/python3 " + script + " " + path + " > " + out + " 2>&1").c_str());
   const std::string report = slurp(out);
   INFO(report);
   CHECK(rc == 0);
@@ -586,11 +611,13 @@ TEST_CASE("scripts/check_h5md.py accepts our trajectories and rejects broken one
 
   // the XDMF sidecar in ParaView's own XDMF Reader, where ParaView's Python module exists
   if (std::system("/usr/bin/python3 -c 'import paraview.simple' >/dev/null 2>&1") == 0) {
-    const int rc_pv = std::system(("/usr/bin/python3 " + script + " --paraview " + path + " > " + out + " 2>&1").c_str());
+    const int rc_pv = std::system(
+        ("/usr/bin/python3 " + script + " --paraview " + path + " > " + out + " 2>&1").c_str());
     const std::string pv = slurp(out);
     INFO(pv);
     CHECK(rc_pv == 0);
-    CHECK(pv.find("ParaView XDMF Reader: 3 time steps, 9 points, last frame exact") != std::string::npos);
+    CHECK(pv.find("ParaView XDMF Reader: 3 time steps, 9 points, last frame exact") !=
+          std::string::npos);
   } else {
     WARN("ParaView's Python module not available: XDMF sidecar not loaded in ParaView");
   }
@@ -601,7 +628,8 @@ TEST_CASE("scripts/check_h5md.py accepts our trajectories and rejects broken one
     h5::Handle box(H5Gopen2(file.get(), "/particles/all/box", H5P_DEFAULT));
     REQUIRE(H5Adelete(box.get(), "boundary") >= 0);
   }
-  const int rc2 = std::system(("/usr/bin/python3 " + script + " " + path + " > " + out + " 2>&1").c_str());
+  const int rc2 =
+      std::system(("/usr/bin/python3 " + script + " " + path + " > " + out + " 2>&1").c_str());
   INFO(slurp(out));
   CHECK(rc2 != 0);
   CHECK(slurp(out).find("boundary") != std::string::npos);

@@ -2,12 +2,12 @@
 // naming the line and particle) and H5MD (last frame of a trajectory), plus coordinate wrapping.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
 #include <string>
-#include <unistd.h>
 
 #include "md/io/H5mdWriter.h"
 #include "md/io/InitialState.h"
@@ -74,11 +74,11 @@ TEST_CASE("CSV initial state: columns in any order, comments, wrapping", "[md][i
   CHECK(f.x[0] == 1.0);
   CHECK(f.vz[0] == 0.3);
   CHECK(f.charge[1] == -0.5);
-  CHECK(f.x[1] == 1.0);   // 11 -> 1, one box crossed
+  CHECK(f.x[1] == 1.0);  // 11 -> 1, one box crossed
   CHECK(f.ix[1] == 1);
-  CHECK(f.y[1] == 9.0);   // -1 -> 9
+  CHECK(f.y[1] == 9.0);  // -1 -> 9
   CHECK(f.iy[1] == -1);
-  CHECK(f.z[2] == 5.0);   // 25 -> 5
+  CHECK(f.z[2] == 5.0);  // 25 -> 5
   CHECK(f.iz[2] == 2);
   CHECK(f.ix[0] == 0);
   CHECK(f.vz[2] == 1e-3);
@@ -92,20 +92,25 @@ TEST_CASE("CSV initial state: columns in any order, comments, wrapping", "[md][i
 
 TEST_CASE("CSV initial state errors name the file, line and particle", "[md][io]") {
   SECTION("non-finite value") {
-    const std::string p = writeText("nan.csv", "# comment\nx,y,z,vx,vy,vz\n1,1,1,0,0,0\n\n2,2,2,nan,0,0\n");
+    const std::string p =
+        writeText("nan.csv", "# comment\nx,y,z,vx,vy,vz\n1,1,1,0,0,0\n\n2,2,2,nan,0,0\n");
     CHECK_THROWS_AS(readInitialState(p, 10.0), std::invalid_argument);
-    CHECK_THROWS_WITH(readInitialState(p, 10.0),
-                      Catch::Contains(p + ":5") && Catch::Contains("particle 1") && Catch::Contains("vx"));
+    CHECK_THROWS_WITH(readInitialState(p, 10.0), Catch::Contains(p + ":5") &&
+                                                     Catch::Contains("particle 1") &&
+                                                     Catch::Contains("vx"));
     std::remove(p.c_str());
   }
   SECTION("infinite position") {
-    const std::string p = writeText("inf.csv", "x,y,z,vx,vy,vz,q\n1,1,1,0,0,0,0\n2,inf,2,0,0,0,0\n");
-    CHECK_THROWS_WITH(readInitialState(p, 10.0), Catch::Contains(p + ":3") && Catch::Contains("y = inf"));
+    const std::string p =
+        writeText("inf.csv", "x,y,z,vx,vy,vz,q\n1,1,1,0,0,0,0\n2,inf,2,0,0,0,0\n");
+    CHECK_THROWS_WITH(readInitialState(p, 10.0),
+                      Catch::Contains(p + ":3") && Catch::Contains("y = inf"));
     std::remove(p.c_str());
   }
   SECTION("not a number") {
     const std::string p = writeText("abc.csv", "x,y,z,vx,vy,vz\n1,1,1,0,0,0\n2,2,abc,0,0,0\n");
-    CHECK_THROWS_WITH(readInitialState(p, 10.0), Catch::Contains(p + ":3") && Catch::Contains("'abc'"));
+    CHECK_THROWS_WITH(readInitialState(p, 10.0),
+                      Catch::Contains(p + ":3") && Catch::Contains("'abc'"));
     std::remove(p.c_str());
   }
   SECTION("too few particles") {
@@ -116,9 +121,11 @@ TEST_CASE("CSV initial state errors name the file, line and particle", "[md][io]
   SECTION("missing, unknown and duplicated columns") {
     const std::string a = writeText("missing.csv", "x,y,z,vx,vy\n1,1,1,0,0\n2,2,2,0,0\n");
     CHECK_THROWS_WITH(readInitialState(a, 10.0), Catch::Contains("vz"));
-    const std::string b = writeText("unknown.csv", "x,y,z,vx,vy,vz,mass\n1,1,1,0,0,0,1\n2,2,2,0,0,0,1\n");
+    const std::string b =
+        writeText("unknown.csv", "x,y,z,vx,vy,vz,mass\n1,1,1,0,0,0,1\n2,2,2,0,0,0,1\n");
     CHECK_THROWS_WITH(readInitialState(b, 10.0), Catch::Contains("unknown column 'mass'"));
-    const std::string c = writeText("twice.csv", "x,y,z,vx,vy,vz,x\n1,1,1,0,0,0,1\n2,2,2,0,0,0,1\n");
+    const std::string c =
+        writeText("twice.csv", "x,y,z,vx,vy,vz,x\n1,1,1,0,0,0,1\n2,2,2,0,0,0,1\n");
     CHECK_THROWS_WITH(readInitialState(c, 10.0), Catch::Contains("column 'x' appears twice"));
     for (const auto& p : {a, b, c}) std::remove(p.c_str());
   }
@@ -126,7 +133,8 @@ TEST_CASE("CSV initial state errors name the file, line and particle", "[md][io]
     const std::string p = writeText("box.csv", "x,y,z,vx,vy,vz\n1,1,1,0,0,0\n2,2,2,0,0,0\n");
     CHECK_THROWS_WITH(readInitialState(p, 0.0), Catch::Contains("box edge must be positive"));
     std::remove(p.c_str());
-    CHECK_THROWS_WITH(readInitialState(tempPath("none.csv"), 10.0), Catch::Contains("does not exist"));
+    CHECK_THROWS_WITH(readInitialState(tempPath("none.csv"), 10.0),
+                      Catch::Contains("does not exist"));
   }
 }
 

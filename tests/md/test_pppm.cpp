@@ -50,9 +50,9 @@ Charges gas(int n, bool neutral, unsigned seed) {
 /// PPPM total (mesh part + O(N^2) real space with the same RealSpace.h terms the engine uses).
 CoulombResult pppmTotal(Pppm& pppm, const Charges& c, double K) {
   CoulombResult r = pppm.computeHost(c.x, c.y, c.z, c.q);
-  r.energy_real = EwaldReference::realSpace(c.x.data(), c.y.data(), c.z.data(), c.q.data(), c.x.size(), c.L, K,
-                                            pppm.params().alpha, pppm.params().r_cut, r.fx.data(), r.fy.data(),
-                                            r.fz.data());
+  r.energy_real = EwaldReference::realSpace(
+      c.x.data(), c.y.data(), c.z.data(), c.q.data(), c.x.size(), c.L, K, pppm.params().alpha,
+      pppm.params().r_cut, r.fx.data(), r.fy.data(), r.fz.data());
   r.energy += r.energy_real;
   return r;
 }
@@ -67,7 +67,8 @@ double rmsDifference(const CoulombResult& a, const CoulombResult& b) {
 }
 double rmsForce(const CoulombResult& a) {
   double s = 0.0;
-  for (std::size_t i = 0; i < a.fx.size(); ++i) s += a.fx[i] * a.fx[i] + a.fy[i] * a.fy[i] + a.fz[i] * a.fz[i];
+  for (std::size_t i = 0; i < a.fx.size(); ++i)
+    s += a.fx[i] * a.fx[i] + a.fy[i] * a.fy[i] + a.fz[i] * a.fz[i];
   return std::sqrt(s / a.fx.size());
 }
 
@@ -105,11 +106,11 @@ TEST_CASE("PPPM: Madelung constants of NaCl and CsCl at the default accuracy", "
     const PppmParams p = choosePppmParams(DEFAULT_ACCURACY, c.x.size(), c.L, c.sumQ2(), 0.5 * c.L);
     Pppm pppm(p, c.L, 1.0);
     const CoulombResult r = pppmTotal(pppm, c, 1.0);
-    INFO((crystal == 0 ? "NaCl" : "CsCl") << ": mesh " << p.mesh << ", order " << p.order << ", alpha " << p.alpha
-                                          << ", r_cut " << p.r_cut);
+    INFO((crystal == 0 ? "NaCl" : "CsCl") << ": mesh " << p.mesh << ", order " << p.order
+                                          << ", alpha " << p.alpha << ", r_cut " << p.r_cut);
     CHECK(-r.energy / (c.q.size() / 2) == Approx(M_ref).margin(1e-4));
-    WARN((crystal == 0 ? "NaCl" : "CsCl") << " Madelung from PPPM: " << -r.energy / (c.q.size() / 2) << " (mesh "
-                                          << p.mesh << ")");
+    WARN((crystal == 0 ? "NaCl" : "CsCl")
+         << " Madelung from PPPM: " << -r.energy / (c.q.size() / 2) << " (mesh " << p.mesh << ")");
   }
 }
 
@@ -138,8 +139,8 @@ TEST_CASE("PPPM: single charge in a neutralising background", "[md][coulomb]") {
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b)
         for (int c = 0; c < 3; ++c, ++samples) {
-          const CoulombResult r =
-              pppm.computeHost({base[0] + a * h / 3}, {base[1] + b * h / 3}, {base[2] + c * h / 3}, {1.0});
+          const CoulombResult r = pppm.computeHost({base[0] + a * h / 3}, {base[1] + b * h / 3},
+                                                   {base[2] + c * h / 3}, {1.0});
           mean += r.energy / (1.0 / (2.0 * L));
           fmax = std::max({fmax, std::abs(r.fx[0]), std::abs(r.fy[0]), std::abs(r.fz[0])});
         }
@@ -158,7 +159,8 @@ TEST_CASE("PPPM: single charge in a neutralising background", "[md][coulomb]") {
   omp_set_num_threads(threads_before);
 }
 
-TEST_CASE("PPPM forces against converged Ewald: RMS error at or below the requested accuracy", "[md][coulomb]") {
+TEST_CASE("PPPM forces against converged Ewald: RMS error at or below the requested accuracy",
+          "[md][coulomb]") {
   // Error = RMS over particles of |F_pppm - F_ewald| / K (K = force between two unit charges at
   // unit distance; docs/coulomb.md). N = 1000 at phi = 0.076, charges +-1 (neutral) or all +1.
   for (bool neutral : {true, false}) {
@@ -170,15 +172,17 @@ TEST_CASE("PPPM forces against converged Ewald: RMS error at or below the reques
       Pppm pppm(p, c.L, 1.0);
       const auto t0 = std::chrono::steady_clock::now();
       const CoulombResult mesh = pppm.computeHost(c.x, c.y, c.z, c.q);
-      const double t_mesh = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double t_mesh =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       const CoulombResult r = pppmTotal(pppm, c, 1.0);
       const double err = rmsDifference(r, ref.ewald);
       const double est = p.estimatedError();
-      INFO((neutral ? "neutral" : "all +1") << ", accuracy " << acc << ": mesh " << p.mesh << ", order " << p.order
-                                            << ", alpha " << p.alpha << ", r_cut " << p.r_cut << "; measured "
-                                            << err << " (relative to RMS |F|: " << err / rmsForce(ref.ewald)
-                                            << "), estimated " << est << " (real " << p.estimated_error_real
-                                            << ", mesh " << p.estimated_error_kspace << "), mesh time " << t_mesh);
+      INFO((neutral ? "neutral" : "all +1")
+           << ", accuracy " << acc << ": mesh " << p.mesh << ", order " << p.order << ", alpha "
+           << p.alpha << ", r_cut " << p.r_cut << "; measured " << err
+           << " (relative to RMS |F|: " << err / rmsForce(ref.ewald) << "), estimated " << est
+           << " (real " << p.estimated_error_real << ", mesh " << p.estimated_error_kspace
+           << "), mesh time " << t_mesh);
       CHECK(err <= acc);
       CHECK(err > est / 3.0);
       CHECK(err < est * 3.0);
@@ -186,15 +190,17 @@ TEST_CASE("PPPM forces against converged Ewald: RMS error at or below the reques
       // charges +1 the real-space truncation misses a systematic tail, (n/2) int_{r_cut} 4 pi r
       // erfc(alpha r) dr per particle, which does not average out (1.2e-3 measured at 1e-3)
       CHECK(std::abs(r.energy - ref.ewald.energy) / c.x.size() < (neutral ? 1.0 : 3.0) * acc);
-      WARN("PPPM " << (neutral ? "neutral" : "all +1") << " acc " << acc << ": mesh " << p.mesh << " P " << p.order
-                   << " alpha " << p.alpha << " rc " << p.r_cut << " measured " << err << " (/RMS|F| "
-                   << err / rmsForce(ref.ewald) << ") est " << est << " mesh-part time " << t_mesh << " s");
+      WARN("PPPM " << (neutral ? "neutral" : "all +1") << " acc " << acc << ": mesh " << p.mesh
+                   << " P " << p.order << " alpha " << p.alpha << " rc " << p.r_cut << " measured "
+                   << err << " (/RMS|F| " << err / rmsForce(ref.ewald) << ") est " << est
+                   << " mesh-part time " << t_mesh << " s");
       (void)mesh;
     }
   }
 }
 
-TEST_CASE("PPPM: mesh part alone against the Ewald reciprocal part at the same alpha", "[md][coulomb]") {
+TEST_CASE("PPPM: mesh part alone against the Ewald reciprocal part at the same alpha",
+          "[md][coulomb]") {
   // Isolates the mesh error from the real-space truncation: Ewald with PPPM's alpha and a large
   // k_max gives the exact reciprocal + self + background part.
   const Reference& ref = gasReference(true);
@@ -206,14 +212,16 @@ TEST_CASE("PPPM: mesh part alone against the Ewald reciprocal part at the same a
   while (ewaldKspaceError(p.alpha, ep.k_max, c.x.size(), c.L, c.sumQ2()) > 1e-9) ++ep.k_max;
   const CoulombResult rec = EwaldReference(ep, c.L, 1.0).compute(c.x, c.y, c.z, c.q);
   const double err = rmsDifference(mesh, rec);
-  INFO("mesh " << p.mesh << ": measured mesh error " << err << ", estimated " << p.estimated_error_kspace);
+  INFO("mesh " << p.mesh << ": measured mesh error " << err << ", estimated "
+               << p.estimated_error_kspace);
   CHECK(err < 3.0 * p.estimated_error_kspace);
   CHECK(err > p.estimated_error_kspace / 3.0);
   CHECK(mesh.energy_self == Approx(rec.energy_self).epsilon(1e-12));
   CHECK(std::abs(mesh.energy_kspace - rec.energy_kspace) < 1e-4 * c.x.size() * 1e-2);
 }
 
-TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of storage order", "[md][coulomb]") {
+TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of storage order",
+          "[md][coulomb]") {
   const Reference& ref = gasReference(false);
   const Charges& c = ref.c;
   const PppmParams p = choosePppmParams(1e-4, c.x.size(), c.L, c.sumQ2(), 6.0);
@@ -224,7 +232,8 @@ TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of stora
   omp_set_num_threads(2);
   Pppm two(p, c.L, 1.0);
   const CoulombResult r2 = two.computeHost(c.x, c.y, c.z, c.q);
-  const CoulombResult r1b = one.computeHost(c.x, c.y, c.z, c.q);  // plan made for 1 thread, run on 2
+  const CoulombResult r1b =
+      one.computeHost(c.x, c.y, c.z, c.q);  // plan made for 1 thread, run on 2
   omp_set_num_threads(threads_before);
   const std::size_t bytes = c.x.size() * sizeof(double);
   for (const CoulombResult* r : {&r2, &r1b}) {
@@ -234,7 +243,8 @@ TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of stora
     CHECK(r1.energy == r->energy);
   }
 
-#if !defined(GRANAGG_CUDA)  // compute() takes device pointers: host arrays serve only on the OpenMP backend
+#if !defined(GRANAGG_CUDA)  // compute() takes device pointers: host arrays serve only on the OpenMP
+                            // backend
   // storage order: the same particles stored reversed, with their ids, give bit-identical forces
   const std::size_t n = c.x.size();
   std::vector<double> x(n), y(n), z(n), q(n), fx(n, 0.0), fy(n, 0.0), fz(n, 0.0);
@@ -247,7 +257,8 @@ TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of stora
     q[s] = c.q[i];
     id[s] = static_cast<int>(i);
   }
-  const double e = two.compute(x.data(), y.data(), z.data(), q.data(), n, fx.data(), fy.data(), fz.data(), id.data());
+  const double e = two.compute(x.data(), y.data(), z.data(), q.data(), n, fx.data(), fy.data(),
+                               fz.data(), id.data());
   CHECK(e == r2.energy);
   // the packed (x, y, z, q) layout of the engine gives the same bits
   std::vector<double> pos4(4 * n), gx(n, 0.0), gy(n, 0.0), gz(n, 0.0);
@@ -269,7 +280,8 @@ TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of stora
 #endif
 }
 
-TEST_CASE("PPPM parameter choice: estimates, cost optimisation and invalid input", "[md][coulomb]") {
+TEST_CASE("PPPM parameter choice: estimates, cost optimisation and invalid input",
+          "[md][coulomb]") {
   const double L = std::cbrt(1e4 * M_PI / (6 * 0.076));
   for (double acc : {1e-3, 1e-4, 1e-5})
     for (int order = 2; order <= 7; ++order) {
@@ -277,7 +289,8 @@ TEST_CASE("PPPM parameter choice: estimates, cost optimisation and invalid input
       try {
         p = choosePppmParams(acc, 10000, L, 1e4, 5.0, order);
       } catch (const std::invalid_argument&) {
-        // low orders need meshes beyond the limit (1024 per edge) at high accuracy: allowed for P <= 3
+        // low orders need meshes beyond the limit (1024 per edge) at high accuracy: allowed for P
+        // <= 3
         CHECK(order <= 3);
         continue;
       }
@@ -288,17 +301,21 @@ TEST_CASE("PPPM parameter choice: estimates, cost optimisation and invalid input
       // the smallest FFT-friendly mesh that meets the target
       int smaller = p.mesh - 1;
       while (smaller >= order && fftFriendlySize(smaller) != smaller) --smaller;
-      if (smaller >= order) CHECK(pppmKspaceError(p.alpha, smaller, order, 10000, L, 1e4) > acc / std::sqrt(2.0));
+      if (smaller >= order)
+        CHECK(pppmKspaceError(p.alpha, smaller, order, 10000, L, 1e4) > acc / std::sqrt(2.0));
     }
   const PppmParams best = optimizePppmParams(1e-4, 10000, L, 1e4, 3.0);
   CHECK(best.estimatedError() <= 1e-4 * (1 + 1e-12));
   CHECK(best.r_cut >= 3.0);
   CHECK(best.r_cut <= 0.5 * L);
   for (double rc : {3.0, 5.0, 8.0})
-    for (int order = 4; order <= 7; ++order)  // (orders 2 and 3 cannot reach 1e-4 at r_cut = 3 within the mesh limit)
-      CHECK(pppmCost(best, 10000, L) <= pppmCost(choosePppmParams(1e-4, 10000, L, 1e4, rc, order), 10000, L));
-  WARN("optimised PPPM for N = 1e4, 1e-4: r_cut " << best.r_cut << ", mesh " << best.mesh << ", order " << best.order
-                                                 << ", alpha " << best.alpha);
+    for (int order = 4; order <= 7;
+         ++order)  // (orders 2 and 3 cannot reach 1e-4 at r_cut = 3 within the mesh limit)
+      CHECK(pppmCost(best, 10000, L) <=
+            pppmCost(choosePppmParams(1e-4, 10000, L, 1e4, rc, order), 10000, L));
+  WARN("optimised PPPM for N = 1e4, 1e-4: r_cut " << best.r_cut << ", mesh " << best.mesh
+                                                  << ", order " << best.order << ", alpha "
+                                                  << best.alpha);
 
   CHECK_THROWS_AS(choosePppmParams(0.0, 100, 10.0, 100.0, 4.0), std::invalid_argument);
   CHECK_THROWS_AS(choosePppmParams(1e-4, 100, -10.0, 100.0, 4.0), std::invalid_argument);
@@ -308,7 +325,8 @@ TEST_CASE("PPPM parameter choice: estimates, cost optimisation and invalid input
   PppmParams bad = choosePppmParams(1e-4, 100, 10.0, 100.0, 4.0);
   bad.mesh = 2;
   CHECK_THROWS_AS(Pppm(bad, 10.0, 1.0), std::invalid_argument);
-  CHECK_THROWS_AS(Pppm(choosePppmParams(1e-4, 100, 10.0, 100.0, 4.0), 0.0, 1.0), std::invalid_argument);
+  CHECK_THROWS_AS(Pppm(choosePppmParams(1e-4, 100, 10.0, 100.0, 4.0), 0.0, 1.0),
+                  std::invalid_argument);
   Pppm fresh(choosePppmParams(1e-4, 100, 10.0, 100.0, 4.0), 10.0, 1.0);
   CHECK_THROWS_AS(fresh.lastEnergies(), std::logic_error);
 }
@@ -327,6 +345,7 @@ TEST_CASE("PPPM: positions outside the box are wrapped", "[md][coulomb]") {
   CHECK(b.energy == Approx(a.energy).epsilon(1e-10));
   double worst = 0.0;
   for (std::size_t i = 0; i < c.x.size(); ++i)
-    worst = std::max({worst, std::abs(a.fx[i] - b.fx[i]), std::abs(a.fy[i] - b.fy[i]), std::abs(a.fz[i] - b.fz[i])});
+    worst = std::max({worst, std::abs(a.fx[i] - b.fx[i]), std::abs(a.fy[i] - b.fy[i]),
+                      std::abs(a.fz[i] - b.fz[i])});
   CHECK(worst < 1e-9);
 }

@@ -77,8 +77,7 @@ void requireSameTrajectory(const fs::path& a, const fs::path& b, std::int64_t st
     const ObservableSeries sa = ra.readObservable(n);
     ObservableSeries sb = rb.readObservable(n);
     for (std::size_t k = 0; k < sb.step.size(); ++k)  // the sample b took when it stopped
-      if (sb.step[k] == stop &&
-          std::find(sa.step.begin(), sa.step.end(), stop) == sa.step.end()) {
+      if (sb.step[k] == stop && std::find(sa.step.begin(), sa.step.end(), stop) == sa.step.end()) {
         sb.step.erase(sb.step.begin() + static_cast<long>(k));
         sb.value.erase(sb.value.begin() + static_cast<long>(k));
         break;

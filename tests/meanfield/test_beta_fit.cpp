@@ -1,11 +1,11 @@
 // beta fitting (meanfield/fit/BetaFit.h): z from exact power laws, beta recovered from S(t) made by
-// the sectional solver with log-normal noise, amplitude S_c and time scale tau_c, beta from z at the
-// data's S range, bootstrap over runs, and rejected inputs.
+// the sectional solver with log-normal noise, amplitude S_c and time scale tau_c, beta from z at
+// the data's S range, bootstrap over runs, and rejected inputs.
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
@@ -19,8 +19,9 @@ using namespace granagg::meanfield;
 
 namespace {
 
-/// S_MF(t; beta) at the given mean-field times, from a finer solve (grid ratio 1.05, rtol 1e-8) than
-/// the fit's curves (1.1, 1e-7): the fit must not depend on reproducing its own discretisation.
+/// S_MF(t; beta) at the given mean-field times, from a finer solve (grid ratio 1.05, rtol 1e-8)
+/// than the fit's curves (1.1, 1e-7): the fit must not depend on reproducing its own
+/// discretisation.
 std::vector<double> sectionalS(double beta, const std::vector<double>& t_mf) {
   SectionalOptions o;
   o.ratio = 1.05;
@@ -75,7 +76,8 @@ Synthetic synthetic(double beta, double S_c, double tau_c, int count, double S_e
 
 }  // namespace
 
-TEST_CASE("fit-beta z of an exact power law is exact and inside its interval", "[meanfield][fitbeta]") {
+TEST_CASE("fit-beta z of an exact power law is exact and inside its interval",
+          "[meanfield][fitbeta]") {
   const double z = 1.37;
   const auto t = logSpacedTimes(0.5, 5e3, 49);
   std::vector<double> S;
@@ -120,14 +122,16 @@ TEST_CASE("fit-beta z of an exact power law is exact and inside its interval", "
   CHECK(z <= h.z_high);
 }
 
-TEST_CASE("fit-beta automatic window finds the late plateau of the local slope", "[meanfield][fitbeta]") {
+TEST_CASE("fit-beta automatic window finds the late plateau of the local slope",
+          "[meanfield][fitbeta]") {
   // S = 1 + (t/10)^{1.2} (1 + 0.02 eps): z(t) rises from 0 to 1.2; the late plateau is flat within
   // the noise, the early part is not.
   const auto t = logSpacedTimes(0.1, 1e5, 121);
   gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(rng, 7);
   std::vector<double> S;
-  for (double x : t) S.push_back((1.0 + std::pow(x / 10.0, 1.2)) * std::exp(gsl_ran_gaussian(rng, 0.02)));
+  for (double x : t)
+    S.push_back((1.0 + std::pow(x / 10.0, 1.2)) * std::exp(gsl_ran_gaussian(rng, 0.02)));
   gsl_rng_free(rng);
   const GrowthData d = growthFromSeries(t, S);
   const SlopeWindow w = automaticWindow(d);
@@ -150,14 +154,15 @@ TEST_CASE("fit-beta automatic window finds the late plateau of the local slope",
   CHECK(all.points == static_cast<int>(t.size()));
 }
 
-TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S_c and tau_c", "[meanfield][fitbeta]") {
+TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S_c and tau_c",
+          "[meanfield][fitbeta]") {
   // 60 samples from t = 0.05 tau_c to S_MF = 2e3 (MD-like: the paper's S range), 3 % log-normal
-  // noise, S_c = 1.6, tau_c = 3.7 (t -> t / tau_c: a shift of ln 3.7 in ln t). Without noise the fit
-  // returns beta within 0.01 and S_c, tau_c within 0.5 % (the difference between the data's finer
-  // solve and the fit's curves, mostly the 0.7 % of S that the grid ratio 1.1 adds).
-  // With noise, 20 fixed-seed replicas per beta: the 95 % interval must contain the true beta,
-  // S_c and tau_c in at least 16 of them (binomial(20, 0.95): P(<= 15) = 0.3 %; an interval too
-  // narrow by 2x would cover ~70 %), and be narrow enough to tell beta = 2 from 3.
+  // noise, S_c = 1.6, tau_c = 3.7 (t -> t / tau_c: a shift of ln 3.7 in ln t). Without noise the
+  // fit returns beta within 0.01 and S_c, tau_c within 0.5 % (the difference between the data's
+  // finer solve and the fit's curves, mostly the 0.7 % of S that the grid ratio 1.1 adds). With
+  // noise, 20 fixed-seed replicas per beta: the 95 % interval must contain the true beta, S_c and
+  // tau_c in at least 16 of them (binomial(20, 0.95): P(<= 15) = 0.3 %; an interval too narrow by
+  // 2x would cover ~70 %), and be narrow enough to tell beta = 2 from 3.
   MeanFieldCurves curves;
   const double S_c = 1.6, tau_c = 3.7;
   for (const double beta : {2.0, 2.5, 3.0}) {
@@ -170,11 +175,13 @@ TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S
     double width = 0.0;
     const int replicas = 20;
     for (int k = 0; k < replicas; ++k) {
-      const GrowthData d = growthFromSeries(s.t, s.noisy(0.03, 1, 100 + static_cast<unsigned long>(k)).front());
+      const GrowthData d =
+          growthFromSeries(s.t, s.noisy(0.03, 1, 100 + static_cast<unsigned long>(k)).front());
       const CurveFit f = fitCurve(curves, d);
-      INFO("beta = " << beta << " replica " << k << ": fit " << f.beta << " [" << f.beta_low << ", " << f.beta_high
-                     << "], S_c " << f.S_c << " [" << f.S_c_low << ", " << f.S_c_high << "], tau_c " << f.tau_c << " ["
-                     << f.tau_c_low << ", " << f.tau_c_high << "], chi2/dof " << f.chi2_dof);
+      INFO("beta = " << beta << " replica " << k << ": fit " << f.beta << " [" << f.beta_low << ", "
+                     << f.beta_high << "], S_c " << f.S_c << " [" << f.S_c_low << ", " << f.S_c_high
+                     << "], tau_c " << f.tau_c << " [" << f.tau_c_low << ", " << f.tau_c_high
+                     << "], chi2/dof " << f.chi2_dof);
       CHECK(f.interval_method == "covariance");
       CHECK(f.chi2_dof == Approx(0.03 * 0.03).epsilon(0.5));  // residual variance ~ sigma^2
       CHECK(f.note.empty());
@@ -184,8 +191,9 @@ TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S
       covered_tau += f.tau_c_low <= tau_c && tau_c <= f.tau_c_high;
       width += (f.beta_high - f.beta_low) / replicas;
     }
-    INFO("beta = " << beta << ": covered " << covered_beta << " (beta), " << covered_Sc << " (S_c), " << covered_tau
-                   << " (tau_c) of " << replicas << "; mean width of the beta interval " << width << "; solves "
+    INFO("beta = " << beta << ": covered " << covered_beta << " (beta), " << covered_Sc
+                   << " (S_c), " << covered_tau << " (tau_c) of " << replicas
+                   << "; mean width of the beta interval " << width << "; solves "
                    << curves.solves());
     CHECK(covered_beta >= 16);
     CHECK(covered_Sc >= 16);
@@ -194,12 +202,15 @@ TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S
   }
 }
 
-TEST_CASE("fit-beta inverts z at the data's S range through the full Smoluchowski z(beta)", "[meanfield][fitbeta]") {
+TEST_CASE("fit-beta inverts z at the data's S range through the full Smoluchowski z(beta)",
+          "[meanfield][fitbeta]") {
   MeanFieldCurves curves;
   // The paper's mean-field local slopes (design.md section 4): 1.19 near S ~ 250 at beta = 2 and
   // 1.49 near S ~ 1650 at beta = 3. A local slope at S compares S(t) with S(t/2) ~ S / 2^z.
-  CHECK(curves.exponentBetween(250.0 / std::pow(2.0, 1.19), 250.0, 2.0) == Approx(1.19).margin(0.01));
-  CHECK(curves.exponentBetween(1650.0 / std::pow(2.0, 1.49), 1650.0, 3.0) == Approx(1.49).margin(0.01));
+  CHECK(curves.exponentBetween(250.0 / std::pow(2.0, 1.19), 250.0, 2.0) ==
+        Approx(1.19).margin(0.01));
+  CHECK(curves.exponentBetween(1650.0 / std::pow(2.0, 1.49), 1650.0, 3.0) ==
+        Approx(1.49).margin(0.01));
 
   for (const double beta : {2.0, 3.0}) {
     // S_c = 1, tau_c = 2: the data's S is the mean field's S, so the S ranges match.
@@ -212,8 +223,9 @@ TEST_CASE("fit-beta inverts z at the data's S range through the full Smoluchowsk
     }
     const ZFit z = fitGrowthExponent(d, explicitWindow(d, t_lo, t_hi));
     const BetaFromZ b = betaFromZ(curves, z.z, z.z_low, z.z_high, z.S0, z.S1, 1.5, 6.0);
-    INFO("beta " << beta << ": z = " << z.z << " [" << z.z_low << ", " << z.z_high << "] over S " << z.S0 << ".."
-                 << z.S1 << " -> beta " << b.beta << " [" << b.beta_low << ", " << b.beta_high << "] " << b.note);
+    INFO("beta " << beta << ": z = " << z.z << " [" << z.z_low << ", " << z.z_high << "] over S "
+                 << z.S0 << ".." << z.S1 << " -> beta " << b.beta << " [" << b.beta_low << ", "
+                 << b.beta_high << "] " << b.note);
     CHECK(b.note.empty());
     CHECK(b.beta == Approx(beta).margin(0.02));
     CHECK(b.beta_low <= b.beta);
@@ -230,7 +242,8 @@ TEST_CASE("fit-beta inverts z at the data's S range through the full Smoluchowsk
   CHECK(out.note.find("above") != std::string::npos);
 }
 
-TEST_CASE("fit-beta bootstrap over runs gives intervals that contain the true values", "[meanfield][fitbeta]") {
+TEST_CASE("fit-beta bootstrap over runs gives intervals that contain the true values",
+          "[meanfield][fitbeta]") {
   // 8 runs with 10 % noise each around S_MF for beta = 2.5: the fit to their mean, with percentile
   // intervals over 200 resamples of the runs (fixed seed).
   MeanFieldCurves curves;
@@ -238,8 +251,9 @@ TEST_CASE("fit-beta bootstrap over runs gives intervals that contain the true va
   const GrowthData d = growthFromRuns(s.t, s.noisy(0.1, 8, 5));
   REQUIRE(d.runs.size() == 8);
   const CurveFit f = fitCurve(curves, d);
-  INFO("fit " << f.beta << " [" << f.beta_low << ", " << f.beta_high << "], S_c " << f.S_c << " [" << f.S_c_low << ", "
-              << f.S_c_high << "], tau_c " << f.tau_c << " [" << f.tau_c_low << ", " << f.tau_c_high << "]");
+  INFO("fit " << f.beta << " [" << f.beta_low << ", " << f.beta_high << "], S_c " << f.S_c << " ["
+              << f.S_c_low << ", " << f.S_c_high << "], tau_c " << f.tau_c << " [" << f.tau_c_low
+              << ", " << f.tau_c_high << "]");
   CHECK(f.interval_method == "bootstrap-runs");
   CHECK(f.replicates >= 190);
   CHECK(f.beta_low <= 2.5);
@@ -262,24 +276,30 @@ TEST_CASE("fit-beta bootstrap over runs gives intervals that contain the true va
 TEST_CASE("fit-beta rejects bad data, windows and beta ranges", "[meanfield][fitbeta]") {
   using Catch::Matchers::Contains;
   const std::vector<double> t{1, 2, 3, 4, 5, 6}, S{1, 2, 3, 4, 5, 6};
-  CHECK_THROWS_WITH(validateGrowthData(growthFromSeries({1, 2, 2, 4, 5, 6}, S)), Contains("increase strictly"));
-  CHECK_THROWS_WITH(validateGrowthData(growthFromSeries(t, {1, 2, 0, 4, 5, 6})), Contains("S must be positive"));
-  CHECK_THROWS_WITH(validateGrowthData(growthFromSeries({0, 2, 3, 4, 5, 6}, S)), Contains("t must be positive"));
+  CHECK_THROWS_WITH(validateGrowthData(growthFromSeries({1, 2, 2, 4, 5, 6}, S)),
+                    Contains("increase strictly"));
+  CHECK_THROWS_WITH(validateGrowthData(growthFromSeries(t, {1, 2, 0, 4, 5, 6})),
+                    Contains("S must be positive"));
+  CHECK_THROWS_WITH(validateGrowthData(growthFromSeries({0, 2, 3, 4, 5, 6}, S)),
+                    Contains("t must be positive"));
   CHECK_THROWS_WITH(growthFromRuns(t, {S, {1, 2}}), Contains("one S per time"));
   const GrowthData d = growthFromSeries(t, S);
   CHECK_THROWS_WITH(explicitWindow(d, 2.0, 4.0), Contains("too few points in the window"));
   CHECK_THROWS_WITH(explicitWindow(d, 4.0, 2.0), Contains("T0 < T1"));
-  CHECK_THROWS_WITH(automaticWindow(growthFromSeries({1, 2, 3}, {1, 2, 3})), Contains("too few points"));
+  CHECK_THROWS_WITH(automaticWindow(growthFromSeries({1, 2, 3}, {1, 2, 3})),
+                    Contains("too few points"));
   CHECK_THROWS_WITH(validateBetaRange(0.5, 6.0), Contains("--beta-min"));
   CHECK_THROWS_WITH(validateBetaRange(2.0, 25.0), Contains("--beta-max"));
   CHECK_THROWS_WITH(validateBetaRange(3.0, 2.0), Contains("--beta-max must exceed --beta-min"));
   MeanFieldCurves curves;
-  CHECK_THROWS_WITH(fitCurve(curves, growthFromSeries({1, 2, 3, 4}, {1, 2, 3, 4})), Contains("too few points"));
+  CHECK_THROWS_WITH(fitCurve(curves, growthFromSeries({1, 2, 3, 4}, {1, 2, 3, 4})),
+                    Contains("too few points"));
   CHECK(curves.solves() == 0);
 }
 
-TEST_CASE("fit-beta's asymptotic beta inverts z = 3 beta/(beta + 3), the full equation's large-S limit",
-          "[meanfield][fitbeta]") {
+TEST_CASE(
+    "fit-beta's asymptotic beta inverts z = 3 beta/(beta + 3), the full equation's large-S limit",
+    "[meanfield][fitbeta]") {
   // Closed form: the paper's two cases and the interval's monotone map.
   const BetaFromZ b2 = betaAsymptotic(1.2, 1.1, 1.3);
   CHECK(b2.beta == Approx(2.0).epsilon(1e-14));
@@ -307,7 +327,8 @@ TEST_CASE("fit-beta's asymptotic beta inverts z = 3 beta/(beta + 3), the full eq
   }
 }
 
-TEST_CASE("fit-beta's explicit window keeps a frame a rounding step past its end", "[meanfield][fitbeta]") {
+TEST_CASE("fit-beta's explicit window keeps a frame a rounding step past its end",
+          "[meanfield][fitbeta]") {
   // The frame of an MD run to t = 1000 sits at t = 1000.0011 (whole time steps).
   const GrowthData d = growthFromSeries({50.0, 100.0011, 200.0, 400.0, 800.0, 1000.0011},
                                         {1.0, 2.0, 4.0, 8.0, 16.0, 20.0});

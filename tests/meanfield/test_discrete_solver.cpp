@@ -31,20 +31,22 @@ Exact constantExact() {
 Exact additiveExact() {
   return {[](int k, double t) {
             const double T = 1 - std::exp(-t);
-            return std::exp((k - 1) * std::log(double(k)) - std::lgamma(k + 1.0) + (k - 1) * std::log(T) - t - k * T);
+            return std::exp((k - 1) * std::log(double(k)) - std::lgamma(k + 1.0) +
+                            (k - 1) * std::log(T) - t - k * T);
           },
           [](double t) { return std::exp(-t); }, [](double t) { return std::exp(2 * t); }};
 }
 // multiplicative ij, t < 1: n_k = k^(k-2)/k! t^(k-1) e^(-kt), M0 = 1 - t/2, M2 = 1/(1-t)
 Exact multiplicativeExact() {
   return {[](int k, double t) {
-            return std::exp((k - 2) * std::log(double(k)) - std::lgamma(k + 1.0) + (k - 1) * std::log(t) - k * t);
+            return std::exp((k - 2) * std::log(double(k)) - std::lgamma(k + 1.0) +
+                            (k - 1) * std::log(t) - k * t);
           },
           [](double t) { return 1.0 - t / 2; }, [](double t) { return 1.0 / (1.0 - t); }};
 }
 
-void checkAgainstExact(const Kernel& kernel, const Exact& ex, const std::vector<double>& times, int M,
-                       const std::string& integrator) {
+void checkAgainstExact(const Kernel& kernel, const Exact& ex, const std::vector<double>& times,
+                       int M, const std::string& integrator) {
   DiscreteOptions o;
   o.times = times;
   o.max_size = M;
@@ -74,21 +76,26 @@ void checkAgainstExact(const Kernel& kernel, const Exact& ex, const std::vector<
 }
 }  // namespace
 
-TEST_CASE("discrete solver reproduces the constant-kernel exact solution", "[meanfield][discrete]") {
-  for (const char* integ : {"adams", "bdf"}) checkAgainstExact(Kernel::constant(), constantExact(), {2, 10, 50}, 2048, integ);
+TEST_CASE("discrete solver reproduces the constant-kernel exact solution",
+          "[meanfield][discrete]") {
+  for (const char* integ : {"adams", "bdf"})
+    checkAgainstExact(Kernel::constant(), constantExact(), {2, 10, 50}, 2048, integ);
 }
 
-TEST_CASE("discrete solver reproduces the additive-kernel exact solution", "[meanfield][discrete]") {
+TEST_CASE("discrete solver reproduces the additive-kernel exact solution",
+          "[meanfield][discrete]") {
   checkAgainstExact(Kernel::additive(), additiveExact(), {0.25, 0.5, 1.0, 1.5}, 2048, "bdf");
 }
 
 TEST_CASE("discrete solver reproduces the multiplicative-kernel exact solution before gelation",
           "[meanfield][discrete]") {
-  checkAgainstExact(Kernel::multiplicative(), multiplicativeExact(), {0.2, 0.5, 0.7, 0.8}, 2048, "bdf");
+  checkAgainstExact(Kernel::multiplicative(), multiplicativeExact(), {0.2, 0.5, 0.7, 0.8}, 2048,
+                    "bdf");
   checkAgainstExact(Kernel::multiplicative(), multiplicativeExact(), {0.2, 0.5}, 300, "bdf-dense");
 }
 
-TEST_CASE("growing range conserves mass and reaches large S for the beta kernel", "[meanfield][discrete]") {
+TEST_CASE("growing range conserves mass and reaches large S for the beta kernel",
+          "[meanfield][discrete]") {
   DiscreteOptions o;
   o.times = logSpacedTimes(0.01, 1e5, 141);
   o.s_end = 2000;

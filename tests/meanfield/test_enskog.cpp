@@ -10,14 +10,16 @@
 
 using namespace granagg::meanfield;
 
-TEST_CASE("Enskog collision frequency at phi = 0.076 matches design.md", "[meanfield][kinetic][enskog]") {
+TEST_CASE("Enskog collision frequency at phi = 0.076 matches design.md",
+          "[meanfield][kinetic][enskog]") {
   // design.md quotes n = 0.145149, g2 = 1.219436, omega = 1.25490: margins of half a unit in the
   // last quoted digit (plus round-off).
   CHECK(numberDensity(0.076) == Approx(0.145149).epsilon(0).margin(6e-7));
   CHECK(carnahanStarlingG2(0.076) == Approx(1.219436).epsilon(0).margin(6e-7));
   CHECK(enskogCollisionFrequency(0.076, 1.0) == Approx(1.25490).epsilon(0).margin(1e-5));
   // omega ~ sqrt(T); dilute limit g2 -> 1 + 5 phi / 2 (Carnahan-Starling expanded).
-  CHECK(enskogCollisionFrequency(0.076, 4.0) == Approx(2.0 * enskogCollisionFrequency(0.076, 1.0)).epsilon(1e-15));
+  CHECK(enskogCollisionFrequency(0.076, 4.0) ==
+        Approx(2.0 * enskogCollisionFrequency(0.076, 1.0)).epsilon(1e-15));
   CHECK(carnahanStarlingG2(1e-6) == Approx(1.0 + 2.5e-6).epsilon(1e-11));
   CHECK(enskogCollisionFrequency(0.076, 0.0) == 0.0);
 }

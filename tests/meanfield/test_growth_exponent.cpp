@@ -26,7 +26,8 @@ TEST_CASE("local slope and fit of an exact power law equal its exponent", "[mean
   CHECK(f.points == 37);  // 12 points per decade, 3 decades, both ends included
 }
 
-TEST_CASE("power-law fit interval covers the true exponent at its nominal rate", "[meanfield][growth]") {
+TEST_CASE("power-law fit interval covers the true exponent at its nominal rate",
+          "[meanfield][growth]") {
   // Multiplicative log-normal noise (sigma = 0.05) on S = t^1.5: 200 independent fixed-seed
   // replicas; a 95 % interval should cover 1.5 in 95 % of them. Binomial spread for 200 trials is
   // sqrt(200 * 0.95 * 0.05) = 3.1, so 180..200 covered (more than 4 sigma wide) cannot fail by
@@ -66,6 +67,7 @@ TEST_CASE("asymptotic exponent extrapolates z(t) = z t/(t+t0)", "[meanfield][gro
 TEST_CASE("growth estimators reject bad series", "[meanfield][growth]") {
   CHECK_THROWS_WITH(localSlope({1, 2, 2}, {1, 2, 3}), Catch::Contains("increase strictly"));
   CHECK_THROWS_WITH(localSlope({1, 2, 3}, {1, -2, 3}), Catch::Contains("S must be positive"));
-  CHECK_THROWS_WITH(fitPowerLaw({1, 2, 3, 4}, {1, 2, 3, 4}, 3.0, 4.0), Catch::Contains("at least 3 points"));
+  CHECK_THROWS_WITH(fitPowerLaw({1, 2, 3, 4}, {1, 2, 3, 4}, 3.0, 4.0),
+                    Catch::Contains("at least 3 points"));
   CHECK_THROWS_AS(localSlope({1, 2, 3}, {1, 2, 3}, 1.0), std::invalid_argument);
 }

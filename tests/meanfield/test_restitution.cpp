@@ -50,7 +50,8 @@ double referenceRestitution(double E, double D, double v, bool clamped) {
 
 }  // namespace
 
-TEST_CASE("restitution at v = 0.05 matches design.md, clamped and unclamped", "[meanfield][kinetic][restitution]") {
+TEST_CASE("restitution at v = 0.05 matches design.md, clamped and unclamped",
+          "[meanfield][kinetic][restitution]") {
   // design.md section 2 quotes e(0.05) = 0.506 (clamped) and 0.469 (unclamped); the brief gives
   // 0.5055 and 0.4691 and asks for 1e-3, the precision to which they are quoted.
   ContactParams clamped;  // defaults E = 278.6, D = 27.7
@@ -68,7 +69,8 @@ TEST_CASE("restitution at v = 0.05 matches design.md, clamped and unclamped", "[
   CHECK(Restitution(clamped).restitution(1.0) == Approx(0.33).epsilon(0).margin(0.01));
 }
 
-TEST_CASE("restitution rises monotonically towards 1 as the impact speed falls", "[meanfield][kinetic][restitution]") {
+TEST_CASE("restitution rises monotonically towards 1 as the impact speed falls",
+          "[meanfield][kinetic][restitution]") {
   for (bool c : {true, false}) {
     ContactParams p;
     p.clamped = c;
@@ -91,7 +93,8 @@ TEST_CASE("restitution rises monotonically towards 1 as the impact speed falls",
   }
 }
 
-TEST_CASE("elastic Hertz contact: e = 1, contact time and largest overlap in closed form", "[meanfield][kinetic][restitution]") {
+TEST_CASE("elastic Hertz contact: e = 1, contact time and largest overlap in closed form",
+          "[meanfield][kinetic][restitution]") {
   // Closed form of the dimensionless contact time (Hertz): (4/5)(5/4)^{2/5} B(2/5, 1/2).
   const double beta = std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);
   const double factor = 0.8 * std::pow(1.25, 0.4) * beta;
@@ -108,8 +111,10 @@ TEST_CASE("elastic Hertz contact: e = 1, contact time and largest overlap in clo
       CHECK(r.restitution == Approx(1.0).epsilon(0).margin(1e-8));
       // design.md: t_c = 3.218065 (m_eff^2/(E^2 v))^{1/5}, to 1e-6 relative as asked; against
       // the closed form to 1e-10 (the dense-output crossing is accurate to ~1e-12, measured).
-      CHECK(r.contact_time == Approx(3.218065 * std::pow(M_EFF * M_EFF / (p.E * p.E * v), 0.2)).epsilon(1e-6));
-      CHECK(r.contact_time == Approx(factor * std::pow(M_EFF * M_EFF / (p.E * p.E * v), 0.2)).epsilon(1e-10));
+      CHECK(r.contact_time ==
+            Approx(3.218065 * std::pow(M_EFF * M_EFF / (p.E * p.E * v), 0.2)).epsilon(1e-6));
+      CHECK(r.contact_time ==
+            Approx(factor * std::pow(M_EFF * M_EFF / (p.E * p.E * v), 0.2)).epsilon(1e-10));
       CHECK(r.contact_time == Approx(R.elasticContactTime(v)).epsilon(1e-6));
       // Largest overlap from (1/2) m_eff v^2 = (2/5) E xi_max^{5/2}.
       CHECK(r.max_overlap == Approx(std::pow(1.25 * M_EFF * v * v / p.E, 0.4)).epsilon(1e-9));
@@ -119,7 +124,8 @@ TEST_CASE("elastic Hertz contact: e = 1, contact time and largest overlap in clo
   }
 }
 
-TEST_CASE("restitution depends on E, D and v only through b = D m_eff^-2/5 E^-3/5 v^1/5", "[meanfield][kinetic][restitution]") {
+TEST_CASE("restitution depends on E, D and v only through b = D m_eff^-2/5 E^-3/5 v^1/5",
+          "[meanfield][kinetic][restitution]") {
   // (E, D, v) and (8E, D 8^{3/5} / 2, 32 v) share b; the reference integration in physical units
   // knows nothing about the scaling, so agreement of both with the scaled solver checks it.
   const double E = 278.6, D = 27.7, v = 0.05;
@@ -130,9 +136,11 @@ TEST_CASE("restitution depends on E, D and v only through b = D m_eff^-2/5 E^-3/
   CHECK(R1.scalingParameter(v) == Approx(1.247105 * std::pow(v, 0.2)).epsilon(1e-6));
   const double e1 = R1.restitution(v), e2 = R2.restitution(v2);
   CHECK(e1 == Approx(e2).epsilon(0).margin(1e-12));
-  CHECK(referenceRestitution(E2, D2, v2, true) == Approx(e1).epsilon(0).margin(1e-8));  // reference error 2e-10
+  CHECK(referenceRestitution(E2, D2, v2, true) ==
+        Approx(e1).epsilon(0).margin(1e-8));  // reference error 2e-10
   // The contact time scales with tau = m_eff^{2/5} E^{-2/5} v^{-1/5}.
-  CHECK(R2.contactTime(v2) / R1.contactTime(v) == Approx(std::pow(8.0, -0.4) * std::pow(32.0, -0.2)).epsilon(1e-10));
+  CHECK(R2.contactTime(v2) / R1.contactTime(v) ==
+        Approx(std::pow(8.0, -0.4) * std::pow(32.0, -0.2)).epsilon(1e-10));
 }
 
 TEST_CASE("restitution integration is converged", "[meanfield][kinetic][restitution]") {
@@ -150,10 +158,12 @@ TEST_CASE("restitution integration is converged", "[meanfield][kinetic][restitut
   }
 }
 
-TEST_CASE("small-damping series agrees with the integration only where damping is small", "[meanfield][kinetic][restitution]") {
+TEST_CASE("small-damping series agrees with the integration only where damping is small",
+          "[meanfield][kinetic][restitution]") {
   // Published constants (Ramirez et al. 1999): C1 = 1.15344, C2 = 0.79826, and their closed
   // forms C1 = Gamma(3/5) sqrt(pi) / (2^{1/5} 5^{2/5} Gamma(21/10)), C2 = 3 C1^2 / 5.
-  const double c1 = std::tgamma(0.6) * std::sqrt(std::acos(-1.0)) / (std::pow(2.0, 0.2) * std::pow(5.0, 0.4) * std::tgamma(2.1));
+  const double c1 = std::tgamma(0.6) * std::sqrt(std::acos(-1.0)) /
+                    (std::pow(2.0, 0.2) * std::pow(5.0, 0.4) * std::tgamma(2.1));
   CHECK(RESTITUTION_C1 == Approx(c1).epsilon(1e-15));
   CHECK(RESTITUTION_C1 == Approx(1.15344).epsilon(0).margin(1e-5));  // published to 5 decimals
   CHECK(RESTITUTION_C2 == Approx(0.79826).epsilon(0).margin(1e-5));
@@ -164,12 +174,14 @@ TEST_CASE("small-damping series agrees with the integration only where damping i
   // term ~ -0.5 b (measured), hence 1e-3 at b = 1e-3.
   for (bool c : {true, false}) {
     const double b = 1e-4;
-    CHECK((1.0 - collideScaled(b, c).restitution) / b == Approx(RESTITUTION_C1 - RESTITUTION_C2 * b).epsilon(0).margin(1e-6));
+    CHECK((1.0 - collideScaled(b, c).restitution) / b ==
+          Approx(RESTITUTION_C1 - RESTITUTION_C2 * b).epsilon(0).margin(1e-6));
   }
   {
     const double b = 1e-3;
     const double e = collideScaled(b, false).restitution;
-    CHECK((e - 1.0 + RESTITUTION_C1 * b) / (b * b) == Approx(RESTITUTION_C2).epsilon(0).margin(1e-3));
+    CHECK((e - 1.0 + RESTITUTION_C1 * b) / (b * b) ==
+          Approx(RESTITUTION_C2).epsilon(0).margin(1e-3));
   }
 
   // D / 100: b = 0.0125 v^{1/5} <= 0.015 for v <= 2, 1 - e < 0.02. The neglected terms are
@@ -218,12 +230,14 @@ TEST_CASE("restitution rejects bad parameters", "[meanfield][kinetic][restitutio
   CHECK_THROWS_AS(Restitution(ContactParams{-1.0, 27.7, true}), std::invalid_argument);
   CHECK_THROWS_AS(Restitution(ContactParams{278.6, -0.1, true}), std::invalid_argument);
   CHECK_THROWS_AS(Restitution(ContactParams{std::nan(""), 27.7, true}), std::invalid_argument);
-  CHECK_THROWS_WITH(Restitution(ContactParams{278.6, -2.0, true}), Catch::Contains("D") && Catch::Contains("-2"));
+  CHECK_THROWS_WITH(Restitution(ContactParams{278.6, -2.0, true}),
+                    Catch::Contains("D") && Catch::Contains("-2"));
   const Restitution R;
   CHECK_THROWS_AS(R.restitution(0.0), std::invalid_argument);
   CHECK_THROWS_AS(R.restitution(-0.05), std::invalid_argument);
   CHECK_THROWS_AS(R.restitution(std::numeric_limits<double>::infinity()), std::invalid_argument);
-  CHECK_THROWS_WITH(R.restitution(-0.05), Catch::Contains("impact speed") && Catch::Contains("-0.05"));
+  CHECK_THROWS_WITH(R.restitution(-0.05),
+                    Catch::Contains("impact speed") && Catch::Contains("-0.05"));
   CHECK_THROWS_AS(collideScaled(-1.0, true), std::invalid_argument);
   RestitutionOptions bad;
   bad.tolerance = 0.0;

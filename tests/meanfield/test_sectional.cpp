@@ -38,7 +38,8 @@ void checkMass(const SmolResult& r, double tol = 1e-10) {
 
 }  // namespace
 
-TEST_CASE("sectional grid: integers up to unit geometric spacing, then geometric", "[meanfield][sectional]") {
+TEST_CASE("sectional grid: integers up to unit geometric spacing, then geometric",
+          "[meanfield][sectional]") {
   const SectionalGrid g = makeSectionalGrid(1.05, 1e12);
   REQUIRE(g.integer_pivots == 20);  // 20 (1.05 - 1) = 1
   for (int k = 0; k < 20; ++k) CHECK(g.pivots[k] == k + 1);
@@ -52,7 +53,8 @@ TEST_CASE("sectional grid: integers up to unit geometric spacing, then geometric
   CHECK(two.pivots == std::vector<double>{1, 2, 4, 8, 16, 32, 64, 128});
   CHECK_THROWS_WITH(makeSectionalGrid(1.0, 1e6), Catch::Contains("ratio"));
   CHECK_THROWS_WITH(makeSectionalGrid(1.05, 1.5), Catch::Contains("max_size"));
-  CHECK_THROWS_WITH(makeSectionalGrid(1.0001, 1e12), Catch::Contains("ratio"));  // too many sections
+  CHECK_THROWS_WITH(makeSectionalGrid(1.0001, 1e12),
+                    Catch::Contains("ratio"));  // too many sections
 }
 
 TEST_CASE("sectional solver rejects bad options", "[meanfield][sectional]") {
@@ -84,9 +86,10 @@ TEST_CASE("sectional solver rejects bad options", "[meanfield][sectional]") {
   CHECK_THROWS_WITH(solveSectional(K, o, &negative), Catch::Contains("initial"));
 }
 
-TEST_CASE("sectional constant kernel: exact M0 and small sizes, M2 within 1 %", "[meanfield][sectional]") {
-  // n_k = (1+a)^-2 (a/(1+a))^(k-1), a = K0 t / 2; M0 = 1/(1+a); M2 = 1 + K0 t (design.md section 4).
-  // Sizes 1..20 are pivots whose gains come only from pairs of integer pivots, and their loss
+TEST_CASE("sectional constant kernel: exact M0 and small sizes, M2 within 1 %",
+          "[meanfield][sectional]") {
+  // n_k = (1+a)^-2 (a/(1+a))^(k-1), a = K0 t / 2; M0 = 1/(1+a); M2 = 1 + K0 t (design.md section
+  // 4). Sizes 1..20 are pivots whose gains come only from pairs of integer pivots, and their loss
   // K0 N_k M0 involves the exact M0: they follow the exact n_k.
   const double K0 = 1.0;
   SectionalOptions o;
@@ -161,7 +164,8 @@ TEST_CASE("sectional multiplicative kernel before the gel point", "[meanfield][s
   }
 }
 
-TEST_CASE("sectional beta kernel: asymptotic local slope is 3 beta / (beta + 3)", "[meanfield][sectional]") {
+TEST_CASE("sectional beta kernel: asymptotic local slope is 3 beta / (beta + 3)",
+          "[meanfield][sectional]") {
   // Issue acceptance test. z(t) = log[S(t)/S(t/2)] / log 2 at the first output with S >= 1e7.
   // z(t) ~ z_inf t / (t + t0) with t0 ~ 1 (design.md section 4), so at S = 1e7 (t ~ 1e4 to 1e5) it
   // sits within ~1e-4 of z_inf; the fixed-pivot error in S is a near-constant factor in the
@@ -172,7 +176,8 @@ TEST_CASE("sectional beta kernel: asymptotic local slope is 3 beta / (beta + 3)"
   o.s_end = 1e7;
   for (double beta : {2.0, 2.5, 3.0, 4.0}) {
     const SmolResult r = solveSectional(Kernel::beta(beta), o);
-    INFO("beta = " << beta << ", wall " << r.stats.wall_seconds << " s, " << r.stats.steps << " steps");
+    INFO("beta = " << beta << ", wall " << r.stats.wall_seconds << " s, " << r.stats.steps
+                   << " steps");
     const auto& s = r.samples;
     REQUIRE(s.size() >= 3);
     REQUIRE(s.back().S >= 1e7);
@@ -221,14 +226,16 @@ TEST_CASE("sectional truncation is reported, never hidden", "[meanfield][section
   const SmolResult all = solveSectional(Kernel::constant(), o);
   REQUIRE(all.samples.size() == o.times.size());
   CHECK(all.stopped_early.empty());
-  for (size_t i = 1; i < all.samples.size(); ++i) CHECK(all.samples[i].mass_loss >= all.samples[i - 1].mass_loss);
+  for (size_t i = 1; i < all.samples.size(); ++i)
+    CHECK(all.samples[i].mass_loss >= all.samples[i - 1].mass_loss);
   CHECK(all.samples.back().mass_loss > 0.1);
   // M0 still follows dM0/dt = -M0^2/2 minus nothing: escaping pairs leave as a pair, so M0 falls
   // below the exact value once mass escapes.
   CHECK(all.samples.back().M0 < 1.0 / (1.0 + 1e4 / 2.0));
 }
 
-TEST_CASE("sectional initial distribution is mapped conserving number and mass", "[meanfield][sectional]") {
+TEST_CASE("sectional initial distribution is mapped conserving number and mass",
+          "[meanfield][sectional]") {
   SectionalOptions o;
   o.times = {1e-12};
   const std::vector<double> mono{1.0};
@@ -260,7 +267,13 @@ TEST_CASE("CvodeSolver integrates y' = -y with every method", "[meanfield][cvode
     o.rtol = 1e-10;
     o.atol = 1e-14;
     const double y0[2] = {1.0, 2.0};
-    CvodeSolver cv(2, [](double, const double* y, double* d) { d[0] = -y[0]; d[1] = -3.0 * y[1]; }, o, 0.0, y0);
+    CvodeSolver cv(
+        2,
+        [](double, const double* y, double* d) {
+          d[0] = -y[0];
+          d[1] = -3.0 * y[1];
+        },
+        o, 0.0, y0);
     CHECK(cv.methodName() == (std::string(name) == "bdf" ? "bdf-gmres" : name));
     double y[2];
     CHECK(cv.advance(1.0, y) == 1.0);
@@ -293,36 +306,46 @@ TEST_CASE("CvodeSolver rethrows callback exceptions and names CVODE flags", "[me
   // (Adams: SUNDIALS' fixed-point solver would otherwise retry a -1 as a convergence failure and
   // creep up to t = 0.5 for max_steps steps; the wrapper makes the failure sticky.)
   long calls = 0;
-  CvodeSolver bad(1, [&calls](double t, const double*, double* d) {
-    ++calls;
-    if (t > 0.5) throw std::domain_error("rhs refused t > 0.5");
-    d[0] = 1.0;
-  }, o, 0.0, &y0);
+  CvodeSolver bad(
+      1,
+      [&calls](double t, const double*, double* d) {
+        ++calls;
+        if (t > 0.5) throw std::domain_error("rhs refused t > 0.5");
+        d[0] = 1.0;
+      },
+      o, 0.0, &y0);
   CHECK_THROWS_AS(bad.advance(1.0), std::domain_error);
   CHECK(calls < 100);
   // recoverable errors make CVODE retry with smaller steps: overcome once, no error
   int failures = 0;
-  CvodeSolver once(1, [&failures](double t, const double* y, double* d) {
-    if (t > 0.5 && failures == 0) {
-      ++failures;
-      throw CvodeRecoverableError("first call beyond 0.5 fails");
-    }
-    d[0] = -y[0];
-  }, o, 0.0, &y0);
+  CvodeSolver once(
+      1,
+      [&failures](double t, const double* y, double* d) {
+        if (t > 0.5 && failures == 0) {
+          ++failures;
+          throw CvodeRecoverableError("first call beyond 0.5 fails");
+        }
+        d[0] = -y[0];
+      },
+      o, 0.0, &y0);
   double y1 = 0.0;
   once.advance(1.0, &y1);
   CHECK(failures == 1);
   CHECK(y1 == Approx(std::exp(-1.0)).epsilon(1e-6));
   // always failing beyond 0.5: CVODE creeps up to 0.5 with ever smaller steps until max_steps
   o.max_steps = 200;
-  CvodeSolver rec(1, [](double t, const double*, double* d) {
-    if (t > 0.5) throw CvodeRecoverableError("not beyond 0.5");
-    d[0] = 1.0;
-  }, o, 0.0, &y0);
+  CvodeSolver rec(
+      1,
+      [](double t, const double*, double* d) {
+        if (t > 0.5) throw CvodeRecoverableError("not beyond 0.5");
+        d[0] = 1.0;
+      },
+      o, 0.0, &y0);
   CHECK_THROWS_WITH(rec.advance(1.0), Catch::Contains("CV_"));
   // a CVODE failure carries the flag name
   o.max_steps = 3;
-  CvodeSolver slow(1, [](double, const double* y, double* d) { d[0] = -y[0]; }, o, 0.0, &y0);
+  CvodeSolver slow(
+      1, [](double, const double* y, double* d) { d[0] = -y[0]; }, o, 0.0, &y0);
   CHECK_THROWS_WITH(slow.advance(1e6), Catch::Contains("CV_TOO_MUCH_WORK"));
   // construction is validated
   CvodeSolver::Options b;

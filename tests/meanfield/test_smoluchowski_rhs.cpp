@@ -32,7 +32,8 @@ TEST_CASE("kernels: values, symmetry and homogeneity", "[meanfield][kernel]") {
     CHECK(k.homogeneity() == Approx(2.0 / 3.0 - 1.0 / beta));
     CHECK(k.scalingExponent() == Approx(3.0 * beta / (beta + 3.0)).epsilon(1e-14));
     // K(a i, a j) = a^lambda K(i, j)
-    CHECK(k(10.0 * 3, 10.0 * 5) == Approx(std::pow(10.0, k.homogeneity()) * k(3, 5)).epsilon(1e-13));
+    CHECK(k(10.0 * 3, 10.0 * 5) ==
+          Approx(std::pow(10.0, k.homogeneity()) * k(3, 5)).epsilon(1e-13));
     // separable representation reproduces the kernel
     double sep = 0.0;
     for (const auto& t : k.terms()) sep += t.weight * std::pow(3.0, t.p) * std::pow(5.0, t.q);
@@ -50,8 +51,8 @@ TEST_CASE("kernels: values, symmetry and homogeneity", "[meanfield][kernel]") {
 
 TEST_CASE("FFT right-hand side equals the direct double sum", "[meanfield][rhs]") {
   const int M = 300;
-  for (const Kernel& k : {Kernel::constant(), Kernel::additive(), Kernel::multiplicative(), Kernel::beta(2.0),
-                          Kernel::beta(3.0, 0.7)}) {
+  for (const Kernel& k : {Kernel::constant(), Kernel::additive(), Kernel::multiplicative(),
+                          Kernel::beta(2.0), Kernel::beta(3.0, 0.7)}) {
     SmoluchowskiRhs fft(k, M, SmoluchowskiRhs::Method::Fft);
     REQUIRE(fft.usesFft());
     REQUIRE(fft.fftLength() >= 2 * M + 1);
@@ -69,7 +70,8 @@ TEST_CASE("FFT right-hand side equals the direct double sum", "[meanfield][rhs]"
   }
 }
 
-TEST_CASE("right-hand side conserves mass when nothing reaches the truncation", "[meanfield][rhs]") {
+TEST_CASE("right-hand side conserves mass when nothing reaches the truncation",
+          "[meanfield][rhs]") {
   const int M = 400;
   for (const Kernel& k : {Kernel::constant(), Kernel::multiplicative(), Kernel::beta(2.5)}) {
     SmoluchowskiRhs rhs(k, M);
