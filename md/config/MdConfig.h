@@ -93,7 +93,7 @@ struct CoulombConfig {
   double skin = 0.0;  ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or
                       ///< neighbor.skin when every = 1)
   double r_fast =
-      0.0;  ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (3.5)
+      0.0;  ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (2)
 };
 
 struct RunConfig {

@@ -238,7 +238,7 @@ TEST_CASE(
     const Frame init = Engine::randomInitialState(c);
     Engine pppm(c, init);
     REQUIRE(pppm.coulombSetup()->every == 8);  // "auto" at dt = 0.002
-    REQUIRE(pppm.coulombSetup()->r_fast == 3.5);
+    REQUIRE(pppm.coulombSetup()->r_fast == 2.0);  // "auto"
     MdConfig c0 = c;
     c0.coulomb.K = 0.0;
     Engine contacts(c0, init);
@@ -263,17 +263,23 @@ TEST_CASE(
     CHECK(impulse2 < 49.0 * ref2);  // the slow part is a fraction of the whole
   }
   // (b) energy: elastic contacts, fixed +-1 charges at the paper's strongest coupling K = 5 (bound
-  // pairs form; the Coulomb energy falls by a factor ~2.8), 1e4 steps: drift below 1e-4 of the
-  // initial kinetic energy with the default multiple time stepping (every 8 steps), as with every =
-  // 1
-  for (int every : {0, 1}) {
-    INFO("coulomb.every = " << every);
+  // pairs form; the Coulomb energy falls by a factor ~2.8), 1e4 steps, max |E - E0| / E_kin(0).
+  // Measured (this schedule): the default interval (every 8 steps) with the pair force fast
+  // within 3.5 d, 7.5e-5, and within the default 2 d, 2.8e-4 (the price of the 1.5x faster cold
+  // gas, docs/coulomb.md); every = 1 (docs/coulomb.md: 5.3e-5). Bounds: 1e-4, 4e-4, 1e-4.
+  struct Split {
+    int every;
+    double r_fast, bound;
+  };
+  for (const Split& sp : {Split{0, 3.5, 1e-4}, Split{0, 0.0, 4e-4}, Split{1, 0.0, 1e-4}}) {
+    INFO("coulomb.every = " << sp.every << ", r_fast = " << sp.r_fast << " (0: auto)");
     MdConfig c = chargedConfig(250, 11, 5.0, "pppm");
     c.contact.D = 0.0;
     c.integrator.dt = 0.002;
-    c.coulomb.every = every;
+    c.coulomb.every = sp.every;
+    c.coulomb.r_fast = sp.r_fast;
     Engine e(c, Engine::randomInitialState(c));
-    REQUIRE(e.coulombSetup()->every == (every == 0 ? 8 : 1));
+    REQUIRE(e.coulombSetup()->every == (sp.every == 0 ? 8 : 1));
     const auto o0 = e.observables();
     const double E0 = totalEnergy(o0), scale = o0.kinetic_energy;
     double worst = 0.0;
@@ -286,8 +292,7 @@ TEST_CASE(
     INFO("max |E - E0| / E_kin(0) = " << worst << ", Coulomb energy " << o0.coulomb_energy << " -> "
                                       << o.coulomb_energy);
     CHECK(o.coulomb_energy < 2.0 * o0.coulomb_energy);  // strongly coupled: pairs bind
-    CHECK(worst < 1e-4);
-    if (every == 1) break;
+    CHECK(worst < sp.bound);
   }
   // (c) a restart at a step between Coulomb evaluations continues bit for bit (the last slow force
   // travels with the checkpoint: Engine::extraState)
@@ -330,13 +335,16 @@ TEST_CASE(
   // intervals of 8, 12 and 16 steps drift 8.2e-5, 2.2e-4 and 5.2e-4; the varying interval (9..15
   // steps, 858 evaluations, as many as a fixed 12) 2.9e-4. Giving the impulse at a change wrongly
   // (k_after for both halves instead of their mean) makes it 9.7e-4: the bound below tells the
-  // two apart and asks for no more drift than a fixed interval of the longest length.
+  // two apart and asks for no more drift than a fixed interval of the longest length. (With the
+  // pair force fast within 3.5 d, where these numbers were measured and the two are far apart;
+  // the default 2 d drifts 1.0e-3 here.)
   {
     MdConfig c = chargedConfig(250, 11, 5.0, "pppm");
     c.contact.D = 0.0;
     c.integrator.dt = 0.002;
     c.integrator.impact_speed_max = 16.0;
     c.coulomb.every_max = 16;
+    c.coulomb.r_fast = 3.5;
     Engine e(c, Engine::randomInitialState(c));
     REQUIRE(e.coulombSetup()->every == 8);
     REQUIRE(e.coulombSetup()->every_max == 16);
@@ -387,4 +395,32 @@ TEST_CASE(
     CHECK(a.vz == b.vz);
     CHECK(a.charge == b.charge);
   }
+}
+
+TEST_CASE("a restart keeps the split it was written with, whatever \"auto\" means now",
+          "[md][coulomb]") {
+  // The checkpoint records the resolved r_fast and every_max (Engine::extraState); one without
+  // them was written when "auto" meant r_fast = 3.5 d and continues with that.
+  MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
+  c.coulomb.r_fast = 2.5;
+  c.coulomb.every_max = 12;
+  Engine first(c, Engine::randomInitialState(c));
+  first.run(10);
+  Checkpoint ck = first.checkpoint();
+  MdConfig automatic = c;
+  automatic.coulomb.r_fast = 0.0;
+  automatic.coulomb.every_max = 0;
+  {
+    Engine resumed(automatic, ck);
+    CHECK(resumed.coulombSetup()->r_fast == 2.5);
+    CHECK(resumed.coulombSetup()->every_max == 12);
+    first.run(40);
+    resumed.run(40);
+    CHECK(first.frame().x == resumed.frame().x);  // and so it continues bit for bit
+  }
+  ck.extra.real_scalars.erase("coulomb_r_fast");
+  ck.extra.int_scalars.erase("coulomb_every_max");
+  Engine legacy(automatic, ck);
+  CHECK(legacy.coulombSetup()->r_fast == 3.5);
+  CHECK(legacy.coulombSetup()->every_max == 4 * legacy.coulombSetup()->every);
 }
