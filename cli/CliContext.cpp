@@ -31,4 +31,15 @@ std::string findPreset(const std::string& sub, const std::string& name, const st
                               "/" + sub + " (available: " + list + ")");
 }
 
+const common::PaperValues& paperValues() {
+  static const common::PaperValues values = [] {
+    for (const auto& d : dataDirs()) {
+      const fs::path p = fs::path(d) / "reference" / "paper.json";
+      if (fs::is_regular_file(p)) return common::readPaperValues(p.string());
+    }
+    throw std::runtime_error("no reference/paper.json in " + dataDirs().back());
+  }();
+  return values;
+}
+
 }  // namespace granagg::cli

@@ -11,6 +11,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/PaperValues.h"
+
 namespace granagg::cli {
 
 struct CliContext {
@@ -24,6 +26,9 @@ std::vector<std::string> dataDirs();
 /// runs and of pair studies). An unknown name throws std::invalid_argument naming `what` (the
 /// option or key) and listing the names available.
 std::string findPreset(const std::string& sub, const std::string& name, const std::string& what);
+
+/// The paper's published values, from data/reference/paper.json (read once).
+const common::PaperValues& paperValues();
 
 /// Registers `granagg smol ...` (cli/SmolCommand.cpp).
 void registerSmolCommand(CLI::App& app, const CliContext& ctx);

@@ -25,11 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The paper's values (Singh & Mazza 2018), printed beside ours.
-constexpr double PAPER_Z_NEUTRAL = 1.21, PAPER_Z_NEUTRAL_ERR = 0.04;
-constexpr double PAPER_Z_CHARGED = 1.49, PAPER_Z_CHARGED_ERR = 0.012;
-constexpr double PAPER_Z_MF_BETA2 = 1.19, PAPER_Z_MF_BETA3 = 1.49;
-
 struct FitBetaArgs {
   std::string input;
   std::string column;
@@ -387,6 +382,7 @@ std::string interval(double v, double lo, double hi) {
 }
 
 void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
+  const common::PaperValues& paper = paperValues();  // printed beside ours
   mf::validateBetaRange(a.beta_min, a.beta_max);
   if (!a.window.empty() && a.window.size() != 2)
     throw std::invalid_argument("--window needs two times T0 T1.");
@@ -637,12 +633,12 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
     j.str("curve_fit_note", cf.note);
     j.num("beta_min", a.beta_min);
     j.num("beta_max", a.beta_max);
-    j.num("paper_z_neutral", PAPER_Z_NEUTRAL);
-    j.num("paper_z_neutral_err", PAPER_Z_NEUTRAL_ERR);
-    j.num("paper_z_charged", PAPER_Z_CHARGED);
-    j.num("paper_z_charged_err", PAPER_Z_CHARGED_ERR);
-    j.num("paper_z_mf_beta2", PAPER_Z_MF_BETA2);
-    j.num("paper_z_mf_beta3", PAPER_Z_MF_BETA3);
+    j.num("paper_z_neutral", paper.z_neutral);
+    j.num("paper_z_neutral_err", paper.z_neutral_pm);
+    j.num("paper_z_charged", paper.z_charged);
+    j.num("paper_z_charged_err", paper.z_charged_pm);
+    j.num("paper_z_mf_beta2", paper.z_meanfield_beta2);
+    j.num("paper_z_mf_beta3", paper.z_meanfield_beta3);
     j.strings("notes", L.notes);
     std::ofstream o(jsonPath);
     o << j.text();
@@ -657,13 +653,13 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
               window.rule.c_str());
   std::printf("fit-beta: z = %s (95 %%, %s)   paper: %.2f +- %.2f neutral, %.2f +- %.3f charged\n",
               interval(zf.z, zf.z_low, zf.z_high).c_str(), zf.interval_method.c_str(),
-              PAPER_Z_NEUTRAL, PAPER_Z_NEUTRAL_ERR, PAPER_Z_CHARGED, PAPER_Z_CHARGED_ERR);
+              paper.z_neutral, paper.z_neutral_pm, paper.z_charged, paper.z_charged_pm);
   std::printf(
       "fit-beta: beta from z = %s (full Smoluchowski z(beta) over S = %.4g..%.4g, where it gives z "
       "= %.4f at "
       "beta = 2, %.4f at beta = 3)   paper: mean field z = %.2f at beta = 2, %.2f at beta = 3\n",
       interval(bz.beta, bz.beta_low, bz.beta_high).c_str(), bz.S0, bz.S1, zmf2, zmf3,
-      PAPER_Z_MF_BETA2, PAPER_Z_MF_BETA3);
+      paper.z_meanfield_beta2, paper.z_meanfield_beta3);
   if (!bz.note.empty()) std::printf("fit-beta:   note: %s\n", bz.note.c_str());
   std::printf(
       "fit-beta: beta from the asymptotic law z = 3 beta/(beta + 3) = %s (no S scale; valid where "

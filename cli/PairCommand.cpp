@@ -1186,10 +1186,14 @@ void Pair::writeSummary() {
     << ",\n  \"command\": " << jsonString(m_ctx.command_line)
     << ",\n  \"written\": " << jsonString(nowUtc()) << ",\n  \"cores\": " << m_cores
     << ",\n  \"backend\": " << jsonString(md::Engine::backendDescription()) << ",\n";
-  s << "  \"paper\": {\"reference\": \"Singh & Mazza, Phys. Rev. E (2018)\", \"z_neutral\": 1.21, "
-       "\"z_neutral_pm\": 0.04, "
-       "\"z_charged\": 1.49, \"z_charged_pm\": 0.012, \"z_meanfield_beta2\": 1.19, "
-       "\"z_meanfield_beta3\": 1.49},\n";
+  const common::PaperValues& paper = paperValues();
+  s << "  \"paper\": {\"reference\": " << jsonString(paper.reference)
+    << ", \"z_neutral\": " << jsonNumber(paper.z_neutral)
+    << ", \"z_neutral_pm\": " << jsonNumber(paper.z_neutral_pm)
+    << ", \"z_charged\": " << jsonNumber(paper.z_charged)
+    << ", \"z_charged_pm\": " << jsonNumber(paper.z_charged_pm)
+    << ", \"z_meanfield_beta2\": " << jsonNumber(paper.z_meanfield_beta2)
+    << ", \"z_meanfield_beta3\": " << jsonNumber(paper.z_meanfield_beta3) << "},\n";
   s << "  \"ensembles\": [\n";
   for (std::size_t k = 0; k < m_c.K.size(); ++k) {
     const double K = m_c.K[k];
@@ -1222,11 +1226,11 @@ void Pair::writeSummary() {
       << ", \"onset_time_se\": " << jsonNumber(r.onset_err)
       << ", \"regime\": " << jsonString(r.regime.regime)
       << ", \"regime_reason\": " << jsonString(r.regime.reason)
-      << ", \"validation\": " << jsonString(validationLine(K)) << ",\n     \"paper_z\": "
-      << (K == 0 ? "1.21, \"paper_z_pm\": 0.04"
-                 : "1.49, \"paper_z_pm\": 0.012, \"paper_note\": \"the paper's charged value (K = "
-                   "5)\"")
-      << "}" << (k + 1 < m_c.K.size() ? "," : "") << "\n";
+      << ", \"validation\": " << jsonString(validationLine(K))
+      << ",\n     \"paper_z\": " << jsonNumber(K == 0 ? paper.z_neutral : paper.z_charged)
+      << ", \"paper_z_pm\": " << jsonNumber(K == 0 ? paper.z_neutral_pm : paper.z_charged_pm)
+      << (K == 0 ? "" : ", \"paper_note\": \"the paper's charged value (K = 5)\"") << "}"
+      << (k + 1 < m_c.K.size() ? "," : "") << "\n";
   }
   s << "  ],\n  \"meanfield\": [\n";
   const common::CsvTable* zb = nullptr;
@@ -1247,11 +1251,12 @@ void Pair::writeSummary() {
     const fs::path csv = m_out / "meanfield" / ("S_beta" + formatReal(b) + ".csv");
     s << "    {\"beta\": " << jsonNumber(b) << ", \"z_scaling\": " << jsonNumber(3 * b / (b + 3))
       << ", \"z_asymptotic\": " << jsonNumber(zinf)
-      << ", \"z_local_S250\": " << jsonNumber(localSlopeAt(csv, 250))
-      << ", \"z_local_S1650\": " << jsonNumber(localSlopeAt(csv, 1650)) << ", \"paper_z\": "
-      << (b == 2   ? "1.19"
-          : b == 3 ? "1.49"
-                   : "null")
+      << ", \"z_local_S250\": " << jsonNumber(localSlopeAt(csv, paper.S_beta2))
+      << ", \"z_local_S1650\": " << jsonNumber(localSlopeAt(csv, paper.S_beta3))
+      << ", \"paper_z\": "
+      << (b == 2   ? jsonNumber(paper.z_meanfield_beta2)
+          : b == 3 ? jsonNumber(paper.z_meanfield_beta3)
+                   : std::string("null"))
       << "}" << (k + 1 < m_c.betas.size() ? "," : "") << "\n";
   }
   s << "  ],\n  \"steps\": {";
@@ -1287,13 +1292,17 @@ std::string fmt(double v, int prec = 3) {
 
 void Pair::printSummary() {
   if (m_a.quiet) return;
+  const common::PaperValues& paper = paperValues();
   std::printf("pair: ---- summary (%s) ----\n", (m_out / "summary.json").c_str());
   for (double K : m_c.K) {
     const KResult r = readK(m_out, K);
     std::printf("pair: K = %-5s z = %s [%s, %s] (analyze, grid, t in [%s, %s])",
                 formatReal(K).c_str(), fmt(r.z).c_str(), fmt(r.z_low).c_str(),
                 fmt(r.z_high).c_str(), fmt(r.fit_t_min, 3).c_str(), fmt(r.fit_t_max, 3).c_str());
-    std::printf("   paper: %s\n", K == 0 ? "1.21 +- 0.04" : "1.49 +- 0.012 (K = 5)");
+    std::printf("   paper: %s +- %s%s\n",
+                formatReal(K == 0 ? paper.z_neutral : paper.z_charged).c_str(),
+                formatReal(K == 0 ? paper.z_neutral_pm : paper.z_charged_pm).c_str(),
+                K == 0 ? "" : " (K = 5)");
     std::printf("pair:           regime: %s (%s)\n", r.regime.regime.c_str(),
                 r.regime.reason.c_str());
     const std::string v = validationLine(K);
@@ -1326,13 +1335,13 @@ void Pair::printSummary() {
   }
   for (double b : m_c.betas) {
     const fs::path csv = m_out / "meanfield" / ("S_beta" + formatReal(b) + ".csv");
-    const double S_paper = b == 2 ? 250 : 1650;
+    const double S_paper = b == 2 ? paper.S_beta2 : paper.S_beta3;
+    const std::string paper_z = b == 2   ? "   paper: " + formatReal(paper.z_meanfield_beta2)
+                                : b == 3 ? "   paper: " + formatReal(paper.z_meanfield_beta3)
+                                         : "";
     std::printf("pair: mean field beta = %s: z(S ~ %g) = %s, asymptotic 3 beta/(beta+3) = %s%s\n",
                 formatReal(b).c_str(), S_paper, fmt(localSlopeAt(csv, S_paper)).c_str(),
-                fmt(3 * b / (b + 3)).c_str(),
-                b == 2   ? "   paper: 1.19"
-                : b == 3 ? "   paper: 1.49"
-                         : "");
+                fmt(3 * b / (b + 3)).c_str(), paper_z.c_str());
   }
   std::printf("pair: wrote %s (summary.json%s) in %.0f s\n", m_out.c_str(),
               fs::exists(m_out / "report.html") ? ", report.html, figures/" : "", seconds());

@@ -14,8 +14,9 @@
 # Installs Debian's `lammps` (29 Sep 2021 stable, binary lmp) if it is missing; builds nothing.
 #
 # Timing: every run is done at two lengths n1 < n2 from the same initial state; the rate is
-# N (n2 - n1) / (t(n2) - t(n1)). For granagg t is the time of the MD loop that `granagg md` reports
-# ("md: n steps in t s": from the first step to the last, output included), so start-up,
+# N (n2 - n1) / (t(n2) - t(n1)). For granagg t is the time of the MD loop that `granagg md
+# --profile` writes to profile.csv (loop_s: from the first step to the last, output included),
+# so start-up,
 # initial-state reading and file creation stay out and the first neighbour build cancels; for
 # LAMMPS the input does `run n1` then `run n2-n1` and t(n2) - t(n1) is the second run's "Loop time"
 # (same steps n1..n2 of the same cooling gas, so both codes do the same physical work). Each time
@@ -109,7 +110,7 @@ gen_state() {  # N -> $TMP/state_N.csv (granagg) and $TMP/state_N.data (LAMMPS):
   /usr/bin/python3 "$ROOT/scripts/lammps/make_state.py" "$1" "$PHI" "$TMP"
 }
 
-granagg_time() {  # N steps threads -> seconds of the MD loop (granagg md's "n steps in t s")
+granagg_time() {  # N steps threads -> seconds of the MD loop (profile.csv's loop_s)
   local N=$1 n=$2 th=$3
   cat > "$TMP/g.toml" <<EOF
 [system]
@@ -137,10 +138,19 @@ checkpoint_interval = 0
 checkpoint_wall_seconds = 0.0
 write_velocities = false
 EOF
-  OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" > "$TMP/g.log" 2>&1 \
+  OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" \
+    --profile > "$TMP/g.log" 2>&1 || { cat "$TMP/g.log" >&2; exit 1; }
+  # the loop time and step count from profile.csv (machine-readable; the log is for people)
+  /usr/bin/python3 - "$ROOT/scripts" "$TMP/gout/profile.csv" "$n" <<'PY' \
     || { cat "$TMP/g.log" >&2; exit 1; }
-  grep -q "$n steps to t_end" "$TMP/g.log" || { echo "granagg did not run $n steps:" >&2; cat "$TMP/g.log" >&2; exit 1; }
-  sed -n "s/^md: $n steps in \([0-9.e+-]*\) s.*/\1/p" "$TMP/g.log"
+import sys
+sys.path.insert(0, sys.argv[1])
+import granagg_tables as gt
+r = gt.read(sys.argv[2])
+if r is None or int(r["steps"][0]) != int(sys.argv[3]):
+    sys.exit(f"granagg did not run {sys.argv[3]} steps ({sys.argv[2]})")
+print(repr(float(r["loop_s"][0])))
+PY
 }
 
 lammps_time() {  # N n1 n2 ranks fix -> loop seconds of steps n1..n2

@@ -2,7 +2,8 @@
 
 granagg writes CSV tables with '# key = value' provenance lines, then one header row
 (docs/analysis.md). `read(path)` returns a numpy structured array (None when the file is absent
-or has no rows); `meta(path)` returns the provenance as a dict; `col(table, name)` a column or None.
+or has no rows); `meta(path)` returns the provenance as a dict; `col(table, name)` a column or None;
+`paper()` the paper's published values (data/reference/paper.json, the one place they are typed).
 Needs Debian's python3-numpy (/usr/bin/python3).
 """
 import io
@@ -49,4 +50,12 @@ def load_json(path):
     if not os.path.exists(path):
         return {}
     with open(path) as f:
+        return json.load(f)
+
+
+def paper():
+    """The paper's published values (Singh & Mazza 2018) from data/reference/paper.json, as a
+    dict (e.g. paper()["z_neutral"]["value"]); C++ reads the same file (common/PaperValues.h)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(here, "..", "data", "reference", "paper.json")) as f:
         return json.load(f)

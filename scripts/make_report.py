@@ -23,7 +23,8 @@ CAPTIONS = {
     "fig4_charge": "Fig. 4. Mean |q|(t) and its rate d<|q|>/dt against the kinetic-theory law; N_s(s) of grid "
     "clusters at three times.",
     "fig5_growth": "Fig. 5. Mean cluster size S(t) (grid clusters) with the power-law fit over the fit window, the "
-    "fitted mean field where available; inset: local slope z(t) with the paper's 1.21 and 1.49.",
+    "fitted mean field where available; inset: local slope z(t) with the paper's neutral and "
+    "charged z.",
     "fig6_meanfield": "Fig. 6. MD S(t) against the mean-field S(t) of the fitted beta kernel, S_c S_MF(t / tau_c); "
     "inset: mean-squared displacement from t = 0.",
     "fig7_speed": "Fig. 7. Speed distribution f(v~), v~ = v / <v^2>^1/2, at the first and last frames against the "
@@ -112,8 +113,10 @@ def main():
     for m in s.get("meanfield", []):
         w(f"<tr><td>{esc(m['beta'])}</td><td>{num(m.get('z_local_S250'))}</td><td>{num(m.get('z_local_S1650'))}</td>"
           f"<td>{num(m.get('z_asymptotic'), 4)}</td><td>{num(m.get('z_scaling'), 4)}</td><td>{esc(m.get('paper_z'))}</td></tr>")
-    w("</table><p class='small'>The paper's 1.19 (beta = 2) and 1.49 (beta = 3) are local slopes near S ~ 250 and "
-      "S ~ 1650; the full equation converges to 3 beta/(beta+3) (design.md section 4).</p>")
+    pz = s.get("paper", {})
+    w(f"</table><p class='small'>The paper's {esc(pz.get('z_meanfield_beta2'))} (beta = 2) and "
+      f"{esc(pz.get('z_meanfield_beta3'))} (beta = 3) are local slopes near S ~ 250 and S ~ 1650; "
+      "the full equation converges to 3 beta/(beta+3) (design.md section 4).</p>")
 
     w("<h2>Figures</h2>")
     figs = os.path.join(d, "figures")

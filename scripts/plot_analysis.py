@@ -6,7 +6,6 @@ usage: /usr/bin/python3 scripts/plot_analysis.py ANALYSIS_DIR
 Reads the ensemble CSV tables (docs/analysis.md, "Outputs") and writes analysis.png next to them.
 Debian's python3-matplotlib and python3-numpy only.
 """
-import io
 import os
 import sys
 
@@ -16,14 +15,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-
-def read(path):
-    """A granagg CSV table as a numpy structured array (None if absent); '#' lines dropped."""
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
-        lines = [line for line in f if not line.startswith("#")]
-    return np.genfromtxt(io.StringIO("".join(lines)), delimiter=",", names=True)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from granagg_tables import read  # noqa: E402
 
 
 def main():

@@ -33,7 +33,7 @@ from matplotlib.collections import EllipseCollection  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from granagg_tables import col, read  # noqa: E402
+from granagg_tables import col, paper, read  # noqa: E402
 
 FAILED = []
 
@@ -157,7 +157,7 @@ def fig2(st, fig):
             ax.add_collection(ec)
             ax.set(xlim=(0, L), ylim=(0, L), aspect="equal", title=f"{st.label(k)}, t = {t:.3g}")
             ax.tick_params(labelsize=7)
-    fig.suptitle(f"Fig. 2: slab |z - L/2| < 2 d projected on (x, y), run 0 (charged: colour = q)")
+    fig.suptitle("Fig. 2: slab |z - L/2| < 2 d projected on (x, y), run 0 (charged: colour = q)")
 
 
 def fig3(st, fig):
@@ -268,12 +268,14 @@ def fig5(st, fig):
         drawn = True
     if not drawn:
         note(ax, "no analysis/K*/S_t.csv")
-    ins.axhline(1.21, color="C0", ls=":", lw=0.8)
-    ins.axhline(1.49, color="C3", ls=":", lw=0.8)
+    zn, zc = paper()["z_neutral"]["value"], paper()["z_charged"]["value"]
+    ins.axhline(zn, color="C0", ls=":", lw=0.8)
+    ins.axhline(zc, color="C3", ls=":", lw=0.8)
     ins.set(xscale="log", xlabel="t", ylabel="z(t)")
     ins.tick_params(labelsize=7)
     ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S (grid sites)",
-           title="Fig. 5: mean cluster size; inset: local slope (paper: 1.21 neutral, 1.49 charged)")
+           title=f"Fig. 5: mean cluster size; inset: local slope (paper: {zn} neutral, "
+                 f"{zc} charged)")
     ax.legend(fontsize=8, loc="upper left")
 
 

@@ -6,7 +6,6 @@ usage: /usr/bin/python3 scripts/plot_meanfield.py RESULTS_DIR
 Reads the CSV tables written by `granagg smol` / `granagg kinetic` (provenance lines start
 with '#') and writes PNG files next to them. Debian's python3-matplotlib and python3-numpy only.
 """
-import io
 import os
 import sys
 
@@ -16,17 +15,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-
-def read(path):
-    """A granagg CSV table as a numpy structured array (None if the file is absent).
-
-    Provenance lines start with '#'; numpy's names=True would take the first of them for the
-    header, so they are dropped before parsing."""
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
-        lines = [line for line in f if not line.startswith("#")]
-    return np.genfromtxt(io.StringIO("".join(lines)), delimiter=",", names=True)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from granagg_tables import paper, read  # noqa: E402
 
 
 def plot_S(out):
@@ -46,7 +36,9 @@ def plot_S(out):
         zinf = 3 * beta / (beta + 3)
         az.axhline(zinf, color=colors[beta], lw=0.6)
     # the paper's mean-field values (Singh & Mazza 2018): local slopes near S ~ 250 and ~ 1650
-    az.plot([250, 1650], [1.19, 1.49], "ko", ms=5, label="paper: 1.19, 1.49")
+    p2, p3 = paper()["z_meanfield_beta2"], paper()["z_meanfield_beta3"]
+    az.plot([p2["S"], p3["S"]], [p2["value"], p3["value"]], "ko", ms=5,
+            label=f"paper: {p2['value']}, {p3['value']}")
     ax.set_xlabel("t  [1/(K0 n1(0))]")
     ax.set_ylabel("S = M2/M1")
     ax.legend(fontsize=7)
