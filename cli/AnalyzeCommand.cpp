@@ -260,35 +260,40 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
   if (a.quiet) return;
   for (std::size_t k = 0; k < results.size(); ++k) {
     const auto& r = results[k];
-    std::printf("analyze: run %zu: %s (%s): %zu frames, N = %zu%s\n", k, r.source.c_str(),
-                r.format.c_str(), r.frames, r.particles, r.partial ? " [PARTIAL]" : "");
+    std::fprintf(stderr, "analyze: run %zu: %s (%s): %zu frames, N = %zu%s\n", k, r.source.c_str(),
+                 r.format.c_str(), r.frames, r.particles, r.partial ? " [PARTIAL]" : "");
     if (r.grid_cells > 0)
-      std::printf("analyze:   grid: %d^3 cells of h = %.4g d, occupied at >= %g centres per cell\n",
-                  r.grid_cells, r.grid_cell_size, r.grid_min_count);
-    for (const auto& n : r.notes) std::printf("analyze:   note: %s\n", n.c_str());
+      std::fprintf(
+          stderr, "analyze:   grid: %d^3 cells of h = %.4g d, occupied at >= %g centres per cell\n",
+          r.grid_cells, r.grid_cell_size, r.grid_min_count);
+    for (const auto& n : r.notes) std::fprintf(stderr, "analyze:   note: %s\n", n.c_str());
   }
   for (const auto& t : ensemble)
     if (t.name == "fits" && !t.rows.empty()) {
       const auto& row = t.rows.front();
       auto c = [&](const char* name) { return row[t.column(name)]; };
-      std::printf(
+      std::fprintf(
+          stderr,
           "analyze: z (grid) = %.4g [%.4g, %.4g], z (particle) = %.4g [%.4g, %.4g] over t in "
           "[%.4g, %.4g] (%s)\n",
           c("z_grid"), c("z_grid_low"), c("z_grid_high"), c("z_particle"), c("z_particle_low"),
           c("z_particle_high"), c("fit_t_min"), c("fit_t_max"),
           results.size() > 1 ? "95% bootstrap over runs" : "95% Student t");
       if (std::isfinite(c("charging_rate_exponent")))
-        std::printf(
+        std::fprintf(
+            stderr,
             "analyze: d<|q|>/dt ~ t^%.4g [%.4g, %.4g]; expected -5/6 - 5 kappa/3 = %.4g (kappa = "
             "%g, %s)\n",
             c("charging_rate_exponent"), c("charging_rate_low"), c("charging_rate_high"),
             c("charging_rate_expected"), c("kappa"), results.front().kappa_source.c_str());
       if (std::isfinite(c("onset_time_grid")))
-        std::printf(
+        std::fprintf(
+            stderr,
             "analyze: onset (S_grid reaches %g x its median %.4g over t <= %g) at t_c = %.4g\n",
             c("onset_factor"), c("onset_S_base_grid"), c("onset_t_base"), c("onset_time_grid"));
     }
-  std::printf("analyze: wrote %s (CSV tables, per_run/, analysis.h5)\n", out.string().c_str());
+  std::fprintf(stderr, "analyze: wrote %s (CSV tables, per_run/, analysis.h5)\n",
+               out.string().c_str());
 }
 
 }  // namespace

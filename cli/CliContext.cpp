@@ -1,5 +1,8 @@
 #include "cli/CliContext.h"
 
+#include <signal.h>
+
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <set>
@@ -8,6 +11,23 @@
 
 namespace granagg::cli {
 namespace fs = std::filesystem;
+
+namespace {
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void onStopSignal(int sig) { g_stop_signal = sig; }
+}  // namespace
+
+void catchStopSignals() {
+  struct sigaction sa {};
+  sa.sa_handler = onStopSignal;
+  sigemptyset(&sa.sa_mask);
+  // no SA_RESETHAND: a second signal (Slurm signals every process of a step, and pair forwards
+  // the signal to its runs as well) must not kill a run while it writes its checkpoint
+  ::sigaction(SIGINT, &sa, nullptr);
+  ::sigaction(SIGTERM, &sa, nullptr);
+}
+
+const volatile std::sig_atomic_t* stopSignal() { return &g_stop_signal; }
 
 std::vector<std::string> dataDirs() {
   std::vector<std::string> dirs;

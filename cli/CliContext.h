@@ -6,6 +6,8 @@
 /// Error convention (README, "Errors"): bad user input throws std::invalid_argument with one
 /// sentence naming the option and the allowed range; main() prints it on one line and exits 2.
 /// Other failures (I/O, a solver that cannot continue) throw std::runtime_error: exit 1.
+#include <csignal>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,26 @@ namespace granagg::cli {
 struct CliContext {
   std::string command_line;  ///< argv joined, recorded in every output's provenance header
 };
+
+/// A command stopped by SIGINT or SIGTERM after saving what it had (a checkpoint, finished runs):
+/// main() prints the message on one line and exits with status(), 128 + the signal number, as
+/// a shell reports a command killed by it (130 for SIGINT, 143 for SIGTERM).
+class Interrupted : public std::runtime_error {
+ public:
+  Interrupted(const std::string& what, int signal)
+      : std::runtime_error(what), m_status(128 + signal) {}
+  int status() const { return m_status; }
+
+ private:
+  int m_status;
+};
+
+/// From now on SIGINT and SIGTERM (Ctrl-C, Slurm's time limit, kill) only set stopSignal(); the
+/// running command polls it and stops cleanly within a chunk of steps. Further signals change
+/// nothing (SIGKILL still kills).
+void catchStopSignals();
+/// The signal caught by catchStopSignals(), 0 if none; a pointer for md::RunOptions::stop.
+const volatile std::sig_atomic_t* stopSignal();
 
 /// Where data/ is looked for: $GRANAGG_DATA first (if set), then the source tree's data/.
 std::vector<std::string> dataDirs();

@@ -646,46 +646,52 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
   }
 
   if (a.quiet) return;
-  std::printf("fit-beta: %s column %s: %zu samples, %zu run%s\n", L.source.c_str(),
-              L.column.c_str(), data.t.size(), L.runs.size(), L.runs.size() == 1 ? "" : "s");
-  for (const auto& n : L.notes) std::printf("fit-beta:   note: %s\n", n.c_str());
-  std::printf("fit-beta: window [%.4g, %.4g], %d samples (%s)\n", zf.t0, zf.t1, zf.points,
-              window.rule.c_str());
-  std::printf("fit-beta: z = %s (95 %%, %s)   paper: %.2f +- %.2f neutral, %.2f +- %.3f charged\n",
-              interval(zf.z, zf.z_low, zf.z_high).c_str(), zf.interval_method.c_str(),
-              paper.z_neutral, paper.z_neutral_pm, paper.z_charged, paper.z_charged_pm);
-  std::printf(
+  std::fprintf(stderr, "fit-beta: %s column %s: %zu samples, %zu run%s\n", L.source.c_str(),
+               L.column.c_str(), data.t.size(), L.runs.size(), L.runs.size() == 1 ? "" : "s");
+  for (const auto& n : L.notes) std::fprintf(stderr, "fit-beta:   note: %s\n", n.c_str());
+  std::fprintf(stderr, "fit-beta: window [%.4g, %.4g], %d samples (%s)\n", zf.t0, zf.t1, zf.points,
+               window.rule.c_str());
+  std::fprintf(stderr,
+               "fit-beta: z = %s (95 %%, %s)   paper: %.2f +- %.2f neutral, %.2f +- %.3f charged\n",
+               interval(zf.z, zf.z_low, zf.z_high).c_str(), zf.interval_method.c_str(),
+               paper.z_neutral, paper.z_neutral_pm, paper.z_charged, paper.z_charged_pm);
+  std::fprintf(
+      stderr,
       "fit-beta: beta from z = %s (full Smoluchowski z(beta) over S = %.4g..%.4g, where it gives z "
       "= %.4f at "
       "beta = 2, %.4f at beta = 3)   paper: mean field z = %.2f at beta = 2, %.2f at beta = 3\n",
       interval(bz.beta, bz.beta_low, bz.beta_high).c_str(), bz.S0, bz.S1, zmf2, zmf3,
       paper.z_meanfield_beta2, paper.z_meanfield_beta3);
-  if (!bz.note.empty()) std::printf("fit-beta:   note: %s\n", bz.note.c_str());
-  std::printf(
+  if (!bz.note.empty()) std::fprintf(stderr, "fit-beta:   note: %s\n", bz.note.c_str());
+  std::fprintf(
+      stderr,
       "fit-beta: beta from the asymptotic law z = 3 beta/(beta + 3) = %s (no S scale; valid where "
       "the local "
       "slope is flat)\n",
       interval(ba.beta, ba.beta_low, ba.beta_high).c_str());
-  if (!ba.note.empty()) std::printf("fit-beta:   note: %s\n", ba.note.c_str());
+  if (!ba.note.empty()) std::fprintf(stderr, "fit-beta:   note: %s\n", ba.note.c_str());
   if (!a.no_curve_fit) {
-    std::printf("fit-beta: beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s\n",
-                bzs.S0, bzs.S1, interval(bzs.beta, bzs.beta_low, bzs.beta_high).c_str());
-    if (!bzs.note.empty()) std::printf("fit-beta:   note: %s\n", bzs.note.c_str());
+    std::fprintf(stderr,
+                 "fit-beta: beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s\n",
+                 bzs.S0, bzs.S1, interval(bzs.beta, bzs.beta_low, bzs.beta_high).c_str());
+    if (!bzs.note.empty()) std::fprintf(stderr, "fit-beta:   note: %s\n", bzs.note.c_str());
     if (cf.at_bound)
-      std::printf(
+      std::fprintf(
+          stderr,
           "fit-beta: beta from the curve fit: not determined (at the bound %.3g of the search "
           "range)\n",
           cf.beta);
-    std::printf(
+    std::fprintf(
+        stderr,
         "fit-beta: beta from the curve fit = %s, S_c = %s, tau_c = %s, chi2/dof = %.3g (%s)\n",
         interval(cf.beta, cf.beta_low, cf.beta_high).c_str(),
         interval(cf.S_c, cf.S_c_low, cf.S_c_high).c_str(),
         interval(cf.tau_c, cf.tau_c_low, cf.tau_c_high).c_str(), cf.chi2_dof,
         cf.interval_method.c_str());
-    if (!cf.note.empty()) std::printf("fit-beta:   note: %s\n", cf.note.c_str());
+    if (!cf.note.empty()) std::fprintf(stderr, "fit-beta:   note: %s\n", cf.note.c_str());
   }
-  std::printf("fit-beta: wrote %s, %s%s\n", csvPath.c_str(),
-              a.no_curve_fit ? "" : (curvePath + ", ").c_str(), jsonPath.c_str());
+  std::fprintf(stderr, "fit-beta: wrote %s, %s%s\n", csvPath.c_str(),
+               a.no_curve_fit ? "" : (curvePath + ", ").c_str(), jsonPath.c_str());
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "cli/CliContext.h"
+#include "common/Csv.h"
 #include "common/Version.h"
 #include "md/config/ConfigParser.h"
 #include "md/engine/Engine.h"
@@ -93,24 +95,25 @@ void printProfile(const md::Engine& engine, std::int64_t steps, double loop_seco
 void printStart(const md::Simulation& sim) {
   const md::Engine& e = sim.engine();
   const md::MdConfig& cfg = sim.config();
-  std::printf("md: %s\n", common::versionString().c_str());
-  std::printf("md: backend: %s\n", md::Engine::backendDescription().c_str());
-  std::printf("md: N = %d, phi = %g, box L = %.6g, contact model %s, seed %llu\n", cfg.system.N,
-              cfg.system.phi, e.box(), cfg.contact.model.c_str(),
-              static_cast<unsigned long long>(cfg.system.seed));
-  std::printf("md: dt = %.6g (%s); %lld steps to t_end = %g\n", e.dt(), sim.dtReason().c_str(),
-              static_cast<long long>(sim.lastStep()), cfg.run.t_end);
+  std::fprintf(stderr, "md: %s\n", common::versionString().c_str());
+  std::fprintf(stderr, "md: backend: %s\n", md::Engine::backendDescription().c_str());
+  std::fprintf(stderr, "md: N = %d, phi = %g, box L = %.6g, contact model %s, seed %llu\n",
+               cfg.system.N, cfg.system.phi, e.box(), cfg.contact.model.c_str(),
+               static_cast<unsigned long long>(cfg.system.seed));
+  std::fprintf(stderr, "md: dt = %.6g (%s); %lld steps to t_end = %g\n", e.dt(),
+               sim.dtReason().c_str(), static_cast<long long>(sim.lastStep()), cfg.run.t_end);
   if (const md::CoulombSetup* cs = e.coulombSetup()) {
     const std::string mesh = cs->method == "pppm" ? "mesh " + std::to_string(cs->mesh) +
                                                         "^3, order " + std::to_string(cs->order)
                                                   : "k_max " + std::to_string(cs->k_max);
-    std::printf(
-        "md: Coulomb K = %g, %s: alpha = %.6g, r_cut = %.6g, %s; estimated relative "
-        "force error %.2g (for sum q^2 = %.4g)\n",
-        cfg.coulomb.K, cs->method.c_str(), cs->alpha, cs->r_cut, mesh.c_str(), cs->estimated_error,
-        cs->sum_q2_design);
+    std::fprintf(stderr,
+                 "md: Coulomb K = %g, %s: alpha = %.6g, r_cut = %.6g, %s; estimated relative "
+                 "force error %.2g (for sum q^2 = %.4g)\n",
+                 cfg.coulomb.K, cs->method.c_str(), cs->alpha, cs->r_cut, mesh.c_str(),
+                 cs->estimated_error, cs->sum_q2_design);
     if (cs->r_fast > 0.0)
-      std::printf(
+      std::fprintf(
+          stderr,
           "md: multiple time stepping: slow Coulomb part every %d steps%s; pair force within "
           "r_fast = %g every step\n",
           cs->every,
@@ -121,34 +124,34 @@ void printStart(const md::Simulation& sim) {
           cs->r_fast);
   }
   if (sim.resumed())
-    std::printf("md: restarting from step %lld of %s\n", static_cast<long long>(e.step()),
-                sim.folder().c_str());
+    std::fprintf(stderr, "md: restarting from step %lld of %s\n", static_cast<long long>(e.step()),
+                 sim.folder().c_str());
 }
 
 void printSummary(const md::Simulation& sim, const md::RunSummary& s) {
   const md::Engine& e = sim.engine();
   const md::Observables o = e.observables();
-  std::printf(
-      "md: %lld steps in %.4g s (%.3g particle-steps/s incl. output); neighbour list "
-      "rebuilt %lld times (every %.3g steps)\n",
-      static_cast<long long>(s.steps), s.loop_seconds,
-      s.loop_seconds > 0 ? static_cast<double>(s.steps) * e.size() / s.loop_seconds : 0.0,
-      static_cast<long long>(s.neighbor_builds),
-      s.neighbor_builds > 0 ? static_cast<double>(s.steps) / s.neighbor_builds : 0.0);
-  std::printf(
-      "md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max "
-      "overlap %.3g\n",
-      o.time, o.temperature, static_cast<long long>(o.collisions), o.contacts_per_particle,
-      o.max_overlap);
+  std::fprintf(stderr,
+               "md: %lld steps in %.4g s (%.3g particle-steps/s incl. output); neighbour list "
+               "rebuilt %lld times (every %.3g steps)\n",
+               static_cast<long long>(s.steps), s.loop_seconds,
+               s.loop_seconds > 0 ? static_cast<double>(s.steps) * e.size() / s.loop_seconds : 0.0,
+               static_cast<long long>(s.neighbor_builds),
+               s.neighbor_builds > 0 ? static_cast<double>(s.steps) / s.neighbor_builds : 0.0);
+  std::fprintf(stderr,
+               "md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max "
+               "overlap %.3g\n",
+               o.time, o.temperature, static_cast<long long>(o.collisions), o.contacts_per_particle,
+               o.max_overlap);
   if (const md::CoulombSetup* cs = e.coulombSetup(); cs && cs->r_fast > 0.0)
-    std::printf(
-        "md: slow Coulomb part evaluated %lld times (every %.3g steps on average; "
-        "interval now %d steps)\n",
-        static_cast<long long>(s.slow_evaluations),
-        s.slow_evaluations > 0 ? static_cast<double>(s.steps) / s.slow_evaluations : 0.0,
-        e.slowInterval());
-  std::printf("md: wrote %s (%zu frames), %s\n", sim.trajectoryPath().c_str(), sim.framesWritten(),
-              sim.checkpointPath().c_str());
+    std::fprintf(stderr,
+                 "md: slow Coulomb part evaluated %lld times (every %.3g steps on average; "
+                 "interval now %d steps)\n",
+                 static_cast<long long>(s.slow_evaluations),
+                 s.slow_evaluations > 0 ? static_cast<double>(s.steps) / s.slow_evaluations : 0.0,
+                 e.slowInterval());
+  std::fprintf(stderr, "md: wrote %s (%zu frames), %s\n", sim.trajectoryPath().c_str(),
+               sim.framesWritten(), sim.checkpointPath().c_str());
 }
 
 void runMd(const MdArgs& a, const CliContext& ctx) {
@@ -158,6 +161,8 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   options.command_line = ctx.command_line;
   options.overwrite = a.force;
   options.profile = a.profile;
+  catchStopSignals();  // SIGINT / SIGTERM: stop at the end of a chunk with a checkpoint
+  options.stop = stopSignal();
   std::optional<md::Simulation> sim;
   if (!a.restart.empty()) {
     if (!a.config.empty() || !a.preset.empty() || a.seed >= 0)
@@ -183,6 +188,18 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   const md::RunSummary s = sim->run();
   if (a.profile) printProfile(sim->engine(), s.steps, s.loop_seconds);
   if (!a.quiet) printSummary(*sim, s);
+  if (s.stopped) {
+    const int sig = *stopSignal();
+    char t[32];
+    std::snprintf(t, sizeof t, "%.6g", sim->engine().time());
+    throw Interrupted(std::string("md: ") + (sig == SIGINT ? "SIGINT" : "SIGTERM") + " at step " +
+                          std::to_string(sim->engine().step()) + " (t = " + t + " of " +
+                          common::formatReal(sim->config().run.t_end) +
+                          "); checkpoint and trajectory written; continue with: granagg md "
+                          "--restart " +
+                          sim->folder().string(),
+                      sig);
+  }
 }
 
 }  // namespace

@@ -465,9 +465,6 @@ std::string joinCommand(const std::vector<std::string>& argv) {
 // ----------------------------------------------------------------------------------------------
 // Subprocesses
 
-volatile sig_atomic_t g_interrupted = 0;
-void onSignal(int sig) { g_interrupted = sig; }
-
 /// fork + exec with stdout and stderr into `log` (appended); the child dies with its parent.
 pid_t spawn(const std::vector<std::string>& argv, const fs::path& log) {
   std::vector<char*> a;
@@ -575,8 +572,7 @@ class Pair {
 void Pair::say(const std::string& line, bool terminal) {
   appendText(m_out / "pair.log", "[" + nowUtc() + "] " + line + "\n");
   if (terminal && !m_a.quiet) {
-    std::printf("pair: %s\n", line.c_str());
-    std::fflush(stdout);
+    std::fprintf(stderr, "pair: %s\n", line.c_str());
   }
 }
 
@@ -669,6 +665,9 @@ void Pair::emitSlurm() {
     << "#SBATCH --array=0-" << (m_runs.size() - 1) << "\n"
     << "#SBATCH --cpus-per-task=" << threads << "\n"
     << "#SBATCH --time=24:00:00\n"
+    << "# SIGTERM to the task 5 minutes before its time limit: the run stops with a checkpoint\n"
+    << "# (granagg md handles the signal), and resubmitting continues it from there.\n"
+    << "#SBATCH --signal=B:TERM@300\n"
     << "#SBATCH --output=" << (m_out / "logs").string() << "/slurm-%A_%a.out\n"
     << "set -euo pipefail\n"
     << "if [ -z \"${SLURM_JOB_ID:-}\" ]; then\n"
@@ -779,20 +778,30 @@ void Pair::runMd(std::vector<RunJob> all) {
   };
 
   while (!pending.empty() || !running.empty()) {
-    while (!g_interrupted && static_cast<int>(running.size()) < jobs && !pending.empty()) {
+    while (!*stopSignal() && static_cast<int>(running.size()) < jobs && !pending.empty()) {
       start(pending.front());
       pending.pop_front();
     }
     progress();
     int st = 0;
     const pid_t pid = ::waitpid(-1, &st, WNOHANG);
-    if (g_interrupted) {
+    if (*stopSignal()) {
+      // each run stops at the end of its chunk of steps with a checkpoint (granagg md handles
+      // the signal); the next pair resumes it from there (RunJob::restart)
+      const int sig = *stopSignal();
       for (auto& [p, r] : running) ::kill(p, SIGTERM);
-      for (auto& [p, r] : running) ::waitpid(p, nullptr, 0);
       if (tty) std::fprintf(stderr, "\n");
-      say("interrupted (signal " + std::to_string(g_interrupted) +
-          "): finished runs are kept; run the same command again to resume");
-      throw std::runtime_error("interrupted; run the same command again to resume");
+      for (auto& [p, r] : running) {
+        int child = 0;
+        while (::waitpid(p, &child, 0) < 0 && errno == EINTR) {
+        }
+        say("md " + kName(r.job.K) + " run " + std::to_string(r.job.r) + ": stopped (" +
+            lastLine(r.job.log) + ")");
+      }
+      say("interrupted (signal " + std::to_string(sig) +
+          "): finished runs are kept, stopped runs continue from their checkpoints; run the "
+          "same command again to resume");
+      throw Interrupted("pair: interrupted; run the same command again to resume", sig);
     }
     if (pid == 0 || (pid < 0 && errno == EINTR)) {
       ::usleep(200000);
@@ -864,11 +873,12 @@ int Pair::runStep(const std::string& label, std::vector<std::string> argv,
   int st = 0;
   while (::waitpid(pid, &st, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error("waitpid failed");
-    if (g_interrupted) {
+    if (*stopSignal()) {
       ::kill(pid, SIGTERM);
       ::waitpid(pid, nullptr, 0);
-      throw std::runtime_error("interrupted during " + label +
-                               "; run the same command again to resume");
+      throw Interrupted(
+          "pair: interrupted during " + label + "; run the same command again to resume",
+          *stopSignal());
     }
   }
   if (!m_a.quiet && ::isatty(2)) std::fprintf(stderr, "\r%100s\r", "");
@@ -1293,22 +1303,23 @@ std::string fmt(double v, int prec = 3) {
 void Pair::printSummary() {
   if (m_a.quiet) return;
   const common::PaperValues& paper = paperValues();
-  std::printf("pair: ---- summary (%s) ----\n", (m_out / "summary.json").c_str());
+  std::fprintf(stderr, "pair: ---- summary (%s) ----\n", (m_out / "summary.json").c_str());
   for (double K : m_c.K) {
     const KResult r = readK(m_out, K);
-    std::printf("pair: K = %-5s z = %s [%s, %s] (analyze, grid, t in [%s, %s])",
-                formatReal(K).c_str(), fmt(r.z).c_str(), fmt(r.z_low).c_str(),
-                fmt(r.z_high).c_str(), fmt(r.fit_t_min, 3).c_str(), fmt(r.fit_t_max, 3).c_str());
-    std::printf("   paper: %s +- %s%s\n",
-                formatReal(K == 0 ? paper.z_neutral : paper.z_charged).c_str(),
-                formatReal(K == 0 ? paper.z_neutral_pm : paper.z_charged_pm).c_str(),
-                K == 0 ? "" : " (K = 5)");
-    std::printf("pair:           regime: %s (%s)\n", r.regime.regime.c_str(),
-                r.regime.reason.c_str());
+    std::fprintf(stderr, "pair: K = %-5s z = %s [%s, %s] (analyze, grid, t in [%s, %s])",
+                 formatReal(K).c_str(), fmt(r.z).c_str(), fmt(r.z_low).c_str(),
+                 fmt(r.z_high).c_str(), fmt(r.fit_t_min, 3).c_str(), fmt(r.fit_t_max, 3).c_str());
+    std::fprintf(stderr, "   paper: %s +- %s%s\n",
+                 formatReal(K == 0 ? paper.z_neutral : paper.z_charged).c_str(),
+                 formatReal(K == 0 ? paper.z_neutral_pm : paper.z_charged_pm).c_str(),
+                 K == 0 ? "" : " (K = 5)");
+    std::fprintf(stderr, "pair:           regime: %s (%s)\n", r.regime.regime.c_str(),
+                 r.regime.reason.c_str());
     const std::string v = validationLine(K);
-    if (!v.empty()) std::printf("pair:           %s\n", v.c_str());
+    if (!v.empty()) std::fprintf(stderr, "pair:           %s\n", v.c_str());
     if (r.has_fit)
-      std::printf(
+      std::fprintf(
+          stderr,
           "pair:           fit-beta: z = %s [%s, %s], beta from z at the data's S %s, asymptotic "
           "beta %s, "
           "full-curve beta = %s\n",
@@ -1325,13 +1336,13 @@ void Pair::printSummary() {
               ? (fmt(r.bf, 2) + " [" + fmt(r.bf_low, 2) + ", " + fmt(r.bf_high, 2) + "]").c_str()
               : "not determined (at the bound of its range)");
     if (r.has_fit && !r.notes.empty())
-      std::printf("pair:           fit-beta note: %.200s%s\n", r.notes.c_str(),
-                  r.notes.size() > 200 ? "..." : "");
+      std::fprintf(stderr, "pair:           fit-beta note: %.200s%s\n", r.notes.c_str(),
+                   r.notes.size() > 200 ? "..." : "");
     if (!r.has_fit)
-      std::printf("pair:           fit-beta: %s\n",
-                  m_fit_note.count(kName(K)) ? m_fit_note.at(kName(K)).c_str()
-                  : m_status.count("fit")    ? m_status.at("fit").c_str()
-                                             : "not run");
+      std::fprintf(stderr, "pair:           fit-beta: %s\n",
+                   m_fit_note.count(kName(K)) ? m_fit_note.at(kName(K)).c_str()
+                   : m_status.count("fit")    ? m_status.at("fit").c_str()
+                                              : "not run");
   }
   for (double b : m_c.betas) {
     const fs::path csv = m_out / "meanfield" / ("S_beta" + formatReal(b) + ".csv");
@@ -1339,12 +1350,13 @@ void Pair::printSummary() {
     const std::string paper_z = b == 2   ? "   paper: " + formatReal(paper.z_meanfield_beta2)
                                 : b == 3 ? "   paper: " + formatReal(paper.z_meanfield_beta3)
                                          : "";
-    std::printf("pair: mean field beta = %s: z(S ~ %g) = %s, asymptotic 3 beta/(beta+3) = %s%s\n",
-                formatReal(b).c_str(), S_paper, fmt(localSlopeAt(csv, S_paper)).c_str(),
-                fmt(3 * b / (b + 3)).c_str(), paper_z.c_str());
+    std::fprintf(stderr,
+                 "pair: mean field beta = %s: z(S ~ %g) = %s, asymptotic 3 beta/(beta+3) = %s%s\n",
+                 formatReal(b).c_str(), S_paper, fmt(localSlopeAt(csv, S_paper)).c_str(),
+                 fmt(3 * b / (b + 3)).c_str(), paper_z.c_str());
   }
-  std::printf("pair: wrote %s (summary.json%s) in %.0f s\n", m_out.c_str(),
-              fs::exists(m_out / "report.html") ? ", report.html, figures/" : "", seconds());
+  std::fprintf(stderr, "pair: wrote %s (summary.json%s) in %.0f s\n", m_out.c_str(),
+               fs::exists(m_out / "report.html") ? ", report.html, figures/" : "", seconds());
 }
 
 void Pair::run() {
@@ -1412,7 +1424,6 @@ void Pair::run() {
   }
   writeSummary();
   printSummary();
-  std::fflush(stdout);
   if (m_failures > 0)
     throw std::runtime_error(std::to_string(m_failures) + " post-processing step(s) failed (see " +
                              (m_out / "pair.log").string() +
@@ -1436,11 +1447,7 @@ void runPair(const PairArgs& a, const CliContext& ctx, const CLI::App* root, boo
   bool fit = false;
   for (const CLI::App* sub : root->get_subcommands({})) fit |= sub->get_name() == "fit-beta";
   Pair pair(a, c, ctx, fit);
-  struct sigaction sa {};
-  sa.sa_handler = onSignal;
-  sigemptyset(&sa.sa_mask);
-  ::sigaction(SIGINT, &sa, nullptr);
-  ::sigaction(SIGTERM, &sa, nullptr);
+  catchStopSignals();  // forwarded to the runs, which stop with a checkpoint
   pair.run();
 }
 

@@ -167,7 +167,7 @@ void runSmol(const SmolArgs& a, const CliContext& ctx) {
   w.close();
 
   if (a.quiet) return;
-  std::FILE* info = a.out == "-" ? stderr : stdout;
+  std::FILE* info = stderr;  // the log; stdout carries only tables written to "-"
   std::fprintf(
       info,
       "smol: kernel %s%s, method %s: %zu samples to t = %.4g, S = %.6g (%.2f s, %ld steps, %ld "
@@ -214,7 +214,7 @@ void runZbeta(const ZbetaArgs& a, const CliContext& ctx) {
                       {"beta", "z_asymptotic", "z_scaling", "difference", "converged", "S_final",
                        "z_local_S250", "z_local_S2500"},
                       a.force);
-  std::FILE* info = a.out == "-" ? stderr : stdout;
+  std::FILE* info = stderr;  // the log; stdout carries only tables written to "-"
   // t_end from the scaling law S ~ t^z with a generous margin; s_end stops the solve.
   for (int i = 0; i < a.count; ++i) {
     const double beta =

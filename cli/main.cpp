@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "granagg: error: %s\n", e.what());
     return 2;
+  } catch (const cli::Interrupted& e) {
+    std::fprintf(stderr, "granagg: stopped: %s\n", e.what());
+    return e.status();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "granagg: failed: %s\n", e.what());
     return 1;

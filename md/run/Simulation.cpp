@@ -238,8 +238,9 @@ RunSummary Simulation::run() {
       for (auto& r : sim.m_impl->reporters) r->finish(sim);
     }
   } finish{*this};
+  const auto stopRequested = [&] { return d.options.stop != nullptr && *d.options.stop != 0; };
   try {
-    while (engine.step() < d.last) {
+    while (engine.step() < d.last && !stopRequested()) {
       std::int64_t target = std::min(d.last, (engine.step() / obs_every + 1) * obs_every);
       if (d.next_frame < d.frames.size()) target = std::min(target, d.frames[d.next_frame]);
       if (ck_every > 0) target = std::min(target, (engine.step() / ck_every + 1) * ck_every);
@@ -281,6 +282,7 @@ RunSummary Simulation::run() {
   s.steps = engine.step() - first_step;
   s.neighbor_builds = engine.neighborBuilds() - first_builds;
   s.slow_evaluations = engine.slowEvaluations() - first_slow;
+  s.stopped = engine.step() < d.last;
   d.checkpoint();
   d.writer->close();
   if (d.options.profile)

@@ -15,6 +15,7 @@
 ///
 /// Determinism: a run resumed from any of its checkpoints writes the same frames, observables and
 /// final state, to the bit, as the uninterrupted run (same build; any thread count).
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -52,6 +53,9 @@ struct RunOptions {
   std::string command_line;  ///< provenance: stored in /parameters of a new trajectory
   bool overwrite = false;    ///< start(): replace the files of a non-empty output folder
   bool profile = false;      ///< time the loop by phase and write profile.csv (no result changes)
+  /// When it points at a nonzero value (a signal handler sets it), run() stops after the chunk of
+  /// steps in progress, writes a checkpoint and returns with RunSummary::stopped.
+  const volatile std::sig_atomic_t* stop = nullptr;
 };
 
 /// What run() did, for the log.
@@ -60,6 +64,7 @@ struct RunSummary {
   double loop_seconds = 0.0;          ///< wall time of the loop, output included
   std::int64_t neighbor_builds = 0;   ///< contact-list builds in this run()
   std::int64_t slow_evaluations = 0;  ///< evaluations of the slow Coulomb part in this run()
+  bool stopped = false;  ///< ended early by RunOptions::stop (checkpoint written; resume() goes on)
 };
 
 class Simulation {
@@ -86,7 +91,8 @@ class Simulation {
   void addReporter(std::shared_ptr<Reporter> reporter);
 
   /// Runs to run.t_end: advances the engine in chunks, writes observables, frames and
-  /// checkpoints on their schedule and a final checkpoint, and closes the trajectory. Throws
+  /// checkpoints on their schedule and a final checkpoint, and closes the trajectory. With
+  /// RunOptions::stop set it ends early the same way, at the end of a chunk. Throws
   /// RunAborted when the engine stops (NaN, deep overlap); the message then says where the
   /// trajectory ends and which checkpoint is the last good state.
   RunSummary run();

@@ -107,6 +107,69 @@ TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   fs::remove_all(dir);
 }
 
+TEST_CASE("md and analyze log on stderr and leave stdout empty", "[cli][md][log]") {
+  // A log redirected to a file (`granagg md ... > run.log 2>&1 &`) must show progress as it
+  // happens: stderr is unbuffered, stdout is block-buffered when redirected.
+  const fs::path dir = tempDir("log");
+  const std::string cfg = writeConfig(dir, SMALL);
+  const std::string md = std::string(GRANAGG_BINARY) + " md --config " + cfg +
+                         " --set run.t_end=0.2 --out " + (dir / "o").string() + " --force";
+  const Run out = sh("{ " + md + " 2>/dev/null; }");  // stdout alone
+  CHECK(out.status == 0);
+  CHECK(out.output.empty());
+  const Run err = sh("{ " + md + " >/dev/null; }");  // stderr alone
+  CHECK(err.status == 0);
+  CHECK_THAT(err.output, Catch::Contains("md: N = 300") && Catch::Contains("md: wrote"));
+  const std::string an = std::string(GRANAGG_BINARY) + " analyze " + (dir / "o").string() +
+                         " --out " + (dir / "a").string() + " --force";
+  const Run a_out = sh("{ " + an + " 2>/dev/null; }");
+  CHECK(a_out.status == 0);
+  CHECK(a_out.output.empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE(
+    "md stops cleanly on SIGTERM with a checkpoint, and the restart ends where an "
+    "uninterrupted run ends",
+    "[cli][md][signal]") {
+  const fs::path dir = tempDir("sigterm");
+  // a charged gas (PPPM, the slow interval following the gas, charge exchange) long enough to be
+  // caught mid-run: about 3000 steps of N = 300, a few seconds
+  const std::string cfg =
+      writeConfig(dir, std::string(SMALL) +
+                           "[charging]\nmode = \"exchange\"\nQ = 0.1\n[coulomb]\nK = 1.0\n"
+                           "[output]\ncheckpoint_wall_seconds = 0.0\n");
+  const std::string t_end = " --set run.t_end=10";
+  REQUIRE(
+      runGranagg("md --config " + cfg + t_end + " --out " + (dir / "a").string() + " -q").status ==
+      0);
+  // SIGTERM once the run is under way (its trajectory exists), then wait for it
+  const std::string b = (dir / "b").string();
+  const Run r = sh(std::string(GRANAGG_BINARY) + " md --config " + cfg + t_end + " --out " + b +
+                   " -q > " + b +
+                   ".log 2>&1 & pid=$!; "
+                   "while [ ! -f " +
+                   b +
+                   "/traj.h5 ]; do sleep 0.05; done; sleep 0.3; "
+                   "kill -TERM $pid; wait $pid; echo \"status=$?\"; cat " +
+                   b + ".log");
+  INFO(r.output);
+  CHECK_THAT(r.output, Catch::Contains("status=143"));  // 128 + SIGTERM, distinct from 0/1/2
+  CHECK_THAT(r.output,
+             Catch::Contains("SIGTERM at step") && Catch::Contains("granagg md --restart " + b));
+  REQUIRE(fs::exists(dir / "b" / "checkpoint.h5"));
+  const Run resumed = runGranagg("md --restart " + b + " -q");
+  INFO(resumed.output);
+  REQUIRE(resumed.status == 0);
+  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()), rb(b + "/traj.h5");
+  const auto fa = ra.readFrame(ra.frames() - 1), fb = rb.readFrame(rb.frames() - 1);
+  CHECK(fa.step == fb.step);
+  CHECK(granagg::test::sameBits(fa.x, fb.x));
+  CHECK(granagg::test::sameBits(fa.vz, fb.vz));
+  CHECK(granagg::test::sameBits(fa.charge, fb.charge));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("md stops at a deep overlap naming step and particles and keeps the last checkpoint",
           "[cli][md]") {
   const fs::path dir = tempDir("abort");
