@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -15,8 +17,7 @@
 #include "md/coulomb/RealSpace.h"
 #include "md/engine/Launch.h"
 #include "md/integrate/VelocityVerlet.h"
-#include "md/potentials/HertzViscoelastic.h"
-#include "md/potentials/SpringDashpot.h"
+#include "md/potentials/ContactModels.h"
 
 namespace granagg::md {
 
@@ -430,49 +431,50 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
       w.pair_next.assign(nl.pairCount(), -std::numeric_limits<double>::infinity());
     w.next_bound = bound >= 0.0 ? bound : -1.0;
   }
-  ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING, ADVANCE> f{
-      raw(p.pos),
-      raw(p.vel),
-      raw(p.force),
-      nl.rows(),
-      nl.counts(),
-      nl.capacity(),
-      paired ? nl.pairOffsets() : nullptr,
-      paired ? nl.pairOwners() : nullptr,
-      paired ? nl.pairPartners() : nullptr,
-      paired ? nl.entryOffsets() : nullptr,
-      paired ? nl.entryOwners() : nullptr,
-      paired ? nl.entryPairs() : nullptr,
-      paired ? nl.pairEntries() : nullptr,
-      box,
-      params,
-      half_dt,
-      dt,
-      raw(w.f),
-      raw(p.id),
-      st.charging,
-      st.step,
-      st.dq,
-      st.ext_fx,
-      st.ext_fy,
-      st.ext_fz,
-      st.ext_force_scale,
-      st.ext_predict_scale,
-      st.coulomb_K,
-      st.fast.r2 * st.fast.r2,
-      st.fast_table,
-      raw(w.pos),
-      raw(w.vel),
-      raw(p.ix),
-      raw(p.iy),
-      raw(p.iz),
-      st.advance_dt,
-      raw(w.pair_hit),
-      raw(w.entry_hit),
-      raw(w.pair_f),
-      raw(w.pair_dq),
-      raw(w.pair_next),
-      st.displacement_bound >= 0.0 ? st.displacement_bound : 0.0};
+  // filled by name (a positional list of 42 values let a swap of two pointers compile)
+  ContactForceFunctor<Potential, EXT, FAST_COULOMB, CHARGING, ADVANCE> f{};
+  f.pos = raw(p.pos);
+  f.vel = raw(p.vel);
+  f.f_old = raw(p.force);
+  f.rows = nl.rows();
+  f.counts = nl.counts();
+  f.cap = nl.capacity();
+  f.pair_offsets = paired ? nl.pairOffsets() : nullptr;
+  f.pair_owners = paired ? nl.pairOwners() : nullptr;
+  f.pair_partners = paired ? nl.pairPartners() : nullptr;
+  f.entry_offsets = paired ? nl.entryOffsets() : nullptr;
+  f.entry_owners = paired ? nl.entryOwners() : nullptr;
+  f.entry_pairs = paired ? nl.entryPairs() : nullptr;
+  f.pair_entries = paired ? nl.pairEntries() : nullptr;
+  f.box = box;
+  f.params = params;
+  f.h_pred = half_dt;
+  f.dt_prev = dt;
+  f.f_new = raw(w.f);
+  f.id = raw(p.id);
+  f.charging = st.charging;
+  f.step = st.step;
+  f.dq = st.dq;
+  f.ext_fx = st.ext_fx;
+  f.ext_fy = st.ext_fy;
+  f.ext_fz = st.ext_fz;
+  f.ext_force_scale = st.ext_force_scale;
+  f.ext_predict_scale = st.ext_predict_scale;
+  f.K = st.coulomb_K;
+  f.fast_r2sq = st.fast.r2 * st.fast.r2;
+  f.fast_table = st.fast_table;
+  f.next_pos = raw(w.pos);
+  f.next_vel = raw(w.vel);
+  f.ix = raw(p.ix);
+  f.iy = raw(p.iy);
+  f.iz = raw(p.iz);
+  f.advance_dt = st.advance_dt;
+  f.pair_hit = raw(w.pair_hit);
+  f.entry_hit = raw(w.entry_hit);
+  f.pair_f = raw(w.pair_f);
+  f.pair_dq = raw(w.pair_dq);
+  f.pair_next = raw(w.pair_next);
+  f.bound = st.displacement_bound >= 0.0 ? st.displacement_bound : 0.0;
   // forces and, per block, collisions, probe sum and largest overlap; then one reduction over
   // blocks
   const int block = blockSizeFor(N);
@@ -501,10 +503,10 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
 }
 
 template <class Potential>
-ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl,
-                                       const common::Box& box,
-                                       const typename Potential::Params& params,
-                                       const ContactStep& st, ContactWork& w) {
+ContactStepResult computeContactForcesOf(ParticleData& p, const NeighborList& nl,
+                                         const common::Box& box,
+                                         const typename Potential::Params& params,
+                                         const ContactStep& st, ContactWork& w) {
   const bool fast = st.fast.r2 > 0.0;
   if (fast && (nl.listRange() < st.fast.r2 || !st.fast_table.data))
     throw std::logic_error("neighbour list range below the fast Coulomb range");
@@ -529,8 +531,8 @@ ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl,
 }
 
 template <class Potential>
-ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                              const typename Potential::Params& params) {
+ContactSummary contactSummaryOf(const ParticleData& p, const NeighborList& nl,
+                                const common::Box& box, const typename Potential::Params& params) {
   const int N = static_cast<int>(p.size());
   SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
   DVec<ContactSummary> per_slot(p.size());
@@ -540,8 +542,8 @@ ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, con
 }
 
 template <class Potential>
-void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                           const typename Potential::Params& params, DVec<double>& out) {
+void maxOverlapPerParticleOf(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                             const typename Potential::Params& params, DVec<double>& out) {
   const int N = static_cast<int>(p.size());
   out.resize(p.size());
   SummaryFunctor<Potential> s{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, params};
@@ -549,17 +551,37 @@ void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const 
                     out.begin(), MaxOverlapOf<Potential>{s});
 }
 
-// the contact models: adding one = one header + one line per function here
-#define GRANAGG_CONTACT_MODEL(P)                                                           \
-  template ContactStepResult computeContactForces<P>(ParticleData&, const NeighborList&,   \
-                                                     const common::Box&, const P::Params&, \
-                                                     const ContactStep&, ContactWork&);    \
-  template ContactSummary contactSummary<P>(const ParticleData&, const NeighborList&,      \
-                                            const common::Box&, const P::Params&);         \
-  template void maxOverlapPerParticle<P>(const ParticleData&, const NeighborList&,         \
-                                         const common::Box&, const P::Params&, DVec<double>&);
-GRANAGG_CONTACT_MODEL(HertzViscoelastic)
-GRANAGG_CONTACT_MODEL(SpringDashpot)
-#undef GRANAGG_CONTACT_MODEL
+// The public entry points dispatch on the model (ContactModels.h); std::visit instantiates the
+// passes for every model in the list.
+ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl,
+                                       const common::Box& box, const ContactModel& model,
+                                       const ContactStep& st, ContactWork& w) {
+  return std::visit(
+      [&](const auto& c) {
+        using Model = typename std::decay_t<decltype(c)>::Model;
+        return computeContactForcesOf<Model>(p, nl, box, c.params, st, w);
+      },
+      model);
+}
+
+ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                              const ContactModel& model) {
+  return std::visit(
+      [&](const auto& c) {
+        using Model = typename std::decay_t<decltype(c)>::Model;
+        return contactSummaryOf<Model>(p, nl, box, c.params);
+      },
+      model);
+}
+
+void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                           const ContactModel& model, DVec<double>& out) {
+  std::visit(
+      [&](const auto& c) {
+        using Model = typename std::decay_t<decltype(c)>::Model;
+        maxOverlapPerParticleOf<Model>(p, nl, box, c.params, out);
+      },
+      model);
+}
 
 }  // namespace granagg::md

@@ -41,6 +41,7 @@
 #include "md/engine/ParticleData.h"
 #include "md/neighbor/NeighborList.h"
 #include "md/potentials/ChargeExchange.h"
+#include "md/potentials/ContactModels.h"
 
 namespace granagg::md {
 
@@ -132,10 +133,8 @@ bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step);
 
 /// Contact forces of the current positions into p.force (state as described above),
 /// collisions, and with charging the charge each particle gains at its new contacts.
-template <class Potential>
 ContactStepResult computeContactForces(ParticleData& p, const NeighborList& nl,
-                                       const common::Box& box,
-                                       const typename Potential::Params& params,
+                                       const common::Box& box, const ContactModel& model,
                                        const ContactStep& step, ContactWork& work);
 
 /// Contact statistics of the current positions (positions only: no velocities needed).
@@ -145,12 +144,10 @@ struct ContactSummary {
   double max_overlap = 0.0;
   std::int64_t contacts = 0;  ///< sum over particles of partners in contact (2 x pairs)
 };
-template <class Potential>
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                              const typename Potential::Params& params);
+                              const ContactModel& model);
 /// Largest overlap of each particle (storage order), for error messages.
-template <class Potential>
 void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const common::Box& box,
-                           const typename Potential::Params& params, DVec<double>& out);
+                           const ContactModel& model, DVec<double>& out);
 
 }  // namespace granagg::md

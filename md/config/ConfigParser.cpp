@@ -20,6 +20,7 @@
 #include <variant>
 
 #include "common/Csv.h"
+#include "md/potentials/ContactModels.h"
 
 namespace granagg::md {
 namespace {
@@ -531,9 +532,9 @@ void validateConfig(const MdConfig& c) {
     invalid("system.initial", quote(s.initial), "be \"random\" or a file path");
 
   const ContactConfig& k = c.contact;
-  if (k.model != "hertz" && k.model != "spring_dashpot")
+  if (!isContactModel(k.model))
     invalid("contact.model", quote(k.model),
-            "be one of \"hertz\", \"spring_dashpot\" (unknown contact model)");
+            "be one of " + contactModelNames() + " (unknown contact model)");
   if (!(k.E >= 0.0 && finite(k.E))) invalid("contact.E", formatReal(k.E), "be >= 0 and finite");
   if (!(k.D >= 0.0 && finite(k.D))) invalid("contact.D", formatReal(k.D), "be >= 0 and finite");
   if (!(k.stiffness > 0.0 && finite(k.stiffness)))

@@ -5,7 +5,9 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
+#include <variant>
 
 #include <thrust/copy.h>
 #include <thrust/execution_policy.h>
@@ -37,8 +39,7 @@
 #include "md/engine/PhaseTimer.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/neighbor/NeighborList.h"
-#include "md/potentials/HertzViscoelastic.h"
-#include "md/potentials/SpringDashpot.h"
+#include "md/potentials/ContactModels.h"
 #include "md/rng/RngStreams.h"
 
 namespace granagg::md {
@@ -204,10 +205,8 @@ struct Engine::Impl {
   DVec<double> ext_fx, ext_fy, ext_fz;  // the Coulomb force at the last evaluation, per slot
   double coulomb_ext_energy = 0.0;      // pppm: mesh + self + background; ewald: everything
   std::int64_t kspace_step = -1;        // step of the last Coulomb evaluation (-1: none yet)
-  bool hertz = true;
-  HertzViscoelastic::Params hertz_params{};
-  SpringDashpot::Params sd_params{};
-  PhaseTimer timer;  // Engine::enableProfile
+  ContactModel contact;  // the contact model and its parameters (md/potentials/ContactModels.h)
+  PhaseTimer timer;      // Engine::enableProfile
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
     nl.keepPairs(
@@ -494,9 +493,7 @@ struct Engine::Impl {
     st.displacement_bound = drift_since_build;
     if (advance) st.advance_dt = dt;
     PhaseTimer::Scope phase(&timer, PhaseTimer::ContactPass);
-    const ContactStepResult r =
-        hertz ? computeContactForces<HertzViscoelastic>(p, nl, box, hertz_params, st, work)
-              : computeContactForces<SpringDashpot>(p, nl, box, sd_params, st, work);
+    const ContactStepResult r = computeContactForces(p, nl, box, contact, st, work);
     if (r.worst != 0) abort(r.worst);
     collisions += r.collisions;
     if (advance) driftTaken(r.max_u2);
@@ -526,10 +523,7 @@ struct Engine::Impl {
     close_pending = false;
   }
 
-  ContactSummary summary() const {
-    return hertz ? contactSummary<HertzViscoelastic>(p, nl, box, hertz_params)
-                 : contactSummary<SpringDashpot>(p, nl, box, sd_params);
-  }
+  ContactSummary summary() const { return contactSummary(p, nl, box, contact); }
 
   /// Velocity offset of the impulse integrator against the smooth trajectory, per unit Coulomb
   /// force: (k/2 - j) dt at j = 1..k-1 steps after an evaluation, 0 at the evaluation step itself
@@ -578,10 +572,7 @@ struct Engine::Impl {
 
   [[noreturn]] void abort(int worst) {
     DVec<double> mx_slots;
-    if (hertz)
-      maxOverlapPerParticle<HertzViscoelastic>(p, nl, box, hertz_params, mx_slots);
-    else
-      maxOverlapPerParticle<SpringDashpot>(p, nl, box, sd_params, mx_slots);
+    maxOverlapPerParticle(p, nl, box, contact, mx_slots);
     const auto mx = toHostById(mx_slots, p.id);
     // which particles: the force pass's test again, per particle (cold path)
     const auto pos = toHostById(p.pos, p.id);
@@ -607,10 +598,11 @@ struct Engine::Impl {
         ++shown;
       }
     msg << "; the time step dt = " << dt << " may be too large for these impacts";
+    const auto* hertz = std::get_if<Contact<HertzViscoelastic>>(&contact);
     if (coulomb && hertz && worst == 2) {
       // An attractive pair has an equilibrium overlap only if K |q_i q_j| / (1 - xi)^2 = E xi^{3/2}
       // has a root: max over xi of E xi^{3/2} (1 - xi)^2 is 0.0916 E (at xi = 3/7).
-      const double hold = 0.0916 * hertz_params.E;
+      const double hold = 0.0916 * hertz->params.E;
       double worst_qq = 0.0;
       for (std::size_t i = 0; i < bad.size(); ++i)
         if (bad[i] == 2) worst_qq = std::max(worst_qq, pos[i].w * pos[i].w);
@@ -672,21 +664,14 @@ double Engine::chooseTimeStep(const MdConfig& c, std::string* reason) {
     return c.integrator.dt;
   }
   std::ostringstream why;
-  double tc;
-  if (c.contact.model == "spring_dashpot") {
-    const auto sp = SpringDashpot::makeParams(c.contact.stiffness, c.contact.restitution,
-                                              c.contact.clamp, M_EFF);
-    tc = SpringDashpot::contactTime(sp, M_EFF);
-    why << "spring-dashpot contact time " << tc;
-  } else {
-    const double v = impactSpeedMax(c);
-    if (!(c.contact.E > 0.0))
-      throw std::invalid_argument(
-          "integrator.dt = \"auto\" needs contact.E > 0 (the Hertz contact time is infinite for E "
-          "= 0); give integrator.dt explicitly.");
-    tc = HertzViscoelastic::contactTime(v, {c.contact.E, c.contact.D, c.contact.clamp}, M_EFF);
-    why << "elastic Hertz contact time " << tc << " at impact speed " << v;
-  }
+  std::string model_why;
+  const double tc = std::visit(
+      [&](const auto& m) {
+        using Model = typename std::decay_t<decltype(m)>::Model;
+        return Model::autoContactTime(m.params, impactSpeedMax(c), M_EFF, model_why);
+      },
+      makeContactModel(c.contact, M_EFF));
+  why << model_why;
   const double dt = tc / c.integrator.steps_per_contact;
   why << " / " << c.integrator.steps_per_contact << " steps per contact";
   if (reason) *reason = "auto: " + why.str();
@@ -715,11 +700,7 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
   if (!(init.box > 0.0) || !std::isfinite(init.box))
     throw std::invalid_argument("initial state: box edge must be positive.");
   d.box.L = init.box;
-  d.hertz = config.contact.model != "spring_dashpot";
-  d.hertz_params = {config.contact.E, config.contact.D, config.contact.clamp};
-  if (!d.hertz)
-    d.sd_params = SpringDashpot::makeParams(config.contact.stiffness, config.contact.restitution,
-                                            config.contact.clamp, M_EFF);
+  d.contact = makeContactModel(config.contact, M_EFF);
   d.dt = chooseTimeStep(config);
   d.every = d.every_prev = d.every_base = d.every_cap = coulombEvery(config, d.dt);
   if (d.every_base > 1) {

@@ -11,8 +11,12 @@
 /// Granular Dynamics; LAMMPS limit_damping). Restitution at impact speed 0.05: 0.506 clamped,
 /// 0.469 unclamped.
 #include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "common/HostDevice.h"
+#include "md/config/MdConfig.h"
 
 namespace granagg::md {
 
@@ -39,6 +43,24 @@ struct HertzViscoelastic {
   /// design.md section 2). Longer for slower impacts and with damping.
   static double contactTime(double v, const Params& p, double m_eff = 0.5) {
     return 3.218065 * std::pow(m_eff * m_eff / (p.E * p.E * v), 0.2);
+  }
+
+  // the model's hooks for the engine (md/potentials/ContactModels.h)
+  /// contact.E, contact.D, contact.clamp
+  static Params fromConfig(const ContactConfig& c, double /*m_eff*/) { return {c.E, c.D, c.clamp}; }
+  /// The contact time that sets the automatic dt: the elastic one at the fastest impact speed;
+  /// `why` says so.
+  static double autoContactTime(const Params& p, double impact_speed, double m_eff,
+                                std::string& why) {
+    if (!(p.E > 0.0))
+      throw std::invalid_argument(
+          "integrator.dt = \"auto\" needs contact.E > 0 (the Hertz contact time is infinite for "
+          "E = 0); give integrator.dt explicitly.");
+    const double tc = contactTime(impact_speed, p, m_eff);
+    std::ostringstream s;
+    s << "elastic Hertz contact time " << tc << " at impact speed " << impact_speed;
+    why = s.str();
+    return tc;
   }
 };
 

@@ -11,9 +11,12 @@
 /// (e.g. Schaefer, Dippel & Wolf, J. Phys. I France 6, 5 (1996)). Contact time pi / omega. With
 /// `clamp` the force is cut at zero and the rebound is slightly more elastic than epsilon.
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "common/HostDevice.h"
+#include "md/config/MdConfig.h"
 
 namespace granagg::md {
 
@@ -45,6 +48,21 @@ struct SpringDashpot {
   static double contactTime(const Params& p, double m_eff = 0.5) {
     const double zeta = p.gamma / (2.0 * m_eff);
     return M_PI / std::sqrt(p.k / m_eff - zeta * zeta);
+  }
+
+  // the model's hooks for the engine (md/potentials/ContactModels.h)
+  /// contact.stiffness, contact.restitution, contact.clamp
+  static Params fromConfig(const ContactConfig& c, double m_eff) {
+    return makeParams(c.stiffness, c.restitution, c.clamp, m_eff);
+  }
+  /// The contact time that sets the automatic dt: pi / omega, whatever the impact speed.
+  static double autoContactTime(const Params& p, double /*impact_speed*/, double m_eff,
+                                std::string& why) {
+    const double tc = contactTime(p, m_eff);
+    std::ostringstream s;
+    s << "spring-dashpot contact time " << tc;
+    why = s.str();
+    return tc;
   }
 };
 

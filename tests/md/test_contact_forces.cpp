@@ -2,6 +2,8 @@
 // launcher against a brute-force O(N^2) host loop calling the same functions.
 #include <catch2/catch.hpp>
 
+#include <variant>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -12,6 +14,7 @@
 #include "md/compute/ContactForce.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/neighbor/NeighborList.h"
+#include "md/potentials/ContactModels.h"
 #include "md/potentials/HertzViscoelastic.h"
 #include "md/potentials/SpringDashpot.h"
 
@@ -49,6 +52,9 @@ TEST_CASE("contact potentials: force is -dV/dxi, clamping, spring-dashpot restit
 }
 
 namespace {
+ContactModel hertzModel(const HertzViscoelastic::Params& p) {
+  return Contact<HertzViscoelastic>{p};
+}
 ParticleData makeParticles(const std::vector<double>& pos, const std::vector<double>& vel) {
   const std::size_t n = pos.size() / 3;
   ParticleData p;
@@ -119,7 +125,7 @@ void compareWithBruteForce(const std::vector<double>& pos, const std::vector<dou
   ContactStep st;
   st.dt = 0.0;
   st.max_overlap = 1.0;
-  const auto flags = computeContactForces<HertzViscoelastic>(p, nl, box, prm, st, w);
+  const auto flags = computeContactForces(p, nl, box, hertzModel(prm), st, w);
   CHECK(flags.worst == 0);
   std::vector<double> ref;
   int pairs;
@@ -225,7 +231,7 @@ TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and
     st.charging.seed = 99;
     st.dq = raw(dq);
     ContactWork w;
-    const ContactStepResult r = computeContactForces<HertzViscoelastic>(p, nl, box, prm, st, w);
+    const ContactStepResult r = computeContactForces(p, nl, box, hertzModel(prm), st, w);
     REQUIRE(r.worst == 0);
     collisions[paired] = r.collisions;
     DVec<double> fx, fy, fz;
@@ -276,7 +282,7 @@ TEST_CASE(
     st.displacement_bound = 0.0;
     if (shape == 2) st.advance_dt = st.dt;
     const std::vector<Scalar4> before(p.pos.begin(), p.pos.end());
-    const ContactStepResult r = computeContactForces<HertzViscoelastic>(p, nl, box, prm, st, w);
+    const ContactStepResult r = computeContactForces(p, nl, box, hertzModel(prm), st, w);
     CHECK(r.worst == 1);
     const std::vector<Scalar4> after(p.pos.begin(), p.pos.end());
     bool unchanged = true;
@@ -330,10 +336,10 @@ TEST_CASE("pairs screened only once the displacement bound allows a contact: no 
     st.max_overlap = 2.0;  // free flight overlaps deeply
     st.displacement_bound = bound;
     const ContactStepResult a =
-        computeContactForces<HertzViscoelastic>(screened, nl, box, prm, st, w_screened);
+        computeContactForces(screened, nl, box, hertzModel(prm), st, w_screened);
     st.displacement_bound = -1.0;
     const ContactStepResult b =
-        computeContactForces<HertzViscoelastic>(every, nl, box, prm, st, w_every);
+        computeContactForces(every, nl, box, hertzModel(prm), st, w_every);
     REQUIRE(a.worst == 0);
     REQUIRE(a.collisions == b.collisions);
     const std::vector<Vec3> fa(screened.force.begin(), screened.force.end()),
@@ -527,4 +533,26 @@ TEST_CASE("neighbour rows hold exactly the pairs within range across capacity sh
     for (int c = 0; c < 3; ++c) full.push_back(5.0 + ((k >> c) & 1 ? 1.155 : -1.155));
   check(full);
   CHECK(nl.capacity() == cap);  // the row fitted exactly: no growth
+}
+
+TEST_CASE("contact.model selects a model from the one list, by its name", "[md][contact]") {
+  CHECK(contactModelNames() == "\"hertz\", \"spring_dashpot\"");
+  CHECK(isContactModel("hertz"));
+  CHECK_FALSE(isContactModel("Hertz"));
+  ContactConfig c;
+  c.E = 100.0;
+  c.D = 2.0;
+  const ContactModel h = makeContactModel(c, 0.5);
+  REQUIRE(std::holds_alternative<Contact<HertzViscoelastic>>(h));
+  CHECK(std::get<Contact<HertzViscoelastic>>(h).params.E == 100.0);
+  c.model = "spring_dashpot";
+  c.stiffness = 1e4;
+  c.restitution = 0.9;
+  const ContactModel s = makeContactModel(c, 0.5);
+  REQUIRE(std::holds_alternative<Contact<SpringDashpot>>(s));
+  const auto& sd = std::get<Contact<SpringDashpot>>(s).params;
+  CHECK(sd.k == 1e4);  // and the damping that gives restitution 0.9 (tested above)
+  CHECK(sd.gamma == SpringDashpot::makeParams(1e4, 0.9, true, 0.5).gamma);
+  c.model = "jkr";
+  CHECK_THROWS_WITH(makeContactModel(c, 0.5), Catch::Contains("jkr"));
 }
