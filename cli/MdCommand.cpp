@@ -165,6 +165,11 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   options.stop = stopSignal();
   std::optional<md::Simulation> sim;
   if (!a.restart.empty()) {
+    if (!a.out.empty())
+      throw std::invalid_argument(
+          "--out cannot be combined with --restart: the run continues in "
+          "its own folder " +
+          a.restart);
     if (!a.config.empty() || !a.preset.empty() || a.seed >= 0)
       throw std::invalid_argument(
           "--restart continues a run with its own configuration: do not "

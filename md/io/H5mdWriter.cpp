@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <exception>
 #include <fstream>
 #include <set>
@@ -467,6 +468,28 @@ H5mdWriter& H5mdWriter::operator=(H5mdWriter&& o) noexcept {
     m_impl = std::move(o.m_impl);
   }
   return *this;
+}
+
+void H5mdWriter::recordRestart(std::int64_t step, double time, double t_end,
+                               const std::string& command, const std::string& version) {
+  Impl& m = *m_impl;
+  m.requireOpen();
+  const std::string ctx = "H5mdWriter ('" + m.path + "'): restart record";
+  const hid_t file = m.file.get();
+  if (!h5::exists(file, "/granagg/restarts")) h5::createGroup(file, "/granagg/restarts", ctx);
+  const h5::Handle all = h5::check(H5Gopen2(file, "/granagg/restarts", H5P_DEFAULT), ctx);
+  const std::string name = std::to_string(h5::children(all.get()).size());
+  const h5::Handle g = h5::createGroup(all.get(), name, ctx);
+  h5::writeAttribute(g.get(), "step", step, ctx);
+  h5::writeAttribute(g.get(), "time", time, ctx);
+  h5::writeAttribute(g.get(), "t_end", t_end, ctx);
+  h5::writeStringAttribute(g.get(), "command", command, ctx);
+  h5::writeStringAttribute(g.get(), "version", version, ctx);
+  char utc[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(utc, sizeof utc, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  h5::writeStringAttribute(g.get(), "utc", utc, ctx);
+  m.flushFile();
 }
 
 void H5mdWriter::writeFrame(const Frame& f) {

@@ -26,6 +26,8 @@
 ///     /parameters                    +-- one string attribute per resolved parameter
 ///         config_toml                    string: TOML text of the resolved configuration
 ///     /granagg/observables/<name>/{value double[S], step int64[S], time double[S]}
+///     /granagg/restarts/<k>      +-- step, time, t_end, command, version, utc: the k-th
+///                                    continuation of the run (k = 0, 1, ...; recordRestart)
 ///
 /// All `step` and `time` datasets under /particles/all are HDF5 hard links to
 /// position/step and position/time (H5MD allows shared step/time), so every element is sampled
@@ -108,6 +110,12 @@ class H5mdWriter {
   /// few steps is cheap. Steps must increase strictly.
   void writeObservables(std::int64_t step, double time,
                         const std::vector<std::pair<std::string, double>>& values);
+
+  /// Records that the run was continued from `step` (time `time`) to `t_end` by `command` with
+  /// granagg `version`, at the current UTC time, as the next group /granagg/restarts/<k>
+  /// (/parameters keeps describing the run as it was started).
+  void recordRestart(std::int64_t step, double time, double t_end, const std::string& command,
+                     const std::string& version);
 
   /// Writes buffered observables, flushes HDF5's caches to disk and refreshes the XDMF sidecar.
   /// Call it before writing a checkpoint so trajectory and checkpoint agree.

@@ -211,10 +211,19 @@ Simulation Simulation::resume(const fs::path& out, const std::vector<std::string
   d->cfg = parseConfigString(ck.extra.config_toml, cpath.string() + ":/config_toml", overrides);
   validateConfig(d->cfg);
   d->setUp(std::make_unique<Engine>(d->cfg, ck));
-  d->last_checkpoint_step = d->engine->step();
+  const Engine& e = *d->engine;
+  if (d->last < e.step())  // (equal: a finished run; run() has nothing to do)
+    throw std::invalid_argument(
+        "run.t_end = " + common::formatReal(d->cfg.run.t_end) + " lies before the checkpoint in " +
+        out.string() + " (t = " + common::formatReal(e.time()) + ", step " +
+        std::to_string(e.step()) + "): give a later --set run.t_end=... to run further");
+  d->last_checkpoint_step = e.step();
   d->writer = std::make_unique<H5mdWriter>(
-      H5mdWriter::reopen(d->trajectory().string(), d->engine->size(), d->engine->step(),
+      H5mdWriter::reopen(d->trajectory().string(), e.size(), e.step(),
                          d->cfg.output.write_velocities, d->cfg.output.write_forces));
+  if (d->last > e.step())  // the run's history: who continued it from where, to where
+    d->writer->recordRestart(e.step(), e.time(), d->cfg.run.t_end, options.command_line,
+                             common::versionString());
   return Simulation(std::move(d));
 }
 

@@ -77,9 +77,11 @@ class Simulation {
   static Simulation start(const MdConfig& config, const std::filesystem::path& out,
                           const RunOptions& options);
   /// Continues the run in `out` from its checkpoint.h5, with the configuration stored there.
-  /// `overrides` ("key=value", as --set) may only set run.t_end, to run further. Throws
-  /// std::invalid_argument for another key, a bad value or a missing checkpoint, and
-  /// std::runtime_error for an unreadable one.
+  /// `overrides` ("key=value", as --set) may only set run.t_end, to run further; the trajectory
+  /// then records the continuation (/granagg/restarts, H5mdWriter::recordRestart). Throws
+  /// std::invalid_argument, before writing anything, for another key, a bad value, a run.t_end
+  /// before the checkpoint or a missing checkpoint, and std::runtime_error for an unreadable one.
+  /// A run already at its run.t_end resumes with nothing to do.
   static Simulation resume(const std::filesystem::path& out,
                            const std::vector<std::string>& overrides, const RunOptions& options);
 

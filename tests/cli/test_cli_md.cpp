@@ -104,6 +104,11 @@ TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   CHECK(fa.vz == fb.vz);
   CHECK(fa.ix == fb.ix);
   CHECK(runGranagg("md --restart " + (dir / "b").string() + " --set system.N=5 -q").status == 2);
+  const Run out = runGranagg("md --restart " + (dir / "b").string() + " --out " +
+                             (dir / "c").string() + " -q");
+  CHECK(out.status == 2);  // the run continues in its own folder: --out would be ignored
+  CHECK_THAT(out.output, Catch::Contains("--out cannot be combined with --restart"));
+  CHECK_FALSE(fs::exists(dir / "c"));
   fs::remove_all(dir);
 }
 

@@ -12,6 +12,7 @@
 
 #include "md/config/MdConfig.h"
 #include "md/io/H5mdReader.h"
+#include "md/io/Hdf5Util.h"
 #include "md/run/Simulation.h"
 
 #include "TestUtil.h"
@@ -106,12 +107,34 @@ TEST_CASE("a resumed Simulation writes the uninterrupted trajectory to the bit",
     b.run();
     stop = b.engine().step();
   }
-  Simulation resumed = Simulation::resume(dir / "b", {"run.t_end=1.5"}, opt);
+  // a run.t_end before the checkpoint is refused before anything is written
+  const std::string before = granagg::test::slurp(dir / "b" / "traj.h5");
+  CHECK_THROWS_WITH(Simulation::resume(dir / "b", {"run.t_end=0.3"}, opt),
+                    Catch::Contains("before the checkpoint") && Catch::Contains("t = 0.6"));
+  CHECK(granagg::test::slurp(dir / "b" / "traj.h5") == before);
+  RunOptions again = opt;
+  again.command_line = "test --restart";
+  Simulation resumed = Simulation::resume(dir / "b", {"run.t_end=1.5"}, again);
   CHECK(resumed.resumed());
-  CHECK(resumed.engine().step() > 0);
+  CHECK(resumed.engine().step() == stop);
   resumed.run();
   CHECK(resumed.engine().step() == resumed.lastStep());
   requireSameTrajectory(dir / "a", dir / "b", stop);
+  // the trajectory records its continuation; /parameters still describes the start
+  {
+    namespace h5 = granagg::md::h5;
+    h5::silenceErrors();
+    const h5::Handle f = h5::check(
+        H5Fopen((dir / "b" / "traj.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open");
+    REQUIRE(h5::exists(f.get(), "/granagg/restarts/0"));
+    CHECK_FALSE(h5::exists(f.get(), "/granagg/restarts/1"));
+    const h5::Handle g = h5::check(H5Gopen2(f.get(), "/granagg/restarts/0", H5P_DEFAULT), "g");
+    const h5::Handle cmd = h5::openAttribute(g.get(), "command");
+    CHECK(h5::readString(cmd.get(), true, "command") == "test --restart");
+    const h5::Handle st = h5::openAttribute(g.get(), "step");
+    CHECK(h5::readNumericAttribute<std::int64_t>(st.get(), H5T_NATIVE_INT64, "step").at(0) ==
+          stop);
+  }
   if (std::getenv("GRANAGG_KEEP_TEST_FILES") == nullptr) fs::remove_all(dir);
 }
 
