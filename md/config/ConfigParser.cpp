@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -507,6 +508,9 @@ MdConfig parseConfigString(const std::string& text, const std::string& source_na
 }
 
 MdConfig parseConfigFile(const std::string& path, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))  // (an ifstream opens a directory and reads "")
+    throw ConfigError("config file '" + path + "' is a directory, not a TOML file", "");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError("cannot open config file '" + path + "'", "");
   std::ostringstream text;

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <stdexcept>
 
@@ -118,6 +119,45 @@ void writeProfile(const Engine& engine, const fs::path& path, const std::string&
   w.close();
 }
 
+// Bounds of what a run may ask for (issue 17): beyond them a typo (t_end = 1e300, a frame every
+// 1e-12) would overflow the step counter or hang in building the frame schedule.
+constexpr double MAX_STEPS = 1e12;  // ~30 years at 1e3 steps/s
+constexpr double MAX_FRAMES = 1e6;  // ~a petabyte at N = 50016
+
+/// The time step and the schedule that `config` asks for, checked before anything is built or
+/// written: a positive finite dt, a step count that fits, a bounded number of frames.
+/// A number for an error message: four significant digits.
+std::string people(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", x);
+  return b;
+}
+
+void checkSchedule(const MdConfig& c) {
+  std::string why;
+  const double dt = Engine::chooseTimeStep(c, &why);
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    throw std::invalid_argument("integrator.dt: the time step is " + people(dt) + " (" + why +
+                                "): it must be positive and finite; check contact.* or give "
+                                "integrator.dt");
+  const double steps = c.run.t_end / dt;
+  if (!(steps <= MAX_STEPS))
+    throw std::invalid_argument("run.t_end = " + people(c.run.t_end) + " at dt = " + people(dt) +
+                                " is " + people(steps) + " steps, more than 1e12: lower run.t_end");
+  double frames = 0.0;
+  if (c.output.frames_per_decade > 0) {
+    const double t0 = std::max(0.01, dt);
+    frames += c.output.frames_per_decade * std::max(0.0, std::log10(c.run.t_end / t0));
+  }
+  if (c.output.frame_interval > 0.0) frames += c.run.t_end / c.output.frame_interval;
+  if (!(frames <= MAX_FRAMES))
+    throw std::invalid_argument(
+        "output.frames_per_decade = " + std::to_string(c.output.frames_per_decade) +
+        " and output.frame_interval = " + people(c.output.frame_interval) + " ask for " +
+        people(std::round(frames)) + " frames up to run.t_end = " + people(c.run.t_end) +
+        ", more than 1e6: space them further apart");
+}
+
 }  // namespace
 
 struct Simulation::Impl {
@@ -173,6 +213,7 @@ Simulation Simulation::start(const MdConfig& config, const fs::path& out,
   d->out = out;
   d->options = options;
   validateConfig(d->cfg);
+  checkSchedule(d->cfg);
   if (fs::exists(out) && !fs::is_empty(out) && !options.overwrite)
     throw std::invalid_argument("output folder '" + out.string() +
                                 "' exists and is not empty; choose another --out or pass --force "
@@ -210,6 +251,7 @@ Simulation Simulation::resume(const fs::path& out, const std::vector<std::string
   const Checkpoint ck = readCheckpoint(cpath.string());
   d->cfg = parseConfigString(ck.extra.config_toml, cpath.string() + ":/config_toml", overrides);
   validateConfig(d->cfg);
+  checkSchedule(d->cfg);
   d->setUp(std::make_unique<Engine>(d->cfg, ck));
   const Engine& e = *d->engine;
   if (d->last < e.step())  // (equal: a finished run; run() has nothing to do)

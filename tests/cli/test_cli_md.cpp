@@ -49,6 +49,24 @@ TEST_CASE("md rejects bad configurations with a message naming the key, exit 2",
   CHECK_THAT(unknown.output, Catch::Contains("run.toml:3"));
   CHECK(runGranagg("md --preset nosuch -q").status == 2);
   CHECK(runGranagg("md -q").status == 2);  // neither --config nor --preset
+  // requests that used to overflow, hang or run the defaults: one line, exit 2, nothing written
+  const std::string small = writeConfig(dir, SMALL);
+  for (const Case& c : {Case{"--set run.t_end=1e300", "run.t_end"},
+                        Case{"--set integrator.dt=1e-300", "run.t_end"},
+                        Case{"--set contact.E=1e300", "integrator.dt"},
+                        Case{"--set output.frame_interval=1e-12", "frame_interval"},
+                        Case{"--set output.frames_per_decade=1000000000", "frames_per_decade"}}) {
+    INFO(c.toml);
+    const Run r = runGranagg("md --config " + small + " " + c.toml + " --out " +
+                             (dir / "o2").string() + " -q");
+    CHECK(r.status == 2);
+    CHECK_THAT(r.output, Catch::Contains(c.says));
+    CHECK_FALSE(fs::exists(dir / "o2"));
+  }
+  const Run folder = runGranagg("md --config " + dir.string() + " --out " +
+                                (dir / "o3").string() + " -q");
+  CHECK(folder.status == 2);
+  CHECK_THAT(folder.output, Catch::Contains("is a directory"));
   fs::remove_all(dir);
 }
 
