@@ -12,6 +12,20 @@ JOBS=${GRANAGG_JOBS:-$(nproc)}
 
 LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
+# Every TEST_CASE must reach CTest. catch_discover_tests builds a CMake list from the names: a
+# ';' split one test into two that ran nothing, and an unmatched '[' swallowed every later name
+# of its suite (issue 16 session: 5 common and 14 cli tests had silently not run).
+CATCH_CASES=0
+for t in "$BUILD_DIR"/tests/test_*; do
+  [ -x "$t" ] && [ -f "$t" ] || continue
+  CATCH_CASES=$((CATCH_CASES + $("$t" --list-test-names-only | grep -c .)))
+done
+CTEST_CASES=$(ctest --test-dir "$BUILD_DIR" -N | sed -n 's/^Total Tests: //p')
+if [ "$CATCH_CASES" != "$CTEST_CASES" ]; then
+  echo "scripts/test.sh: the suites hold $CATCH_CASES test cases but CTest registered" \
+    "$CTEST_CASES: a test name with ';' or '[' (see tests/CMakeLists.txt)" >&2
+  exit 1
+fi
 set +e
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" | tee "$LOG"
 CTEST_RC=${PIPESTATUS[0]}

@@ -141,7 +141,7 @@ TEST_CASE("the fit's 95 % interval uses the Student t quantile", "[analysis][fit
   CHECK_FALSE(fitPowerLaw({1, 2}, {1, 2}, 0, 10).valid);
 }
 
-TEST_CASE("bootstrap over runs of exact power laws is exact; with noise it is reproducible",
+TEST_CASE("bootstrap over runs of exact power laws is exact, with noise it is reproducible",
           "[analysis][fit]") {
   std::vector<double> t;
   for (int k = 1; k <= 20; ++k) t.push_back(k * 5.0);

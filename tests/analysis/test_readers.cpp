@@ -137,7 +137,7 @@ TEST_CASE("H5MD and LAMMPS dump of the same frames give identical frames and res
 }
 
 TEST_CASE(
-    "a LAMMPS dump cut mid-frame names the file and frame; --allow-partial keeps the frames before",
+    "a LAMMPS dump cut mid-frame names the file and frame, --allow-partial keeps the frames before",
     "[analysis][io]") {
   const fs::path dir = tempDir("cut");
   const auto frames = sampleFrames(5);
@@ -325,7 +325,7 @@ TEST_CASE("ensemble of runs: per-run tables, means and a bootstrap growth expone
   fs::remove_all(dir);
 }
 
-TEST_CASE("the charging-rate fit recovers the exponent of d<|q|>/dt; kappa comes from /parameters",
+TEST_CASE("the charging-rate fit recovers the exponent of d<|q|>/dt, kappa comes from /parameters",
           "[analysis][charge]") {
   // <|q|>(t) = 2 - t^-1.2 exactly: d<|q|>/dt = 1.2 t^-2.2. Frames 20 per decade on [1, 100]; the
   // finite-difference rate at the geometric mid-time carries a relative error O((ln 10 / 20)^2)

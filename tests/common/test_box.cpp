@@ -54,7 +54,7 @@ TEST_CASE(
   CHECK_FALSE(box.insideAll(0.0, 1.0, 1.0));
 }
 
-TEST_CASE("wrap returns a coordinate in [0, L) and the image shift, fast path and general case",
+TEST_CASE("wrap returns a coordinate in 0 <= x < L and the image shift, fast path and general case",
           "[box]") {
   const Box box{10.0};
   struct Case {
