@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -77,6 +78,19 @@ class Progress {
 };
 
 an::AnalysisOptions toOptions(const AnalyzeArgs& a) {
+  // the options by their names (the libraries' own checks name their parameters instead)
+  if (!(a.grid_spacing > 0.0) || !std::isfinite(a.grid_spacing))
+    throw std::invalid_argument("--grid-spacing must be > 0 and finite (got " +
+                                common::formatReal(a.grid_spacing) + ")");
+  if (!(a.grid_min_fill > 0.0 && a.grid_min_fill <= 1.0))
+    throw std::invalid_argument("--grid-min-fill must lie in (0, 1] (got " +
+                                common::formatReal(a.grid_min_fill) + ")");
+  if (a.grid_min_count < 0)
+    throw std::invalid_argument("--grid-min-count must be >= 0 (got " +
+                                std::to_string(a.grid_min_count) + ")");
+  if (!(a.tolerance >= 0.0) || !std::isfinite(a.tolerance))
+    throw std::invalid_argument("--tolerance must be >= 0 and finite (got " +
+                                common::formatReal(a.tolerance) + ")");
   an::AnalysisOptions o;
   o.grid.spacing = a.grid_spacing;
   o.grid.min_fill = a.grid_min_fill;
@@ -182,14 +196,23 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
   if (a.threads > 0) omp_set_num_threads(a.threads);
 #endif
   const an::AnalysisOptions o = toOptions(a);
-  for (const auto& r : a.runs)
+  std::set<fs::path> seen;
+  for (const auto& r : a.runs) {
     if (!fs::exists(r))
       throw std::invalid_argument("no such trajectory or run folder: '" + r + "'");
+    // the ensemble statistics treat runs as independent samples: one run twice is not two
+    fs::path canonical = fs::weakly_canonical(r);
+    if (canonical.filename().empty()) canonical = canonical.parent_path();  // "dir/" = "dir"
+    if (!seen.insert(canonical).second)
+      throw std::invalid_argument("run '" + r +
+                                  "' is given twice: an ensemble needs independent runs");
+  }
   const fs::path out(a.out);
   if (fs::exists(out) && (!fs::is_directory(out) || (!fs::is_empty(out) && !a.force)))
     throw std::invalid_argument(
         "output folder '" + out.string() +
         "' exists and is not empty; choose another --out or pass --force to overwrite it");
+  const bool created = !fs::exists(out);
   fs::create_directories(out / "per_run");
 
   // analysis.h5 is opened first so that --write-grid streams one frame at a time into it; a
@@ -215,6 +238,11 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
     file.reset();
     std::error_code ec;
     fs::remove(h5path, ec);
+    // nothing left that would block the rerun: a folder made here goes, an empty per_run too
+    if (created)
+      fs::remove_all(out, ec);
+    else
+      fs::remove(out / "per_run", ec);
     throw;
   }
   progress.done();
@@ -364,7 +392,8 @@ void registerAnalyzeCommand(CLI::App& app, const CliContext& ctx) {
                 "The paper's Fisher estimator: log bins [r^k, r^(k+1)) (default 2)");
   c->add_flag("--write-grid", a->write_grid,
               "Store every frame's occupancy grid and cluster labels in analysis.h5");
-  c->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)");
+  c->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)")
+      ->check(CLI::Range(1, 4096));
   c->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
   c->callback([a, ctx]() { runAnalyze(*a, ctx); });
 }

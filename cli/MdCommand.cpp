@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -32,7 +33,7 @@ struct MdArgs {
   std::vector<std::string> set;
   std::string out;
   std::string restart;
-  long long seed = -1;
+  std::string seed;  // "" = not given; else an integer in [0, 2^64) (checked in runMd)
   int threads = 0;
   bool force = false;
   bool quiet = false;
@@ -154,6 +155,19 @@ void printSummary(const md::Simulation& sim, const md::RunSummary& s) {
                sim.framesWritten(), sim.checkpointPath().c_str());
 }
 
+/// --seed as given, if it is an integer in [0, 2^64) (system.seed's range, docs/config.md): a
+/// long long option turned -1 into "not given" and clamped seeds above 2^63 - 1.
+std::string checkedSeed(const std::string& s) {
+  errno = 0;
+  char* end = nullptr;
+  const bool digits =
+      !s.empty() && s.size() <= 20 && s.find_first_not_of("0123456789") == std::string::npos;
+  if (digits) std::strtoull(s.c_str(), &end, 10);
+  if (!digits || errno == ERANGE)
+    throw std::invalid_argument("--seed must be an integer in [0, 2^64) (got '" + s + "')");
+  return s;
+}
+
 void runMd(const MdArgs& a, const CliContext& ctx) {
   if (a.threads < 0) throw std::invalid_argument("--threads must be >= 1.");
   if (a.threads > 0) md::Engine::setThreads(a.threads);
@@ -170,20 +184,23 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
           "--out cannot be combined with --restart: the run continues in "
           "its own folder " +
           a.restart);
-    if (!a.config.empty() || !a.preset.empty() || a.seed >= 0)
+    if (!a.config.empty() || !a.preset.empty() || !a.seed.empty())
       throw std::invalid_argument(
           "--restart continues a run with its own configuration: do not "
           "combine it with --config, --preset or --seed.");
     sim.emplace(md::Simulation::resume(a.restart, a.set, options));
   } else {
-    if (a.config.empty() == a.preset.empty())
-      throw std::invalid_argument(
-          "give exactly one of --config FILE or --preset NAME (or --restart DIR).");
+    if (!a.config.empty() && !a.preset.empty())
+      throw std::invalid_argument("give one of --config FILE and --preset NAME, not both.");
     std::vector<std::string> overrides = a.set;
-    if (a.seed >= 0) overrides.push_back("system.seed=" + std::to_string(a.seed));
-    const std::string file =
-        a.config.empty() ? findPreset("presets", a.preset, "--preset") : a.config;
-    const md::MdConfig cfg = md::parseConfigFile(file, overrides);
+    if (!a.seed.empty()) overrides.push_back("system.seed=" + checkedSeed(a.seed));
+    // neither: every key has a default (docs/config.md), --set changes them
+    const md::MdConfig cfg =
+        a.config.empty() && a.preset.empty()
+            ? md::parseConfigString("", "(defaults)", overrides)
+            : md::parseConfigFile(
+                  a.config.empty() ? findPreset("presets", a.preset, "--preset") : a.config,
+                  overrides);
     sim.emplace(md::Simulation::start(cfg, a.out.empty() ? "md-out" : a.out, options));
   }
   if (!a.quiet) {
@@ -224,8 +241,9 @@ void registerMdCommand(CLI::App& app, const CliContext& ctx) {
   md->add_option("--restart", a->restart,
                  "Continue the run whose output folder (with checkpoint.h5) is given; --set "
                  "run.t_end=T runs it further");
-  md->add_option("--seed", a->seed, "Random seed (overrides system.seed)");
-  md->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)");
+  md->add_option("--seed", a->seed, "Random seed, an integer in [0, 2^64) (overrides system.seed)");
+  md->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)")
+      ->check(CLI::Range(1, 4096));
   md->add_flag("--force", a->force, "Overwrite an existing output folder");
   md->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
   md->add_flag(

@@ -51,6 +51,10 @@ namespace {
 // ----------------------------------------------------------------------------------------------
 // Options and the pair configuration (data/pair/*.toml, docs/pair.md)
 
+/// Runs per K at most: a study of 2 x 10000 runs is far beyond any this code is for, and the
+/// bound keeps a typo from allocating the study's bookkeeping until the machine runs out.
+constexpr int MAX_RUNS = 10000;
+
 struct PairArgs {
   std::string preset, config, K, out, emit_batch;
   int runs = 0;        // used when given on the command line
@@ -206,7 +210,7 @@ PairConfig parsePairConfig(const std::string& path) {
   integer("meanfield", "zbeta_count", zcount);
   numbers("fit", "window", c.fit_window);
   string("fit", "column", c.fit_column);
-  c.runs = static_cast<int>(std::clamp<long long>(runs, -1, 1000000));
+  c.runs = static_cast<int>(std::clamp<long long>(runs, -1, MAX_RUNS + 1));
   c.zbeta_count = static_cast<int>(std::clamp<long long>(zcount, -1, 100000));
   if (c.md_preset.empty() == c.md_config.empty())
     throw std::invalid_argument(
@@ -291,8 +295,9 @@ void validate(const PairConfig& c) {
     if (!seen.insert(formatReal(k)).second)
       throw std::invalid_argument("K = " + formatReal(k) + " is listed twice (--K, pair.K)");
   }
-  if (c.runs < 1)
-    throw std::invalid_argument("--runs must be >= 1 (got " + std::to_string(c.runs) + ")");
+  if (c.runs < 1 || c.runs > MAX_RUNS)
+    throw std::invalid_argument(src + "pair.runs must lie in 1.." + std::to_string(MAX_RUNS) +
+                                " (got " + std::to_string(c.runs) + ")");
   if (c.seed < 0) throw std::invalid_argument(src + "pair.seed must be >= 0");
   if (!(c.charged_Q > 0) || !std::isfinite(c.charged_Q))
     throw std::invalid_argument(src + "charged.Q must be > 0");
@@ -1430,7 +1435,8 @@ void Pair::run() {
                              "); run the same command again to retry them");
 }
 
-void runPair(const PairArgs& a, const CliContext& ctx, const CLI::App* root, bool runs_given) {
+void runPair(const PairArgs& a, const CliContext& ctx, const CLI::App* root, bool runs_given,
+             bool K_given) {
   if (a.preset.empty() == a.config.empty())
     throw std::invalid_argument("give exactly one of --preset NAME or --config FILE");
   if (a.jobs < 0)
@@ -1441,7 +1447,7 @@ void runPair(const PairArgs& a, const CliContext& ctx, const CLI::App* root, boo
     throw std::invalid_argument("--emit-batch supports only 'slurm' (got '" + a.emit_batch + "')");
   PairConfig c =
       parsePairConfig(a.config.empty() ? findPreset("pair", a.preset, "--preset") : a.config);
-  if (!a.K.empty()) c.K = parseKList(a.K);
+  if (K_given) c.K = parseKList(a.K);  // (--K "" is refused there, not ignored)
   if (runs_given) c.runs = a.runs;
   validate(c);
   bool fit = false;
@@ -1455,23 +1461,28 @@ void runPair(const PairArgs& a, const CliContext& ctx, const CLI::App* root, boo
 
 void registerPairCommand(CLI::App& app, const CliContext& ctx) {
   auto a = std::make_shared<PairArgs>();
-  CLI::App* c = app.add_subcommand("pair",
-                                   "Paired MD / mean-field study (docs/pair.md): MD ensembles for "
-                                   "each Coulomb constant K (independent seeds, up to\n"
-                                   "--jobs runs at a time), their analysis, the mean field "
-                                   "(Smoluchowski S(t) for beta = 2, 3 and z(beta)), the\n"
-                                   "beta fit, the paper's figures and report.html, and "
-                                   "summary.json. An interrupted study resumes: run the same\n"
-                                   "command again and finished runs are not redone.");
+  CLI::App* c = app.add_subcommand(
+      "pair",
+      "Paired MD / mean-field study (docs/pair.md): MD ensembles for "
+      "each Coulomb constant K (run r has seed pair.seed + r for every K, up to\n"
+      "--jobs runs at a time), their analysis, the mean field "
+      "(Smoluchowski S(t) for beta = 2, 3 and z(beta)), the\n"
+      "beta fit, the paper's figures and report.html, and "
+      "summary.json. An interrupted study resumes: run the same\n"
+      "command again and finished runs are not redone.");
   c->add_option("--preset", a->preset,
                 "Pair preset from data/pair: tiny, quick, paper, validate-neutral, "
                 "validate-charged, validate-box");
   c->add_option("-c,--config", a->config, "Pair configuration TOML (keys: docs/pair.md)");
   c->add_option("--K", a->K, "Comma-separated Coulomb constants, e.g. 0,5 (overrides pair.K)");
-  c->add_option("--runs", a->runs, "Runs per K (>= 1; overrides pair.runs)");
-  c->add_option("--jobs", a->jobs, "MD runs at a time (default: max(1, cores / 2))");
+  // bounded: --runs 1e9 grew to 24 GB before failing; 1e5 wrote a 2e5-task Slurm array
+  c->add_option("--runs", a->runs, "Runs per K (1..10000; overrides pair.runs)")
+      ->check(CLI::Range(1, MAX_RUNS));
+  c->add_option("--jobs", a->jobs, "MD runs at a time, 1..1024 (default: max(1, cores / 2))")
+      ->check(CLI::Range(1, 1024));
   c->add_option("--threads", a->threads,
-                "OpenMP threads per MD run (default: max(1, cores / jobs))");
+                "OpenMP threads per MD run, 1..4096 (default: max(1, cores / jobs))")
+      ->check(CLI::Range(1, 4096));
   c->add_option("-o,--out", a->out,
                 "Output folder (default pair-<preset>); an existing study there is resumed");
   c->add_flag("--force", a->force, "Start over in an existing output folder (redo every run)");
@@ -1483,7 +1494,12 @@ void registerPairCommand(CLI::App& app, const CliContext& ctx) {
   c->add_flag("--no-figures", a->no_figures, "Skip the figures and the report");
   c->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
   const CLI::App* root = &app;
-  c->callback([a, ctx, root, c]() { runPair(*a, ctx, root, c->count("--runs") > 0); });
+  c->callback([a, ctx, root, c]() {
+    if (c->count("--run-index") > 0 && a->run_index < 0)  // -1 would start the whole study
+      throw std::invalid_argument("--run-index must be >= 0 (got " +
+                                  std::to_string(a->run_index) + ")");
+    runPair(*a, ctx, root, c->count("--runs") > 0, c->count("--K") > 0);
+  });
 }
 
 }  // namespace granagg::cli

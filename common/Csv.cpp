@@ -52,7 +52,10 @@ CsvWriter::CsvWriter(const std::string& path, const Provenance& prov,
     m_file = stdout;
   } else {
     refuseToOverwrite(path, overwrite);
-    m_file = std::fopen(path.c_str(), "w");
+    // written as PATH.partial and renamed at close(): a failed command leaves no header-only or
+    // half-written table behind to block (or mislead) its rerun
+    m_partial = path + ".partial";
+    m_file = std::fopen(m_partial.c_str(), "w");
     if (!m_file) throw std::runtime_error("cannot open '" + path + "' for writing");
     m_owns = true;
   }
@@ -66,7 +69,10 @@ CsvWriter::CsvWriter(const std::string& path, const Provenance& prov,
 }
 
 CsvWriter::~CsvWriter() {
-  if (m_file && m_owns) std::fclose(m_file);
+  if (m_file && m_owns) {  // not closed: the command failed; its table is not a result
+    std::fclose(m_file);
+    std::remove(m_partial.c_str());
+  }
 }
 
 void CsvWriter::row(const std::vector<double>& values) {
@@ -89,6 +95,8 @@ void CsvWriter::close() {
   bool bad = std::ferror(m_file) != 0;
   if (m_owns) {
     bad = (std::fclose(m_file) != 0) || bad;
+    if (!bad) bad = std::rename(m_partial.c_str(), m_path.c_str()) != 0;
+    if (bad) std::remove(m_partial.c_str());
   } else {
     std::fflush(m_file);
   }

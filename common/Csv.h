@@ -45,6 +45,8 @@ std::string formatReal(double x);
 
 /// Writes one CSV table. Path "-" writes to standard output. An existing file is never
 /// overwritten unless `overwrite` is true (std::invalid_argument names the file otherwise).
+/// The table appears at `path` only when close() succeeds (it is written as `path.partial` and
+/// renamed); a writer destroyed without close() -- a command that failed -- leaves nothing.
 class CsvWriter {
  public:
   CsvWriter(const std::string& path, const Provenance& provenance,
@@ -62,7 +64,7 @@ class CsvWriter {
   const std::string& path() const { return m_path; }
 
  private:
-  std::string m_path;
+  std::string m_path, m_partial;
   std::size_t m_ncol;
   std::FILE* m_file = nullptr;
   bool m_owns = false;

@@ -799,7 +799,8 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   if (fit.at_bound)
     fit.note = "beta_fit lies at the bound " +
                formatReal(fit.beta <= o.beta_min + edge ? o.beta_min : o.beta_max) +
-               " of the search range; widen --beta-min/--beta-max.";
+               " of the search range, so beta is not determined there; granagg fit-beta with a "
+               "wider --beta-min/--beta-max searches further.";
   fit.S_fitted.resize(n);
   for (std::size_t i = 0; i < n; ++i)
     fit.S_fitted[i] = fit.S_c * std::exp(prob.model(lt[i], fit.beta, r.lntau));

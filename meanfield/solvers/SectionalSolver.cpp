@@ -210,10 +210,10 @@ SectionalGrid makeSectionalGrid(double ratio, double max_size) {
   while (g.pivots.back() < max_size) {
     g.pivots.push_back(g.pivots.back() * ratio);
     if (g.pivots.size() > static_cast<size_t>(MAX_SECTIONS))
-      throw std::invalid_argument("sectional grid with ratio " + formatReal(ratio) +
-                                  " and max_size " + formatReal(max_size) + " needs more than " +
-                                  std::to_string(MAX_SECTIONS) +
-                                  " sections: raise ratio or lower max_size.");
+      throw std::invalid_argument(
+          "sectional grid with ratio " + formatReal(ratio) + " and max_size " +
+          formatReal(max_size) + " needs more than " + std::to_string(MAX_SECTIONS) +
+          " sections: raise the ratio (--ratio) or lower the largest size (--M).");
   }
   return g;
 }
@@ -312,10 +312,11 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
       result.snapshots.push_back(std::move(snap));
     }
     if (!s.valid && options.stop_on_truncation) {
-      result.stopped_early =
-          "mass loss " + formatReal(s.mass_loss) + " at t = " + formatReal(tout) +
-          " exceeds mass_loss_tolerance " + formatReal(options.mass_loss_tolerance) +
-          " (aggregates beyond the last pivot " + formatReal(x.back()) + "; raise max_size)";
+      result.stopped_early = "mass loss " + formatReal(s.mass_loss) +
+                             " at t = " + formatReal(tout) + " exceeds mass_loss_tolerance " +
+                             formatReal(options.mass_loss_tolerance) +
+                             " (aggregates beyond the last pivot " + formatReal(x.back()) +
+                             "; raise the largest size, --M on the command line)";
       break;
     }
     if (s.S >= options.s_end) break;

@@ -58,9 +58,11 @@ TEST_CASE("analyze rejects bad input with exit status 2 and a message naming it"
   };
   for (const Case& c : {Case{"analyze" + out, "runs"},
                         Case{"analyze " + (dir / "nosuch.h5").string() + out, "nosuch.h5"},
-                        Case{"analyze " + dump + out + " --grid-spacing -1", "spacing"},
-                        Case{"analyze " + dump + out + " --grid-min-fill 2", "min_fill"},
-                        Case{"analyze " + dump + out + " --tolerance -0.5", "tolerance"},
+                        Case{"analyze " + dump + out + " --grid-spacing -1", "--grid-spacing"},
+                        Case{"analyze " + dump + out + " --grid-spacing 0", "--grid-spacing"},
+                        Case{"analyze " + dump + out + " --grid-min-fill 2", "--grid-min-fill"},
+                        Case{"analyze " + dump + out + " --tolerance -0.5", "--tolerance"},
+                        Case{"analyze " + dump + out + " --threads 0", "--threads"},
                         Case{"analyze " + dump + out + " --msd-origins sometimes", "--msd-origins"},
                         Case{"analyze " + dump + out + " --fit-window 5 1", "--fit-window"},
                         Case{"analyze " + dump + out + " --slope-ratio 1", "--slope-ratio"},
@@ -78,14 +80,14 @@ TEST_CASE("analyze rejects bad input with exit status 2 and a message naming it"
 }
 
 TEST_CASE(
-    "analyze of a truncated dump fails naming file and frame; --allow-partial analyses the rest",
+    "analyze of a truncated dump fails naming file and frame, --allow-partial analyses the rest",
     "[cli][analyze]") {
   const fs::path dir = tempDir("cut");
   const std::string dump = tinyDump(dir, true);
   const Run r = runGranagg("analyze " + dump + " --out " + (dir / "o1").string() + " -q");
   CHECK(r.status == 1);
   CHECK_THAT(r.output, Catch::Contains("cut.dump") && Catch::Contains("frame 1"));
-  CHECK_FALSE(fs::exists(dir / "o1" / "analysis.h5"));  // no half-written output left behind
+  CHECK_FALSE(fs::exists(dir / "o1"));  // nothing left behind that would block the rerun
   const Run p =
       runGranagg("analyze " + dump + " --out " + (dir / "o2").string() + " --allow-partial");
   INFO(p.output);
@@ -101,6 +103,12 @@ TEST_CASE(
                            " -q --allow-partial");
   CHECK(h.status == 1);
   CHECK_THAT(h.output, Catch::Contains("cut.h5") && Catch::Contains("frame 0"));
+  CHECK_FALSE(fs::exists(dir / "o3"));
+  // one run given twice is not an ensemble of two
+  const Run twice = runGranagg("analyze " + run.string() + " " + run.string() + "/ --out " +
+                               (dir / "o4").string() + " -q");
+  CHECK(twice.status == 2);
+  CHECK_THAT(twice.output, Catch::Contains("given twice"));
   fs::remove_all(dir);
 }
 

@@ -79,3 +79,20 @@ TEST_CASE("smol writes a table with provenance and refuses to overwrite it", "[c
   CHECK(runGranagg("smol --beta 3 --method mono --t-end 100 --force --out " + out).status == 0);
   std::remove(out.c_str());
 }
+
+TEST_CASE("a failed smol or kinetic leaves no table behind", "[cli]") {
+  // They used to leave header-only CSVs that blocked the rerun ("already exists").
+  const std::string zb = tempPath("zb.csv"), rs = tempPath("r.csv");
+  std::remove(zb.c_str());
+  std::remove(rs.c_str());
+  const Run z = runGranagg("smol zbeta --ratio 1 --out " + zb);
+  CHECK(z.status != 0);
+  std::ifstream fz(zb);
+  CHECK_FALSE(fz.good());
+  const Run k = runGranagg("kinetic restitution --D 1e6 --out " + rs);
+  CHECK(k.status != 0);
+  std::ifstream fk(rs);
+  CHECK_FALSE(fk.good());
+  std::ifstream partial(zb + ".partial");
+  CHECK_FALSE(partial.good());
+}

@@ -48,14 +48,19 @@ TEST_CASE("md rejects bad configurations with a message naming the key, exit 2",
       runGranagg("md --config " + writeConfig(dir, "[system]\nN = 100\nNn = 5\n") + " -q");
   CHECK_THAT(unknown.output, Catch::Contains("run.toml:3"));
   CHECK(runGranagg("md --preset nosuch -q").status == 2);
-  CHECK(runGranagg("md -q").status == 2);  // neither --config nor --preset
+  CHECK(runGranagg("md --preset quick --config " + writeConfig(dir, SMALL) + " -q").status == 2);
+  // neither --config nor --preset: the defaults, changed by --set
+  const Run defaults = runGranagg("md --set system.N=50 --set run.t_end=0.01 --out " +
+                                  (dir / "defaults").string() + " -q");
+  CHECK(defaults.status == 0);
+  CHECK(fs::exists(dir / "defaults" / "traj.h5"));
   // requests that used to overflow, hang or run the defaults: one line, exit 2, nothing written
   const std::string small = writeConfig(dir, SMALL);
-  for (const Case& c : {Case{"--set run.t_end=1e300", "run.t_end"},
-                        Case{"--set integrator.dt=1e-300", "run.t_end"},
-                        Case{"--set contact.E=1e300", "integrator.dt"},
-                        Case{"--set output.frame_interval=1e-12", "frame_interval"},
-                        Case{"--set output.frames_per_decade=1000000000", "frames_per_decade"}}) {
+  for (const Case& c :
+       {Case{"--set run.t_end=1e300", "run.t_end"}, Case{"--set integrator.dt=1e-300", "run.t_end"},
+        Case{"--set contact.E=1e300", "integrator.dt"},
+        Case{"--set output.frame_interval=1e-12", "frame_interval"},
+        Case{"--set output.frames_per_decade=1000000000", "frames_per_decade"}}) {
     INFO(c.toml);
     const Run r = runGranagg("md --config " + small + " " + c.toml + " --out " +
                              (dir / "o2").string() + " -q");
@@ -63,10 +68,35 @@ TEST_CASE("md rejects bad configurations with a message naming the key, exit 2",
     CHECK_THAT(r.output, Catch::Contains(c.says));
     CHECK_FALSE(fs::exists(dir / "o2"));
   }
-  const Run folder = runGranagg("md --config " + dir.string() + " --out " +
-                                (dir / "o3").string() + " -q");
+  const Run folder =
+      runGranagg("md --config " + dir.string() + " --out " + (dir / "o3").string() + " -q");
   CHECK(folder.status == 2);
   CHECK_THAT(folder.output, Catch::Contains("is a directory"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("md --seed takes 0 to 2^64 - 1 and refuses the rest, --threads 0 is refused", "[cli][md]") {
+  const fs::path dir = tempDir("seeds");
+  const std::string cfg = writeConfig(dir, SMALL) + " --set run.t_end=0.01";
+  for (const char* bad : {"-1", "18446744073709551616", "1e3", "abc"}) {
+    INFO(bad);
+    const Run r = runGranagg("md --config " + cfg + " --seed " + bad + " --out " +
+                             (dir / "bad").string() + " -q");
+    CHECK(r.status == 2);
+    CHECK_THAT(r.output, Catch::Contains("--seed"));
+  }
+  CHECK(runGranagg("md --config " + cfg + " --threads 0 --out " + (dir / "t").string() + " -q")
+            .status == 2);
+  CHECK_FALSE(fs::exists(dir / "bad"));
+  // the two largest signed and unsigned 64-bit seeds are two different runs (the option used to
+  // clamp the second to the first)
+  for (const char* seed : {"9223372036854775807", "18446744073709551615"})
+    REQUIRE(runGranagg("md --config " + cfg + " --seed " + seed + " --out " +
+                       (dir / seed).string() + " -q")
+                .status == 0);
+  granagg::md::H5mdReader a((dir / "9223372036854775807" / "traj.h5").string()),
+      b((dir / "18446744073709551615" / "traj.h5").string());
+  CHECK(a.readFrame(0).x != b.readFrame(0).x);
   fs::remove_all(dir);
 }
 
@@ -122,8 +152,8 @@ TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   CHECK(fa.vz == fb.vz);
   CHECK(fa.ix == fb.ix);
   CHECK(runGranagg("md --restart " + (dir / "b").string() + " --set system.N=5 -q").status == 2);
-  const Run out = runGranagg("md --restart " + (dir / "b").string() + " --out " +
-                             (dir / "c").string() + " -q");
+  const Run out =
+      runGranagg("md --restart " + (dir / "b").string() + " --out " + (dir / "c").string() + " -q");
   CHECK(out.status == 2);  // the run continues in its own folder: --out would be ignored
   CHECK_THAT(out.output, Catch::Contains("--out cannot be combined with --restart"));
   CHECK_FALSE(fs::exists(dir / "c"));

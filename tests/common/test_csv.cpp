@@ -48,6 +48,17 @@ TEST_CASE("CSV round trip keeps provenance, columns and exact values", "[common]
   // never overwrite silently
   CHECK_THROWS_WITH(CsvWriter(path, prov, {"t"}), Catch::Contains("already exists"));
   CHECK_NOTHROW(CsvWriter(path, prov, {"t"}, /*overwrite=*/true));
+  // a writer abandoned without close() (its command failed) leaves the old table as it was
+  // and no new one: nothing half-written blocks or misleads the rerun
+  CHECK(readCsv(path).rows.size() == 2);
+  const std::string fresh = tempPath("abandoned.csv");
+  std::remove(fresh.c_str());
+  {
+    CsvWriter w(fresh, prov, {"t", "S"});
+    w.row({1.0, 2.0});
+  }
+  CHECK_THROWS_WITH(readCsv(fresh), Catch::Contains("abandoned.csv"));
+  CHECK_THROWS(readCsv(fresh + ".partial"));
   std::remove(path.c_str());
 }
 
