@@ -14,7 +14,7 @@ LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 # Every TEST_CASE must reach CTest. catch_discover_tests builds a CMake list from the names: a
 # ';' split one test into two that ran nothing, and an unmatched '[' swallowed every later name
-# of its suite (issue 16 session: 5 common and 14 cli tests had silently not run).
+# of its suite (5 common, 3 analysis and 1 cli test case had silently not run, b9085c6).
 CATCH_CASES=0
 for t in "$BUILD_DIR"/tests/test_*; do
   [ -x "$t" ] && [ -f "$t" ] || continue
