@@ -11,7 +11,7 @@ PACKAGES=(build-essential cmake pkg-config git
           libsundials-dev libeigen3-dev libboost-dev libgsl-dev libhdf5-dev catch2 libfftw3-dev
           librandom123-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libthrust-dev
           libomp-dev
-          python3-matplotlib python3-numpy python3-h5py)
+          python3-matplotlib python3-numpy python3-h5py python3-mdanalysis)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -5,8 +5,10 @@
 /// lengths in particle diameters, time in sqrt(m d^2 / T0)); no `unit` attributes are written,
 /// so MDAnalysis must be told `convert_units=False`:
 ///
-///     u = MDAnalysis.Universe.empty(N, trajectory=True)   # or any topology with N atoms
+///     u = MDAnalysis.Universe.empty(N, trajectory=False)   # or any topology with N atoms
 ///     u.load_new("traj.h5", format="H5MD", convert_units=False)
+///
+/// (checked against h5py frame by frame by scripts/check_mdanalysis.py, run by the CLI tests).
 ///
 /// MDAnalysis also ignores charges (read them from particles/all/charge/value with h5py).
 ///

@@ -131,6 +131,22 @@ TEST_CASE("md writes a readable trajectory and refuses to overwrite it", "[cli][
   fs::remove_all(dir);
 }
 
+TEST_CASE("MDAnalysis reads a granagg run with the README's recipe", "[cli][md][mdanalysis]") {
+  // python3-mdanalysis is a Debian package and part of the set-up (scripts/setup.sh): a peer
+  // reading our files is part of the contract, so its absence fails the test.
+  const fs::path dir = tempDir("mda");
+  const std::string cfg = writeConfig(dir, SMALL);
+  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.3 --out " +
+                     (dir / "o").string() + " -q")
+              .status == 0);
+  const Run r = sh("/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) +
+                   "/scripts/check_mdanalysis.py " + (dir / "o" / "traj.h5").string());
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK_THAT(r.output, Catch::Contains("agree with the file"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   const fs::path dir = tempDir("restart");
   const std::string cfg = writeConfig(dir, SMALL);
