@@ -11,6 +11,7 @@
 
 #include "cli/CliContext.h"
 #include "common/Csv.h"
+#include "common/Strings.h"
 #include "meanfield/kinetic/Charging.h"
 #include "meanfield/kinetic/Cooling.h"
 #include "meanfield/kinetic/Restitution.h"
@@ -95,17 +96,32 @@ void addContactProvenance(common::Provenance& prov, const mf::ContactParams& p) 
 
 // ---- restitution ----
 struct RestitutionArgs {
-  std::vector<double> v{0.05, 0.1, 1.0, 2.0};
+  std::string v = "0.05,0.1,1,2";  // parsed by impactSpeeds(): an empty item is an error
   ContactArgs contact;
   OutArgs out;
 };
 
+/// --v: comma-separated impact speeds, each > 0 and finite; an empty or malformed item is an
+/// error (CLI11's delimiter dropped the empty item of "1,,2").
+std::vector<double> impactSpeeds(const std::string& text) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    double v = 0.0;
+    require(common::parseReal(item, v) && v > 0.0 && std::isfinite(v),
+            "--v takes comma-separated impact speeds > 0, e.g. --v 0.1,1 (got '" + text + "').");
+    out.push_back(v);
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
 void runRestitution(const RestitutionArgs& a, const CliContext& ctx) {
   const mf::ContactParams p = a.contact.params();
-  require(!a.v.empty(), "--v needs at least one impact speed.");
-  for (double v : a.v)
-    require(v > 0.0 && std::isfinite(v),
-            "--v must be positive and finite (got " + formatReal(v) + ").");
+  const std::vector<double> speeds = impactSpeeds(a.v);
   common::refuseToOverwrite(a.out.out == "-" ? std::string() : a.out.out, a.out.force);
   const mf::Restitution R(p);
 
@@ -126,8 +142,17 @@ void runRestitution(const RestitutionArgs& a, const CliContext& ctx) {
                       {"v", "e", "contact_time", "release_time", "max_overlap", "b", "e_series",
                        "elastic_contact_time"},
                       a.out.force);
-  for (double v : a.v) {
+  for (double v : speeds) {
     const mf::CollisionResult r = R.collide(v);
+    if (r.max_overlap > 1.0) {  // the centres would pass each other: not a contact any more
+      char why[200];
+      std::snprintf(why, sizeof why,
+                    "v = %.4g: max_overlap %.3g > 1 d, the spheres would pass through each "
+                    "other; the Hertz law does not describe such an impact",
+                    v, r.max_overlap);
+      std::fprintf(stderr, "kinetic restitution: warning: %s\n", why);
+      w.comment(std::string("warning: ") + why);
+    }
     const double series =
         r.scaling_parameter < SERIES_B_MAX ? R.seriesRestitution(v) : std::nan("");
     w.row({v, r.restitution, r.contact_time, r.release_time, r.max_overlap, r.scaling_parameter,
@@ -301,7 +326,6 @@ void registerKineticCommand(CLI::App& app, const CliContext& ctx) {
       "m_eff xi'' = -(E xi^{3/2} + D xi^{1/2} xi') from xi = 0, xi' = v until xi = 0 again.");
   rest->add_option("--v", ra->v,
                    "Impact speeds (normal relative speed, sqrt(T0/m), > 0), comma separated")
-      ->delimiter(',')
       ->capture_default_str();
   addContactOptions(rest, ra->contact);
   addOutOptions(rest, ra->out);

@@ -97,12 +97,22 @@ void printStart(const md::Simulation& sim) {
   const md::Engine& e = sim.engine();
   const md::MdConfig& cfg = sim.config();
   std::fprintf(stderr, "md: %s\n", common::versionString().c_str());
-  std::fprintf(stderr, "md: backend: %s\n", md::Engine::backendDescription().c_str());
+  // the hint belongs in the log, not in the outputs that store the description
+#ifdef GRANAGG_CUDA
+  const char* hint = "";
+#else
+  const char* hint = " (set OMP_NUM_THREADS or --threads to change)";
+#endif
+  std::fprintf(stderr, "md: backend: %s%s\n", md::Engine::backendDescription().c_str(), hint);
   std::fprintf(stderr, "md: N = %d, phi = %g, box L = %.6g, contact model %s, seed %llu\n",
                cfg.system.N, cfg.system.phi, e.box(), cfg.contact.model.c_str(),
                static_cast<unsigned long long>(cfg.system.seed));
-  std::fprintf(stderr, "md: dt = %.6g (%s); %lld steps to t_end = %g\n", e.dt(),
-               sim.dtReason().c_str(), static_cast<long long>(sim.lastStep()), cfg.run.t_end);
+  const double t_last = static_cast<double>(sim.lastStep()) * e.dt();
+  char ends[96] = "";
+  if (t_last != cfg.run.t_end)  // time = step * dt: the run ends on the step nearest t_end
+    std::snprintf(ends, sizeof ends, " (ends at t = %.6g, the whole step nearest t_end)", t_last);
+  std::fprintf(stderr, "md: dt = %.6g (%s); %lld steps to t_end = %g%s\n", e.dt(),
+               sim.dtReason().c_str(), static_cast<long long>(sim.lastStep()), cfg.run.t_end, ends);
   if (const md::CoulombSetup* cs = e.coulombSetup()) {
     const std::string mesh = cs->method == "pppm" ? "mesh " + std::to_string(cs->mesh) +
                                                         "^3, order " + std::to_string(cs->order)

@@ -1023,8 +1023,7 @@ std::string Engine::backendDescription() {
     return std::string("Thrust CUDA backend on ") + prop.name;
   return "Thrust CUDA backend (no device found)";
 #else
-  return "Thrust OpenMP backend, " + std::to_string(omp_get_max_threads()) +
-         " thread(s) (set OMP_NUM_THREADS or --threads to change)";
+  return "Thrust OpenMP backend, " + std::to_string(omp_get_max_threads()) + " thread(s)";
 #endif
 }
 

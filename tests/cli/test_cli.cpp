@@ -49,7 +49,9 @@ TEST_CASE("bad input gives one line naming the option and exit status 2", "[cli]
         Case{"smol --ratio 1", "--ratio"},
         Case{"smol --kernel multiplicative --t-end 2", "gel time"},
         Case{"smol zbeta --count 0", "--count"}, Case{"smol zbeta --beta-min -2", "--beta-min"},
-        Case{"smol --no-such-option", "no-such-option"}, Case{"frobnicate", "frobnicate"}}) {
+        Case{"smol --no-such-option", "no-such-option"}, Case{"frobnicate", "frobnicate"},
+        Case{"kinetic restitution --v 1,,2", "--v"}, Case{"kinetic restitution --v 1,", "--v"},
+        Case{"kinetic restitution --v 0", "--v"}}) {
     INFO(c.args);
     const Run r = runGranagg(c.args);
     CHECK(r.status == 2);
@@ -78,6 +80,13 @@ TEST_CASE("smol writes a table with provenance and refuses to overwrite it", "[c
   CHECK_THAT(again.output, Catch::Contains("already exists"));
   CHECK(runGranagg("smol --beta 3 --method mono --t-end 100 --force --out " + out).status == 0);
   std::remove(out.c_str());
+}
+
+TEST_CASE("kinetic restitution warns where the overlap exceeds a diameter", "[cli]") {
+  const Run r = runGranagg("kinetic restitution --v 0.1,1e10");
+  CHECK(r.status == 0);
+  CHECK_THAT(r.output, Catch::Contains("restitution: warning: v = 1e+10: max_overlap 4.18e+05"));
+  CHECK_THAT(r.output, Catch::Contains("# warning: v = 1e+10"));  // in the table too
 }
 
 TEST_CASE("a failed smol or kinetic leaves no table behind", "[cli]") {
