@@ -64,9 +64,13 @@ std::vector<double> outputTimes(double t_min, double t_end, int per_decade) {
                "--t-end must be larger than --t-min = " + common::formatReal(t_min) + " (got " +
                    common::formatReal(t_end) + ").");
   requireRange(per_decade >= 1 && per_decade <= 10000, "--per-decade must lie in [1, 10000].");
-  const int count =
-      std::max(2, static_cast<int>(std::ceil(std::log10(t_end / t_min) * per_decade)) + 1);
-  return mf::logSpacedTimes(t_min, t_end, count);
+  const double count = std::max(2.0, std::ceil(std::log10(t_end / t_min) * per_decade) + 1.0);
+  // (t_end = 1e300 at 10000 per decade wrote 357 MB)
+  requireRange(count <= 1e6, "--t-end = " + common::formatReal(t_end) +
+                                 " and --per-decade = " + std::to_string(per_decade) +
+                                 " ask for more than 1e6 output "
+                                 "times: lower one of them.");
+  return mf::logSpacedTimes(t_min, t_end, static_cast<int>(count));
 }
 
 /// Runs the chosen method; all three return moments on the same output times.
@@ -159,6 +163,9 @@ void runSmol(const SmolArgs& a, const CliContext& ctx) {
                       a.force);
   std::size_t j = 0;
   for (const auto& s : r.samples) {
+    if (!std::isfinite(s.S))  // (the table used to end in NaN rows, with exit status 0)
+      throw std::runtime_error("S(t) is no longer finite at t = " + common::formatReal(s.t) +
+                               " (the solver's numbers overflowed): lower --t-end");
     double z = std::nan("");
     if (s.valid && j < ls.t.size() && ls.t[j] == s.t) z = ls.z[j++];
     w.row({s.t, s.S, s.M0, s.M1, s.M2, z, s.mass_loss, s.valid ? 1.0 : 0.0, s.max_size});

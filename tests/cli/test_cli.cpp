@@ -51,7 +51,8 @@ TEST_CASE("bad input gives one line naming the option and exit status 2", "[cli]
         Case{"smol zbeta --count 0", "--count"}, Case{"smol zbeta --beta-min -2", "--beta-min"},
         Case{"smol --no-such-option", "no-such-option"}, Case{"frobnicate", "frobnicate"},
         Case{"kinetic restitution --v 1,,2", "--v"}, Case{"kinetic restitution --v 1,", "--v"},
-        Case{"kinetic restitution --v 0", "--v"}}) {
+        Case{"kinetic restitution --v 0", "--v"},
+        Case{"smol --method mono --t-end 1e300 --per-decade 10000", "--per-decade"}}) {
     INFO(c.args);
     const Run r = runGranagg(c.args);
     CHECK(r.status == 2);
@@ -104,4 +105,12 @@ TEST_CASE("a failed smol or kinetic leaves no table behind", "[cli]") {
   CHECK_FALSE(fk.good());
   std::ifstream partial(zb + ".partial");
   CHECK_FALSE(partial.good());
+  // a solution that overflows fails (exit 1) instead of writing NaN rows
+  const std::string mono = tempPath("mono_overflow.csv");
+  std::remove(mono.c_str());
+  const Run m = runGranagg("smol --beta 3 --method mono --t-end 1e300 --out " + mono);
+  CHECK(m.status == 1);
+  CHECK_THAT(m.output, Catch::Contains("--t-end"));
+  std::ifstream fm(mono);
+  CHECK_FALSE(fm.good());
 }
