@@ -64,24 +64,29 @@ struct RealForceFunctor {
   }
 };
 
+/// The energy of the pairs (i, j) of i's row with id_j > id_i: each pair once (one erfc per pair,
+/// not two), and by particle id, so that the per-particle terms, summed in id order, do not depend
+/// on the storage order.
 struct RealEnergyFunctor {
   const Scalar4* pos;
-  const int *rows, *counts;
+  const int *rows, *counts, *id;
   int cap;
   common::Box box;
   double K, alpha, rc2;
   HD double operator()(int i) const {
     const Scalar4 ri = pos[i];
+    const int id_i = id[i];
     double e = 0.0;
     const int* row = rows + static_cast<long>(i) * cap;
     for (int k = 0; k < counts[i]; ++k) {
-      const Scalar4 rj = pos[row[k]];
+      const int j = row[k];
+      if (id[j] <= id_i) continue;
+      const Scalar4 rj = pos[j];
       const double rx = box.minimumImageWrapped(ri.x - rj.x),
                    ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
-      if (r2 < rc2)
-        e += 0.5 * ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);  // half per partner
+      if (r2 < rc2) e += ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);
     }
     return e;
   }
@@ -121,8 +126,8 @@ double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const co
   DVec<double> per_slot(p.size());
   thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
                     per_slot.begin(),
-                    RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), nl.capacity(), box, prm.K,
-                                      prm.alpha, prm.r_cut * prm.r_cut});
+                    RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), raw(p.id), nl.capacity(),
+                                      box, prm.K, prm.alpha, prm.r_cut * prm.r_cut});
   return reduceById(per_slot, p.id, 0.0, thrust::plus<double>());  // restart: same bits
 }
 

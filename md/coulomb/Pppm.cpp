@@ -486,6 +486,9 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   s.energies.kspace =
       s.K / (2.0 * s.V) * s.sum(raw(s.terms), nc, false) + s.self_correction * sum_q2;
 
+  s.computed = true;
+  if (!fx) return s.energies.total();  // the energy alone (Pppm.h): no field, no forces
+
   // 4. field by ik-differentiation: one inverse FFT per component (backward overwrites `work`)
   DVec<double>* field[3] = {&s.ex, &s.ey, &s.ez};
   for (int d = 0; d < 3; ++d) {
@@ -503,7 +506,6 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
       counting_iterator<int>(0), counting_iterator<int>(N),
       Interpolate{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.ex), raw(s.ey), raw(s.ez),
                   raw(s.jx), raw(s.jy), raw(s.jz), raw(s.order), M, P, s.K, fx, fy, fz});
-  s.computed = true;
   return s.energies.total();
 }
 

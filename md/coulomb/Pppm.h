@@ -55,7 +55,8 @@ class Pppm {
   /// All pointers are device pointers (host memory in the CPU build), n entries each. Positions
   /// may lie anywhere (they are wrapped into the box). `id` (optional, values 0..n-1, a
   /// permutation) orders the charges within a mesh cell, so that results do not depend on the
-  /// storage order; without it the slot index is used.
+  /// storage order; without it the slot index is used. fx, fy and fz all null: the energy alone
+  /// (charge assignment and one FFT; none of the field's three inverse FFTs and interpolation).
   double compute(const double* x, const double* y, const double* z, const double* q, std::size_t n,
                  double* fx, double* fy, double* fz, const int* id = nullptr);
 

@@ -559,11 +559,9 @@ struct Engine::Impl {
         drift_since_coul_build = 0.0;
       }
       double ext = coulomb_ext_energy;
-      if (kspace_step != step) {
-        DVec<double> gx(p.size(), 0.0), gy(p.size(), 0.0), gz(p.size(), 0.0);
-        ext = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), p.size(), raw(gx), raw(gy),
-                            raw(gz), raw(p.id));
-      }
+      if (kspace_step != step)  // the energy alone: no forces
+        ext = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), p.size(), nullptr, nullptr,
+                            nullptr, raw(p.id));
       return coulombRealEnergy(p, *nl_coul, box, realParams()) + ext;
     }
     if (kspace_step == step) return coulomb_ext_energy;

@@ -1,7 +1,7 @@
 // PPPM (md/coulomb/Pppm.h): Madelung constants and the single charge in a background at the default
 // accuracy, forces against converged plain Ewald on gas-like random configurations (neutral and
 // all-positive) at 1e-3, 1e-4 and 1e-5 with the error estimate within a factor 3, determinism with
-// 1 and 2 threads, independence of the storage order, and input validation.
+// 1 and 2 threads, independence of the storage order, the energy alone, and input validation.
 #include <catch2/catch.hpp>
 
 #include <omp.h>
@@ -277,6 +277,9 @@ TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of stora
     same = same && fx[s] == r2.fx[i] && fy[s] == r2.fy[i] && fz[s] == r2.fz[i];
   }
   CHECK(same);
+  // the energy alone (null forces: the engine's observables) is the same energy, to the bit
+  CHECK(two.compute(pos4.data(), n, nullptr, nullptr, nullptr, id.data()) == e);
+  CHECK(two.lastEnergies().total() == e);
 #endif
 }
 
