@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/Interrupted.h"
 #include "common/PaperValues.h"
 
 namespace granagg::cli {
@@ -21,18 +22,7 @@ struct CliContext {
   std::string command_line;  ///< argv joined, recorded in every output's provenance header
 };
 
-/// A command stopped by SIGINT or SIGTERM after saving what it had (a checkpoint, finished runs):
-/// main() prints the message on one line and exits with status(), 128 + the signal number, as
-/// a shell reports a command killed by it (130 for SIGINT, 143 for SIGTERM).
-class Interrupted : public std::runtime_error {
- public:
-  Interrupted(const std::string& what, int signal)
-      : std::runtime_error(what), m_status(128 + signal) {}
-  int status() const { return m_status; }
-
- private:
-  int m_status;
-};
+using common::Interrupted;  // (common/Interrupted.h)
 
 /// From now on SIGINT and SIGTERM (Ctrl-C, Slurm's time limit, kill) only set stopSignal(); the
 /// running command polls it and stops cleanly within a chunk of steps. Further signals change

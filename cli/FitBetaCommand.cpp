@@ -1,6 +1,8 @@
 /// `granagg fit-beta`: growth exponent z of a measured S(t), beta from z through the full
 /// Smoluchowski z(beta), and a full-curve fit of S(t) against S_c S_MF(t / tau_c; beta)
 /// (meanfield/fit/BetaFit.h, docs/fit-beta.md).
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -334,44 +336,21 @@ void dropUnusableRows(Loaded& L) {
   L.runs = runs;
 }
 
-// ---- JSON (flat, numbers with round-trip precision, NaN -> null)
+// ---- fit_beta.json: nlohmann-json, keys in the order written, NaN and inf -> null
 
 class Json {
  public:
   void num(const std::string& k, double v) {
-    add(k, std::isfinite(v) ? common::formatReal(v) : "null");
+    m_j[k] = std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
   }
-  void integer(const std::string& k, long long v) { add(k, std::to_string(v)); }
-  void boolean(const std::string& k, bool v) { add(k, v ? "true" : "false"); }
-  void str(const std::string& k, const std::string& v) { add(k, quote(v)); }
-  void strings(const std::string& k, const std::vector<std::string>& v) {
-    std::string s = "[";
-    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + quote(v[i]);
-    add(k, s + "]");
-  }
-  std::string text() const { return "{\n" + m_body + "\n}\n"; }
+  void integer(const std::string& k, long long v) { m_j[k] = v; }
+  void boolean(const std::string& k, bool v) { m_j[k] = v; }
+  void str(const std::string& k, const std::string& v) { m_j[k] = v; }
+  void strings(const std::string& k, const std::vector<std::string>& v) { m_j[k] = v; }
+  std::string text() const { return m_j.dump(2) + "\n"; }
 
  private:
-  static std::string quote(const std::string& s) {
-    std::string o = "\"";
-    for (char c : s) {
-      if (c == '"' || c == '\\') {
-        o += '\\';
-        o += c;
-      } else if (static_cast<unsigned char>(c) < 0x20) {
-        char buf[8];
-        std::snprintf(buf, sizeof buf, "\\u%04x", c);
-        o += buf;
-      } else {
-        o += c;
-      }
-    }
-    return o + "\"";
-  }
-  void add(const std::string& k, const std::string& v) {
-    m_body += (m_body.empty() ? "  " : ",\n  ") + quote(k) + ": " + v;
-  }
-  std::string m_body;
+  nlohmann::ordered_json m_j = nlohmann::ordered_json::object();
 };
 
 std::string interval(double v, double lo, double hi) {

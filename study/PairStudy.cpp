@@ -1,0 +1,579 @@
+/// \file PairStudy.cpp
+/// The study's steps: folder, MD job pool with resume records, post-processing stages
+/// (PairStudy.h).
+#include "study/PairStudy.h"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <stdexcept>
+
+#include "common/Csv.h"
+#include "common/Interrupted.h"
+#include "common/Version.h"
+#include "study/Process.h"
+#include "study/Slurm.h"
+
+namespace granagg::study {
+namespace fs = std::filesystem;
+using common::formatReal;
+
+namespace {
+
+/// "[0, 5]": the K values as the log shows them.
+std::string kList(const std::vector<double>& K) {
+  std::string s;
+  for (double k : K) s += (s.empty() ? "" : ", ") + formatReal(k);
+  return "[" + s + "]";
+}
+
+/// What run.json and done.json of a run share: the spec it must match to count, and its identity.
+nlohmann::ordered_json runRecord(const RunJob& j) {
+  return {
+      {"spec", j.spec}, {"K", j.K}, {"run", j.r}, {"seed", j.seed}, {"config", j.config.string()}};
+}
+
+/// Whether a run record (run.json, done.json) was made for this run's configuration and seed;
+/// false when the file is missing or not a record.
+bool recordOf(const fs::path& p, const RunJob& job) {
+  if (!fs::exists(p)) return false;
+  try {
+    const std::string spec = nlohmann::json::parse(readText(p)).at("spec").get<std::string>();
+    return spec == job.spec || spec == job.legacy_spec;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+bool stageDone(const fs::path& marker, const std::string& spec) {
+  return fs::exists(marker) && readText(marker) == spec;
+}
+
+}  // namespace
+
+void PairStudy::say(const std::string& line, bool terminal) {
+  appendText(m_out / "pair.log", "[" + nowUtc() + "] " + line + "\n");
+  if (terminal && !m_a.quiet) {
+    std::fprintf(stderr, "pair: %s\n", line.c_str());
+  }
+}
+
+void PairStudy::prepareFolder() {
+  const bool exists = fs::exists(m_out);
+  if (exists && !fs::is_directory(m_out))
+    throw std::invalid_argument("--out '" + m_out.string() + "' exists and is not a folder");
+  const bool is_pair = fs::exists(m_out / "config" / "pair.toml");
+  if (exists && !fs::is_empty(m_out) && !is_pair && !m_a.force)
+    throw std::invalid_argument(
+        "output folder '" + m_out.string() +
+        "' exists, is not empty and holds no pair study; choose another --out or pass --force");
+  if (is_pair && m_a.force && m_a.run_index < 0) {
+    // --force: start over (keep nothing this command made before).
+    for (const char* sub : {"runs", "analysis", "meanfield", "fit", "figures", "logs", "config"})
+      fs::remove_all(m_out / sub);
+    for (const char* f : {"summary.json", "report.html", "commands.txt", "batch.slurm", "pair.log"})
+      fs::remove(m_out / f);
+  }
+  fs::create_directories(m_out / "config");
+  fs::create_directories(m_out / "logs");
+}
+
+PairStudy::PairStudy(PairConfig config, StudyRequest request, StudyServices services)
+    : m_c(std::move(config)),
+      m_a(std::move(request)),
+      m_s(std::move(services)),
+      m_out(fs::absolute(m_a.out.empty() ? fs::path("pair-" + m_c.name) : fs::path(m_a.out))
+                .lexically_normal()),
+      m_cores(availableCores()),
+      m_start(clock::now()) {
+  validate(m_c);
+  if (m_a.jobs < 0)
+    throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(m_a.jobs) + ")");
+  if (m_a.threads < 0)
+    throw std::invalid_argument("--threads must be >= 1 (got " + std::to_string(m_a.threads) + ")");
+  if (!m_a.emit_batch.empty() && m_a.emit_batch != "slurm")
+    throw std::invalid_argument("--emit-batch supports only 'slurm' (got '" + m_a.emit_batch +
+                                "')");
+  // every ensemble's MD configuration, resolved before anything is written (exit 2 on a bad key)
+  const std::string base =
+      m_c.md_preset.empty() ? m_c.md_config : m_s.find_md_preset(m_c.md_preset);
+  for (std::size_t k = 0; k < m_c.K.size(); ++k) {
+    const double K = m_c.K[k];
+    std::vector<std::string> set = m_c.md_set;
+    set.push_back("coulomb.K=" + formatReal(K));
+    if (K > 0) {
+      set.push_back("charging.Q=" + formatReal(m_c.charged_Q));
+      set.insert(set.end(), m_c.charged_set.begin(), m_c.charged_set.end());
+    }
+    const MdPlan plan = m_s.resolve_md(base, set);
+    const std::string name = kName(K);
+    const fs::path path = m_out / "config" / ("md_" + name + ".toml");
+    m_md[name] = plan;
+    const std::string header = "# granagg md configuration of the K = " + formatReal(K) +
+                               " runs of pair study '" + m_c.name + "' (resolved from " + base +
+                               "; every run sets its own --seed)\n";
+    m_md_text[path.string()] = header + plan.toml;  // written once the folder is prepared
+    const std::string hash = fnv1a(plan.toml), legacy = fnv1a(plan.toml, LEGACY_HASH_BASIS);
+    for (int r = 0; r < m_c.runs; ++r) {
+      RunJob j;
+      j.K = K;
+      j.r = r;
+      j.seed = m_c.seed + r;
+      j.index = static_cast<int>(k) * m_c.runs + r;
+      j.dir = m_out / "runs" / name / ("run" + std::to_string(r));
+      j.config = path;
+      j.log = m_out / "logs" / ("md-" + name + "-run" + std::to_string(r) + ".log");
+      j.spec = "md_config_fnv1a=" + hash + " seed=" + std::to_string(j.seed);
+      j.legacy_spec = "md_config_fnv1a=" + legacy + " seed=" + std::to_string(j.seed);
+      j.cost = static_cast<double>(plan.N) * plan.steps * (K > 0 ? 100.0 : 1.0);
+      m_runs.push_back(j);
+    }
+  }
+  if (m_a.run_index >= static_cast<int>(m_runs.size()))
+    throw std::invalid_argument("--run-index " + std::to_string(m_a.run_index) +
+                                " is out of range (the study has " + std::to_string(m_runs.size()) +
+                                " runs: 0.." + std::to_string(m_runs.size() - 1) + ")");
+}
+
+std::string PairStudy::batchCommand() const {
+  return shellQuote(m_s.exe) + " pair --config " +
+         shellQuote((m_out / "config" / "pair.toml").string()) + " --out " +
+         shellQuote(m_out.string());
+}
+
+void PairStudy::emitSlurm() {
+  SlurmJob job;
+  job.name = m_c.name;
+  job.tasks = m_runs.size();
+  job.runs_per_K = m_c.runs;
+  job.K = m_c.K;
+  job.threads = m_a.threads > 0 ? m_a.threads : 4;
+  job.out = m_out;
+  job.study_command = batchCommand();
+  job.written_by = m_s.command_line;
+  const fs::path path = m_out / "batch.slurm";
+  writeText(path, slurmScript(job));
+  fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+  say("wrote " + path.string() + " (" + std::to_string(m_runs.size()) +
+      " array tasks + a follow-up job); submit with: bash " + path.string());
+}
+
+void PairStudy::runMd(std::vector<RunJob> all) {
+  // Which runs are finished (done.json with the same spec), which can restart from a checkpoint.
+  std::vector<RunJob> todo;
+  int done = 0;
+  for (RunJob& j : all) {
+    const fs::path marker = j.dir / "done.json";
+    if (fs::exists(marker)) {
+      if (recordOf(marker, j)) {
+        ++done;
+        say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": finished already, skipped",
+            false);
+        continue;
+      }
+      if (!m_a.force)
+        throw std::invalid_argument("run folder '" + j.dir.string() +
+                                    "' holds a run made with another configuration; choose another "
+                                    "--out or pass --force to redo it");
+    }
+    j.restart = fs::exists(j.dir / "checkpoint.h5") && fs::exists(j.dir / "traj.h5") &&
+                recordOf(j.dir / "run.json", j);
+    todo.push_back(j);
+  }
+  if (todo.empty()) {
+    if (m_a.run_index < 0) say("md: all " + std::to_string(all.size()) + " runs finished already");
+    return;
+  }
+  if (m_a.run_index < 0)
+    say("md: " + std::to_string(todo.size()) + " of " + std::to_string(all.size()) + " runs to do" +
+        (done ? " (" + std::to_string(done) + " finished already)" : ""));
+  std::stable_sort(todo.begin(), todo.end(),
+                   [](const RunJob& a, const RunJob& b) { return a.cost > b.cost; });
+
+  // Default: two OpenMP threads per run. The engine's one-thread path is currently several times
+  // slower per core than its two-thread path (measured 2026-11-23: N = 500 neutral, 1.9e5 vs
+  // 1.2e6 particle-steps/s), so one run per core loses on a 2-core machine.
+  const int default_jobs = std::max(1, m_cores / 2);
+  const int jobs = std::max(
+      1, std::min<int>(m_a.jobs > 0 ? m_a.jobs : default_jobs, static_cast<int>(todo.size())));
+  const int threads = m_a.threads > 0 ? m_a.threads : std::max(1, m_cores / jobs);
+  struct Running {
+    RunJob job;
+    clock::time_point start;
+  };
+  std::deque<RunJob> pending(todo.begin(), todo.end());
+  std::map<pid_t, Running> running;
+  std::vector<std::string> failed;
+  const bool tty = !m_a.quiet && ::isatty(2);
+  const auto t0 = clock::now();
+  std::size_t finished = 0;
+  auto progress = [&]() {
+    if (!tty) return;
+    std::fprintf(stderr,
+                 "\rpair: md %zu/%zu runs done, %zu running (%d jobs x %d threads), %.0f s   ",
+                 finished, todo.size(), running.size(), jobs, threads,
+                 std::chrono::duration<double>(clock::now() - t0).count());
+    std::fflush(stderr);
+  };
+  auto start = [&](RunJob j) {
+    fs::create_directories(j.dir);
+    std::vector<std::string> argv{m_s.exe, "md"};
+    if (j.restart) {
+      argv.insert(argv.end(), {"--restart", j.dir.string()});
+    } else {
+      // A fresh start: clear what an interrupted attempt left behind.
+      for (const char* f : {"traj.h5", "traj.xdmf", "checkpoint.h5", "done.json"})
+        fs::remove(j.dir / f);
+      nlohmann::ordered_json rec = runRecord(j);
+      rec["started"] = nowUtc();
+      writeText(j.dir / "run.json", rec.dump(2) + "\n");
+      argv.insert(argv.end(), {"--config", j.config.string(), "--seed", std::to_string(j.seed),
+                               "--out", j.dir.string(), "--force"});
+    }
+    argv.insert(argv.end(), {"--threads", std::to_string(threads), "-q"});
+    appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
+    appendText(j.log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
+    say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": " +
+            (j.restart ? "restarting from its checkpoint" : "started") + " (seed " +
+            std::to_string(j.seed) + ")",
+        !tty);
+    const pid_t pid = spawn(argv, j.log);
+    running[pid] = {j, clock::now()};
+  };
+
+  while (!pending.empty() || !running.empty()) {
+    while (!stopped() && static_cast<int>(running.size()) < jobs && !pending.empty()) {
+      start(pending.front());
+      pending.pop_front();
+    }
+    progress();
+    int st = 0;
+    const pid_t pid = ::waitpid(-1, &st, WNOHANG);
+    if (stopped()) {
+      // each run stops at the end of its chunk of steps with a checkpoint (granagg md handles
+      // the signal); the next pair resumes it from there (RunJob::restart)
+      const int sig = stopped();
+      for (auto& [p, r] : running) ::kill(p, SIGTERM);
+      if (tty) std::fprintf(stderr, "\n");
+      for (auto& [p, r] : running) {
+        int child = 0;
+        while (::waitpid(p, &child, 0) < 0 && errno == EINTR) {
+        }
+        say("md " + kName(r.job.K) + " run " + std::to_string(r.job.r) + ": stopped (" +
+            lastLine(r.job.log) + ")");
+      }
+      say("interrupted (signal " + std::to_string(sig) +
+          "): finished runs are kept, stopped runs continue from their checkpoints; run the "
+          "same command again to resume");
+      throw common::Interrupted("pair: interrupted; run the same command again to resume", sig);
+    }
+    if (pid == 0 || (pid < 0 && errno == EINTR)) {
+      ::usleep(200000);
+      continue;
+    }
+    if (pid < 0) throw std::runtime_error("waitpid failed: " + std::string(std::strerror(errno)));
+    auto it = running.find(pid);
+    if (it == running.end()) continue;
+    Running r = it->second;
+    running.erase(it);
+    const double wall = std::chrono::duration<double>(clock::now() - r.start).count();
+    const bool ok = WIFEXITED(st) && WEXITSTATUS(st) == 0;
+    const std::string name = kName(r.job.K) + " run " + std::to_string(r.job.r);
+    if (ok) {
+      nlohmann::ordered_json rec = runRecord(r.job);
+      rec["wall_seconds"] = wall;
+      rec["threads"] = threads;
+      rec["restarted"] = r.job.restart;
+      rec["finished"] = nowUtc();
+      rec["granagg"] = common::versionString();
+      writeText(r.job.dir / "done.json", rec.dump(2) + "\n");
+      ++finished;
+      m_changed_k.insert(kName(r.job.K));
+      if (tty) std::fprintf(stderr, "\r%100s\r", "");
+      say("md " + name + ": done in " + formatReal(std::round(wall * 10) / 10) + " s" +
+          (r.job.restart ? " (restarted)" : ""));
+    } else if (r.job.restart) {
+      // The checkpoint could not be continued (e.g. a trajectory cut by a kill): start afresh.
+      say("md " + name + ": restart failed (" + lastLine(r.job.log) + "); starting it afresh",
+          !tty);
+      r.job.restart = false;
+      pending.push_front(r.job);
+    } else {
+      ++finished;
+      const std::string why = WIFEXITED(st) ? "exit status " + std::to_string(WEXITSTATUS(st))
+                                            : "killed by signal " + std::to_string(WTERMSIG(st));
+      failed.push_back(name);
+      if (tty) std::fprintf(stderr, "\r%100s\r", "");
+      say("md " + name + ": FAILED (" + why + "): " + lastLine(r.job.log) +
+          " [log: " + r.job.log.string() + "]");
+    }
+  }
+  if (tty) std::fprintf(stderr, "\r%100s\r", "");
+  m_timing["md"] += std::chrono::duration<double>(clock::now() - t0).count();
+  if (!failed.empty()) {
+    std::string list;
+    for (const auto& f : failed) list += (list.empty() ? "" : ", ") + f;
+    throw std::runtime_error(
+        std::to_string(failed.size()) + " MD run(s) failed (" + list + "; logs in " +
+        (m_out / "logs").string() +
+        "); finished runs are kept: run the same command again to retry the others");
+  }
+}
+
+/// Runs one post-processing command (blocking); returns its exit status (127: could not run).
+int PairStudy::runStep(const std::string& label, std::vector<std::string> argv,
+                       const std::string& logname, bool quiet_failure) {
+  const fs::path log = m_out / "logs" / (logname + ".log");
+  appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
+  appendText(log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
+  if (!m_a.quiet && ::isatty(2)) {
+    std::fprintf(stderr, "\rpair: %s ...%40s\r", label.c_str(), "");
+    std::fflush(stderr);
+  }
+  const pid_t pid = spawn(argv, log);
+  int st = 0;
+  while (::waitpid(pid, &st, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error("waitpid failed");
+    if (stopped()) {
+      ::kill(pid, SIGTERM);
+      ::waitpid(pid, nullptr, 0);
+      throw common::Interrupted(
+          "pair: interrupted during " + label + "; run the same command again to resume",
+          stopped());
+    }
+  }
+  if (!m_a.quiet && ::isatty(2)) std::fprintf(stderr, "\r%100s\r", "");
+  const int rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  if (rc != 0 && !quiet_failure)
+    say(label + ": FAILED (exit status " + std::to_string(rc) + "): " + lastLine(log) +
+        " [log: " + log.string() + "]");
+  return rc;
+}
+
+void PairStudy::analyse() {
+  const auto t0 = clock::now();
+  for (double K : m_c.K) {
+    const std::string name = kName(K);
+    const fs::path dir = m_out / "analysis" / name, marker = m_out / "analysis" / (name + ".done");
+    std::vector<std::string> argv{m_s.exe, "analyze"};
+    std::string spec = "analyze";
+    for (const RunJob& j : m_runs)
+      if (j.K == K) {
+        argv.push_back(j.dir.string());
+        spec += " " + j.spec;
+      }
+    argv.insert(argv.end(), m_c.analysis_args.begin(), m_c.analysis_args.end());
+    for (const auto& x : m_c.analysis_args) spec += " " + x;
+    spec += "\n";
+    if (!m_changed_k.count(name) && stageDone(marker, spec) && fs::exists(dir / "S_t.csv")) {
+      say("analysis " + name + ": up to date, skipped", false);
+      continue;
+    }
+    fs::remove(marker);
+    fs::remove_all(dir);
+    argv.insert(argv.end(), {"--out", dir.string(), "--threads", std::to_string(m_cores), "-q"});
+    if (runStep("analysis " + name, argv, "analyze-" + name) == 0) {
+      writeText(marker, spec);
+      m_changed_k.insert(name);
+      say("analysis " + name + ": done (" + dir.string() + ")");
+    } else {
+      ++m_failures;
+      m_status["analysis " + name] = "failed";
+    }
+  }
+  m_timing["analysis"] += std::chrono::duration<double>(clock::now() - t0).count();
+}
+
+void PairStudy::meanField() {
+  const auto t0 = clock::now();
+  const fs::path dir = m_out / "meanfield";
+  fs::create_directories(dir);
+  // Kinetic theory with the neutral runs' contact parameters (or the first K's).
+  const MdPlan& ref = m_md.count(kName(0.0)) ? m_md.at(kName(0.0)) : m_md.at(kName(m_c.K.front()));
+  double kappa = ref.kappa;
+  for (double K : m_c.K)
+    if (K > 0) kappa = m_md.at(kName(K)).kappa;
+  double t_md = 0;
+  for (const auto& [n, plan] : m_md) t_md = std::max(t_md, plan.t_end);
+  struct Step {
+    std::string label, file;
+    std::vector<std::string> args;
+  };
+  std::vector<Step> steps;
+  for (double b : m_c.betas)
+    steps.push_back({"mean field S(t), beta = " + formatReal(b),
+                     "S_beta" + formatReal(b) + ".csv",
+                     {"smol", "--beta", formatReal(b), "--method", "sectional", "--t-end",
+                      formatReal(m_c.mf_t_end), "--s-end", formatReal(m_c.mf_s_end)}});
+  steps.push_back({"mean field z(beta)",
+                   "zbeta.csv",
+                   {"smol", "zbeta", "--beta-min", formatReal(m_c.zbeta_min), "--beta-max",
+                    formatReal(m_c.zbeta_max), "--count", std::to_string(m_c.zbeta_count)}});
+  steps.push_back({"kinetic theory: cooling",
+                   "cooling.csv",
+                   {"kinetic", "cooling", "--phi", formatReal(ref.phi), "--E", formatReal(ref.E),
+                    "--D", formatReal(ref.D), "--t-end", formatReal(std::max(t_md, 1.0))}});
+  steps.push_back({"kinetic theory: charging rate",
+                   "charging.csv",
+                   {"kinetic", "charging", "--kappa", formatReal(kappa)}});
+  int ok = 0;
+  for (const Step& s : steps) {
+    const fs::path out = dir / s.file, marker = dir / (s.file + ".done");
+    std::string spec;
+    for (const auto& x : s.args) spec += x + " ";
+    spec += "\n";
+    if (stageDone(marker, spec) && fs::exists(out)) {
+      ++ok;
+      continue;
+    }
+    fs::remove(marker);
+    std::vector<std::string> argv{m_s.exe};
+    argv.insert(argv.end(), s.args.begin(), s.args.end());
+    argv.insert(argv.end(), {"--out", out.string(), "--force"});
+    if (s.args[0] == "smol" && s.args[1] != "zbeta") argv.push_back("-q");
+    if (runStep(s.label, argv, "meanfield") == 0) {
+      writeText(marker, spec);
+      ++ok;
+    } else {
+      ++m_failures;
+    }
+  }
+  m_status["meanfield"] =
+      ok == static_cast<int>(steps.size()) ? "done" : "failed (see logs/meanfield.log)";
+  say("mean field: " + m_status["meanfield"] + " (" + dir.string() + ")");
+  m_timing["meanfield"] += std::chrono::duration<double>(clock::now() - t0).count();
+}
+
+void PairStudy::fitBeta() {
+  const auto t0 = clock::now();
+  if (!m_s.fit_available) {
+    m_status["fit"] = "skipped: this granagg has no fit-beta subcommand";
+    say("fit: skipped (this granagg build has no `fit-beta` subcommand; no beta is reported)");
+    return;
+  }
+  int ok = 0;
+  for (double K : m_c.K) {
+    const std::string name = kName(K);
+    const fs::path in = m_out / "analysis" / name, dir = m_out / "fit" / name,
+                   marker = m_out / "fit" / (name + ".done");
+    if (!fs::exists(in / "S_t.csv")) continue;
+    std::vector<std::string> argv{m_s.exe, "fit-beta", in.string()};
+    if (!m_c.fit_column.empty()) argv.insert(argv.end(), {"--column", m_c.fit_column});
+    if (!m_c.fit_window.empty())
+      argv.insert(argv.end(),
+                  {"--window", formatReal(m_c.fit_window[0]), formatReal(m_c.fit_window[1])});
+    const std::string spec = joinCommand(std::vector<std::string>(argv.begin() + 1, argv.end())) +
+                             " " + readText(m_out / "analysis" / (name + ".done"));
+    if (!m_changed_k.count(name) && stageDone(marker, spec) && fs::exists(dir / "fit_beta.json")) {
+      ++ok;
+      say("fit " + name + ": up to date, skipped", false);
+      continue;
+    }
+    fs::remove(marker);
+    fs::remove_all(dir);
+    fs::create_directories(dir.parent_path());
+    argv.insert(argv.end(), {"--out", dir.string(), "-q"});
+    const int rc = runStep("fit " + name, argv, "fit-" + name, /*quiet_failure=*/true);
+    if (rc == 0) {
+      writeText(marker, spec);
+      ++ok;
+      say("fit " + name + ": done (" + dir.string() + ")");
+    } else if (rc == 2) {
+      // fit-beta's "these data cannot be fitted" (e.g. S(t) that does not grow in a short run): a
+      // result to report, not a failure of the study.
+      std::string why = lastLine(m_out / "logs" / ("fit-" + name + ".log"));
+      if (why.rfind("granagg: error: ", 0) == 0) why = why.substr(16);
+      m_fit_note[name] = "not possible for these data: " + why;
+      say("fit " + name + ": not possible for these data (" + why + ")");
+    } else {
+      ++m_failures;
+      say("fit " + name + ": FAILED (exit status " + std::to_string(rc) +
+          ", log: " + (m_out / "logs" / ("fit-" + name + ".log")).string() + ")");
+    }
+  }
+  const std::size_t fitted = static_cast<std::size_t>(ok), nK = m_c.K.size();
+  m_status["fit"] = fitted == nK                      ? "done"
+                    : fitted + m_fit_note.size() < nK ? "failed for some K (see logs/fit-*.log)"
+                    : fitted > 0
+                        ? "done where the data allow a fit"
+                        : "not possible for these data (see each ensemble's fit_beta note)";
+  m_timing["fit"] += std::chrono::duration<double>(clock::now() - t0).count();
+}
+
+/// One Python stage (scripts/<script> with the study folder as its argument) that writes `made`;
+/// its failure is counted, not fatal.
+void PairStudy::pythonStage(const std::string& stage, const std::string& script,
+                            const fs::path& made) {
+  const auto t0 = clock::now();
+  const fs::path path = m_s.scripts / script;
+  if (!fs::exists(path)) {
+    m_status[stage] = "skipped: " + path.string() + " not found (set GRANAGG_SCRIPTS)";
+    say(stage + ": " + m_status[stage]);
+  } else if (runStep(stage, {m_s.python, path.string(), m_out.string()}, stage) == 0) {
+    m_status[stage] = "done";
+    say(stage + ": done (" + made.string() + ")");
+  } else {
+    m_status[stage] = "failed (see logs/" + stage + ".log)";
+    ++m_failures;
+  }
+  m_timing[stage] = std::chrono::duration<double>(clock::now() - t0).count();
+}
+
+/// The figures (scripts/plot_figures.py) and report.html (scripts/make_report.py, which reads
+/// summary.json): Python from Debian.
+void PairStudy::figures() {
+  if (m_a.no_figures) {
+    m_status["figures"] = m_status["report"] = "skipped (--no-figures)";
+    return;
+  }
+  pythonStage("figures", "plot_figures.py", m_out / "figures");
+  writeSummary();
+  pythonStage("report", "make_report.py", m_out / "report.html");
+}
+
+void PairStudy::run() {
+  prepareFolder();
+  for (const auto& [path, text] : m_md_text)
+    if (!fs::exists(path) || readText(path) != text) writeText(path, text);
+  const std::string resolved = toToml(m_c);
+  const fs::path cfgpath = m_out / "config" / "pair.toml";
+  if (m_a.run_index < 0 && (!fs::exists(cfgpath) || readText(cfgpath) != resolved))
+    writeText(cfgpath, resolved);
+  if (m_a.run_index >= 0 && !fs::exists(cfgpath)) writeText(cfgpath, resolved);
+
+  if (m_a.emit_batch == "slurm") {
+    emitSlurm();
+    return;
+  }
+  if (m_a.run_index >= 0) {  // one array task of a batch job
+    runMd({m_runs[static_cast<std::size_t>(m_a.run_index)]});
+    return;
+  }
+  say("study '" + m_c.name + "' -> " + m_out.string() + " (" + common::versionString() +
+      "; K = " + kList(m_c.K) + ", " + std::to_string(m_c.runs) + " runs each, " +
+      std::to_string(m_cores) + " cores)");
+  runMd(m_runs);
+  analyse();
+  meanField();
+  fitBeta();
+  m_status["md"] = "done";
+  writeSummary();
+  figures();
+  writeSummary();
+  printSummary();
+  if (m_failures > 0)
+    throw std::runtime_error(std::to_string(m_failures) + " post-processing step(s) failed (see " +
+                             (m_out / "pair.log").string() +
+                             "); run the same command again to retry them");
+}
+
+}  // namespace granagg::study

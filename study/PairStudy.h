@@ -1,0 +1,136 @@
+#pragma once
+/// \file PairStudy.h
+/// A paired MD / mean-field study (docs/pair.md): the MD ensembles (one `granagg md` process per
+/// run, up to `jobs` at a time, resumable), their analysis (`granagg analyze`), the mean field
+/// (`granagg smol`, `granagg kinetic`), the beta fit (`granagg fit-beta`), the figures and report
+/// (scripts/plot_figures.py, scripts/make_report.py) and summary.json. Every step is a subprocess
+/// of the granagg binary, with its output in DIR/logs/ and its command line in DIR/commands.txt;
+/// each run and stage leaves a record, so that the same request again resumes where it stopped.
+///
+/// The library includes none of md/, analysis/ or meanfield/: what it needs of them comes in
+/// StudyServices, wired by the command line (cli/PairCommand.cpp).
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "common/PaperValues.h"
+#include "study/PairConfig.h"
+
+namespace granagg::study {
+
+/// One ensemble's MD configuration, resolved by the MD library (StudyServices::resolve_md).
+struct MdPlan {
+  std::string toml;  ///< every key resolved (its hash identifies the runs made with it)
+  long long N = 0;
+  double phi = 0, t_end = 0, charging_Q = 0, kappa = 0, E = 0, D = 0;
+  double steps = 0;  ///< time steps to t_end (the job pool starts the longest runs first)
+};
+
+/// The growth regime of an ensemble's S(t) (analysis/stats/GrowthMarkers.h).
+struct GrowthSummary {
+  std::string regime = "unknown", reason;
+  double growth_factor = 0.0;
+};
+
+/// What a study needs from the rest of granagg.
+struct StudyServices {
+  std::string exe;           ///< the granagg binary that runs every step
+  std::string command_line;  ///< of this study's command, for provenance
+  std::string backend;       ///< the MD backend's description, for summary.json
+  /// The MD configuration file behind [md] preset = "name" (std::invalid_argument if unknown).
+  std::function<std::string(const std::string& name)> find_md_preset;
+  /// Base configuration file + `--set` assignments -> the resolved configuration (throws
+  /// std::invalid_argument for a bad key or value: before anything is written).
+  std::function<MdPlan(const std::string& base, const std::vector<std::string>& set)> resolve_md;
+  /// The regime of S(t) with its local slope z(t).
+  std::function<GrowthSummary(const std::vector<double>& t, const std::vector<double>& S,
+                              const std::vector<double>& z)>
+      classify_growth;
+  double flat_slope_tolerance = 0.1;   ///< relative spread of z(t) that still counts as flat
+  std::vector<std::string> data_dirs;  ///< where data/validation/verdict.csv is looked for
+  common::PaperValues paper;
+  bool fit_available = true;                         ///< this build has `granagg fit-beta`
+  const volatile std::sig_atomic_t* stop = nullptr;  ///< set (to the signal) to stop the study
+  std::filesystem::path scripts;                     ///< scripts/ (figures and report)
+  std::string python = "/usr/bin/python3";
+};
+
+/// What to do with the study (the command line's options).
+struct StudyRequest {
+  std::string out;         ///< "" : pair-<name>
+  std::string emit_batch;  ///< "slurm": write DIR/batch.slurm instead of running
+  int jobs = 0;            ///< MD runs at a time; 0: max(1, cores / 2)
+  int threads = 0;         ///< threads per run; 0: max(1, cores / jobs)
+  int run_index = -1;      ///< >= 0: run only this run (a batch array task)
+  bool force = false, quiet = false, no_figures = false;
+};
+
+/// One MD run of the study.
+struct RunJob {
+  double K = 0;
+  int r = 0;
+  long long seed = 0;
+  int index = 0;  ///< k * runs + r: the batch array index
+  std::filesystem::path dir, config, log;
+  std::string spec;  ///< the resolved configuration's hash and the seed: what a record must match
+  std::string
+      legacy_spec;  ///< the same with the hash of records made before 2026-12-02 (Process.h)
+  double cost = 0;  ///< particle-steps, x100 with Coulomb: longest first
+  bool restart = false;
+};
+
+class PairStudy {
+ public:
+  /// Checks the request and resolves every ensemble's MD configuration: bad input throws
+  /// std::invalid_argument before anything is written.
+  PairStudy(PairConfig config, StudyRequest request, StudyServices services);
+
+  /// Runs (or resumes) the study. A stop signal throws common::Interrupted once the runs have
+  /// stopped with their checkpoints; failed steps throw std::runtime_error at the end.
+  void run();
+
+  const std::filesystem::path& out() const { return m_out; }
+  const std::vector<RunJob>& runs() const { return m_runs; }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  void prepareFolder();
+  void say(const std::string& line, bool terminal = true);
+  std::string batchCommand() const;
+  void emitSlurm();
+  void runMd(std::vector<RunJob> jobs);
+  int runStep(const std::string& label, std::vector<std::string> argv, const std::string& logname,
+              bool quiet_failure = false);
+  void analyse();
+  void meanField();
+  void fitBeta();
+  void pythonStage(const std::string& stage, const std::string& script,
+                   const std::filesystem::path& made);
+  void figures();
+  void writeSummary();
+  void printSummary();
+  double seconds() const { return std::chrono::duration<double>(clock::now() - m_start).count(); }
+  int stopped() const { return m_s.stop ? static_cast<int>(*m_s.stop) : 0; }
+
+  PairConfig m_c;
+  StudyRequest m_a;
+  StudyServices m_s;
+  std::filesystem::path m_out;
+  int m_cores;
+  clock::time_point m_start;
+  std::map<std::string, MdPlan> m_md;            ///< per K name
+  std::map<std::string, std::string> m_md_text;  ///< path -> resolved MD TOML to write
+  std::vector<RunJob> m_runs;                    ///< every run of the study
+  std::set<std::string> m_changed_k;             ///< K names with a run (re)done now
+  std::map<std::string, double> m_timing;
+  std::map<std::string, std::string> m_status;    ///< step -> done / skipped: ... / failed: ...
+  std::map<std::string, std::string> m_fit_note;  ///< K name -> why fit-beta gave no result
+  int m_failures = 0;
+};
+
+}  // namespace granagg::study

@@ -1,0 +1,50 @@
+#pragma once
+/// \file Process.h
+/// What a study needs of the operating system: child processes with their output in a log,
+/// command lines a shell can repeat, and files written whole or not at all (POSIX; Linux's
+/// PR_SET_PDEATHSIG so that no child outlives an interrupted study).
+#include <sys/types.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace granagg::study {
+
+/// fork + exec of argv (argv[0] looked up in PATH) with stdout and stderr appended to `log` and
+/// stdin from /dev/null. The child gets SIGTERM when its parent dies. Status 127: could not run.
+pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& log);
+
+/// `a` quoted for a POSIX shell where it needs to be ('...' with ' escaped).
+std::string shellQuote(const std::string& a);
+/// argv as one line a shell runs as the same command.
+std::string joinCommand(const std::vector<std::string>& argv);
+
+/// The last non-empty line of a log ("" if none), after its last carriage return (progress).
+std::string lastLine(const std::filesystem::path& log);
+
+/// The path of the running executable (/proc/self/exe), "granagg" if unknown.
+std::string selfExe();
+/// Cores this process may run on (its affinity mask).
+int availableCores();
+/// The current UTC time, ISO 8601 to the second.
+std::string nowUtc();
+
+/// The whole file ("" when it does not exist).
+std::string readText(const std::filesystem::path& p);
+/// Writes p.tmp and renames it to p: a marker or record is either complete or absent. Creates
+/// p's folder if needed.
+void writeText(const std::filesystem::path& p, const std::string& text);
+void appendText(const std::filesystem::path& p, const std::string& text);
+
+/// The FNV-1a 64-bit offset basis (Fowler, Noll, Vo; draft-eastlake-fnv).
+constexpr std::uint64_t FNV1A_BASIS = 14695981039346656037ULL;
+/// Until 2026-12-02 the basis lacked its last digit (1469598103934665603): not FNV-1a, though as
+/// good a hash. Run records made then carry it; PairStudy still accepts them (RunJob).
+constexpr std::uint64_t LEGACY_HASH_BASIS = 1469598103934665603ULL;
+
+/// FNV-1a 64-bit hash as 16 hex digits: identifies a resolved configuration in a run's spec.
+std::string fnv1a(const std::string& s, std::uint64_t basis = FNV1A_BASIS);
+
+}  // namespace granagg::study
