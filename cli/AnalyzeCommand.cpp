@@ -232,6 +232,7 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
           file->writeGridFrame(k, f, g);
         };
       results.push_back(an::analyzeRun(a.runs[k], o, cb));
+      an::checkSameSystem(results.front(), results.back());  // before analysing the rest
     }
   } catch (...) {
     progress.done();

@@ -104,7 +104,8 @@ double key9(double x) {
   return std::round(x * scale) / scale;
 }
 
-/// The default S column: S_grid_mean, else S, else the only column besides t (and run).
+/// The default S column: S_grid_mean, else S_grid, else S, else the only column besides t (and
+/// run).
 std::string defaultColumn(const Columns& c, const std::string& input) {
   for (const char* n : {"S_grid_mean", "S_grid", "S"})
     if (c.has(n)) return n;
@@ -689,10 +690,12 @@ void registerFitBetaCommand(CLI::App& app, const CliContext& ctx) {
                 "a CSV with a t column "
                 "and S column(s)")
       ->required();
-  c->add_option("--column", args->column,
-                "S column (default: S_grid_mean, else S, else the only column besides t); a prefix "
-                "(e.g. S_run) takes "
-                "every matching column as one run");
+  c->add_option(
+      "--column", args->column,
+      "S column (default: S_grid_mean, else S_grid (per_run tables), else S, else the only "
+      "column besides t); a prefix "
+      "(e.g. S_run) takes "
+      "every matching column as one run");
   c->add_option("--window", args->window,
                 "Fit window T0 T1 for z (default: automatic, the late plateau of the local slope)")
       ->expected(2);

@@ -11,6 +11,39 @@
 #include "common/Csv.h"
 #include "common/Version.h"
 
+namespace {
+
+/// CLI11 reports an unknown word where a subcommand is expected as "A subcommand is required"
+/// (top level, `kinetic`) or "The following argument was not expected": this names the word and
+/// the subcommands available there, the same at every level. "" when the words are known (or the
+/// level takes positional arguments, whose checks are CLI11's).
+std::string unknownSubcommand(const CLI::App& app, int argc, const char* const* argv) {
+  const CLI::App* level = &app;
+  std::string path = "granagg";
+  for (int k = 1; k < argc && argv[k][0] != '-'; ++k) {
+    const auto subs = level->get_subcommands({});
+    if (subs.empty()) break;
+    const CLI::App* next = nullptr;
+    std::string names;
+    for (const CLI::App* sub : subs) {
+      if (sub->check_name(argv[k])) next = sub;
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!next) {
+      const bool positionals =
+          !level->get_options([](const CLI::Option* o) { return o->get_positional(); }).empty();
+      if (positionals) break;
+      return "unknown subcommand '" + std::string(argv[k]) + "' of '" + path +
+             "' (available: " + names + "; see " + path + " --help)";
+    }
+    level = next;
+    path += " " + next->get_name();
+  }
+  return "";
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace granagg;
   cli::CliContext ctx{common::commandLine(argc, argv)};
@@ -32,19 +65,9 @@ int main(int argc, char** argv) {
   cli::registerAnalyzeCommand(app, ctx);
   cli::registerPairCommand(app, ctx);
 
-  // CLI11 reports an unknown first word only as "A subcommand is required": name it instead.
-  if (argc >= 2 && argv[1][0] != '-') {
-    bool known = false;
-    std::string names;
-    for (const CLI::App* sub : app.get_subcommands({})) {
-      known |= sub->check_name(argv[1]);
-      names += (names.empty() ? "" : ", ") + sub->get_name();
-    }
-    if (!known) {
-      std::fprintf(stderr, "granagg: error: unknown subcommand '%s' (available: %s; see --help)\n",
-                   argv[1], names.c_str());
-      return 2;
-    }
+  if (const std::string unknown = unknownSubcommand(app, argc, argv); !unknown.empty()) {
+    std::fprintf(stderr, "granagg: error: %s\n", unknown.c_str());
+    return 2;
   }
 
   try {

@@ -22,9 +22,23 @@ LammpsDump::LammpsDump(const std::string& path, double dt) : m_path(path), m_dt(
                                 common::formatReal(dt));
 }
 
-void LammpsDump::error(const std::string& what) const {
-  throw TrajectoryError(m_path, m_frame, what + " (line " + std::to_string(m_line) + ")");
+void LammpsDump::error(const std::string& what) const { errorAt(m_line, what); }
+
+void LammpsDump::errorAt(std::size_t line, const std::string& what) const {
+  throw TrajectoryError(m_path, m_frame, what + " (line " + std::to_string(line) + ")");
 }
+
+namespace {
+
+/// A line for an error message: at most `max` characters, quoted; a line with bytes that are not
+/// printable text is not echoed (a binary file would print garbage to the terminal).
+std::string quoted(const std::string& line, std::size_t max) {
+  for (unsigned char c : line)
+    if ((c < 0x20 && c != '\t') || c >= 0x7f) return "binary data (not a text dump)";
+  return "'" + (line.size() > max ? line.substr(0, max) + "..." : line) + "'";
+}
+
+}  // namespace
 
 bool LammpsDump::getLine(std::string& line) {
   if (!std::getline(m_in, line)) return false;
@@ -50,25 +64,24 @@ bool LammpsDump::next(Frame& f) {
       error(std::string("file ends inside the frame header (expected ") + what + ")");
   };
   while (true) {
-    if (line.rfind("ITEM:", 0) != 0)
-      error("expected an 'ITEM:' line, found '" + line.substr(0, 60) + "'");
+    if (line.rfind("ITEM:", 0) != 0) error("expected an 'ITEM:' line, found " + quoted(line, 60));
     const std::string item = common::trim(line.substr(5));
     if (item == "TIMESTEP") {
       need(line, "the timestep");
       char* end = nullptr;
       errno = 0;
       step = std::strtoll(line.c_str(), &end, 10);
-      if (errno || end == line.c_str()) error("bad timestep '" + line + "'");
+      if (errno || end == line.c_str()) error("bad timestep " + quoted(line, 40));
       have_step = true;
     } else if (item == "TIME") {
       need(line, "the time");
-      if (!common::parseReal(common::trim(line), time)) error("bad time '" + line + "'");
+      if (!common::parseReal(common::trim(line), time)) error("bad time " + quoted(line, 40));
       have_time = true;
     } else if (item == "NUMBER OF ATOMS") {
       need(line, "the number of atoms");
       char* end = nullptr;
       const long long v = std::strtoll(line.c_str(), &end, 10);
-      if (end == line.c_str() || v <= 0) error("bad number of atoms '" + line + "'");
+      if (end == line.c_str() || v <= 0) error("bad number of atoms " + quoted(line, 40));
       n = static_cast<std::size_t>(v);
       have_n = true;
     } else if (item.rfind("BOX BOUNDS", 0) == 0) {
@@ -81,7 +94,8 @@ bool LammpsDump::next(Frame& f) {
       for (int d = 0; d < 3; ++d) {
         need(line, "the box bounds");
         std::istringstream is(line);
-        if (!(is >> lo[d] >> hi[d]) || !(hi[d] > lo[d])) error("bad box bounds '" + line + "'");
+        if (!(is >> lo[d] >> hi[d]) || !(hi[d] > lo[d]))
+          error("bad box bounds " + quoted(line, 60));
       }
       have_box = true;
     } else if (item.rfind("ATOMS", 0) == 0) {
@@ -134,17 +148,19 @@ bool LammpsDump::next(Frame& f) {
   std::vector<double> pos(3 * n), vel(has_vel ? 3 * n : 0), q(c_q >= 0 ? n : 0);
   std::vector<std::int32_t> img(3 * n, 0);
   std::vector<double> values(cols.size());
+  std::vector<std::size_t> line_of(n);  // each atom's line, for errors found after reading
   for (std::size_t a = 0; a < n; ++a) {
     if (!getLine(line))
       error("file ends after " + std::to_string(a) + " of " + std::to_string(n) +
             " atoms (truncated dump?)");
+    line_of[a] = m_line;
     const char* p = line.c_str();
     for (std::size_t c = 0; c < cols.size(); ++c) {
       char* end = nullptr;
       values[c] = std::strtod(p, &end);
       if (end == p)
         error("atom line has " + std::to_string(c) + " of " + std::to_string(cols.size()) +
-              " values: '" + line.substr(0, 80) + "'");
+              " values: " + quoted(line, 80));
       p = end;
     }
     ids[a] = c_id >= 0 ? static_cast<std::int64_t>(values[c_id]) : static_cast<std::int64_t>(a);
@@ -161,11 +177,13 @@ bool LammpsDump::next(Frame& f) {
   // Sort by id (LAMMPS writes atoms in processor order).
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
+  std::stable_sort(order.begin(), order.end(),  // stable: a repeated id is named at its 2nd line
+                   [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
   for (std::size_t k = 1; k < n; ++k)
     if (ids[order[k]] == ids[order[k - 1]])
-      error("atom id " + std::to_string(ids[order[k]]) + " appears twice");
+      errorAt(line_of[order[k]], "atom id " + std::to_string(ids[order[k]]) +
+                                     " appears twice (also on line " +
+                                     std::to_string(line_of[order[k - 1]]) + ")");
 
   const common::Box box{L};
   const bool images = has_img || kind == UNWRAPPED;
@@ -184,7 +202,8 @@ bool LammpsDump::next(Frame& f) {
     f.id[k] = ids[a];
     for (int d = 0; d < 3; ++d) {
       double x = pos[3 * a + d];
-      if (!std::isfinite(x)) error("atom " + std::to_string(ids[a]) + " has a non-finite position");
+      if (!std::isfinite(x))
+        errorAt(line_of[a], "atom " + std::to_string(ids[a]) + " has a non-finite position");
       const int shift = box.wrap(x);
       f.position[3 * k + d] = x;
       if (images) f.image[3 * k + d] = img[3 * a + d] + shift;

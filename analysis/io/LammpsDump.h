@@ -30,7 +30,8 @@ class LammpsDump final : public TrajectoryReader {
   std::string format() const override { return "lammps-dump"; }
 
  private:
-  [[noreturn]] void error(const std::string& what) const;
+  [[noreturn]] void error(const std::string& what) const;  ///< at the line just read
+  [[noreturn]] void errorAt(std::size_t line, const std::string& what) const;
   bool getLine(std::string& line);
 
   std::string m_path;

@@ -305,6 +305,7 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       if (!reader->next(f)) break;
       if (first) {
         n_particles = f.size();
+        r.box = f.box;
       } else if (f.size() != n_particles) {
         throw TrajectoryError(reader->path(), f.index,
                               "has " + std::to_string(f.size()) +
@@ -501,8 +502,22 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   return r;
 }
 
+void checkSameSystem(const RunResult& a, const RunResult& b) {
+  if (a.particles != b.particles)
+    throw std::invalid_argument("runs '" + a.source + "' (N = " + std::to_string(a.particles) +
+                                ") and '" + b.source + "' (N = " + std::to_string(b.particles) +
+                                ") simulate different systems: an ensemble averages runs of one "
+                                "system (same N and box); analyse them separately");
+  if (std::fabs(a.box - b.box) > 1e-9 * std::max(a.box, b.box))
+    throw std::invalid_argument("runs '" + a.source + "' (box L = " + common::formatReal(a.box) +
+                                ") and '" + b.source + "' (box L = " + common::formatReal(b.box) +
+                                ") simulate different systems: an ensemble averages runs of one "
+                                "system (same N and box); analyse them separately");
+}
+
 std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const AnalysisOptions& o) {
   if (runs.empty()) throw std::invalid_argument("analyzeEnsemble needs at least one run.");
+  for (const RunResult& r : runs) checkSameSystem(runs.front(), r);
   std::vector<Table> out;
   // Averages of every per-frame table present in all runs.
   for (const Table& t : runs.front().tables) {

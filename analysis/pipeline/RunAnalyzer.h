@@ -55,6 +55,7 @@ struct RunResult {
   std::string source;  ///< the path given
   std::string format;  ///< "h5md" or "lammps-dump"
   std::size_t frames = 0, particles = 0;
+  double box = 0.0;      ///< box edge L of the first frame, in d
   bool partial = false;  ///< stopped at a bad frame (--allow-partial)
   std::string partial_reason;
   std::map<std::string, std::string> parameters;  ///< the file's /parameters
@@ -81,6 +82,10 @@ struct RunCallbacks {
 /// was read; std::invalid_argument for a missing file or bad options.
 RunResult analyzeRun(const std::string& path, const AnalysisOptions& options,
                      const RunCallbacks& callbacks = {});
+
+/// Throws std::invalid_argument naming both runs when they do not simulate the same system (a
+/// different particle count N or box edge L): an ensemble's statistics average runs of one system.
+void checkSameSystem(const RunResult& a, const RunResult& b);
 
 /// Ensemble tables over runs: every per-frame table averaged (mean, standard error; rows matched
 /// by time), the ensemble growth and charging fits (bootstrap over runs when there are 2 or

@@ -1,10 +1,15 @@
 #include "md/io/InitialState.h"
 
 #include <sys/stat.h>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -156,6 +161,237 @@ Frame readInitialStateCsv(const std::string& path, double box) {
   return f;
 }
 
+namespace {
+
+/// One line of a LAMMPS data file: its number, its words (comment removed) and the comment.
+struct DataLine {
+  std::size_t number = 0;
+  std::vector<std::string> words;
+  std::string comment;
+};
+
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+}  // namespace
+
+bool isLammpsData(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  for (int k = 0; k < 50 && std::getline(in, line); ++k) {
+    if (k == 0) continue;  // the title line may say anything
+    const auto w = words(line.substr(0, line.find('#')));
+    if (w.size() == 2 && w[1] == "atoms" &&
+        w[0].find_first_not_of("0123456789") == std::string::npos)
+      return true;
+  }
+  return false;
+}
+
+Frame readInitialStateLammps(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("initial state file '" + path + "' cannot be read");
+  // the header (up to the first section keyword), then the sections by name
+  std::vector<DataLine> header;
+  std::map<std::string, std::vector<DataLine>> sections;
+  std::map<std::string, DataLine> keyword;  // section name -> its keyword line
+  std::string current, line;
+  for (std::size_t n = 1; std::getline(in, line); ++n) {
+    if (n == 1) continue;  // title
+    const std::size_t hash = line.find('#');
+    DataLine d{n, words(line.substr(0, hash)),
+               hash == std::string::npos ? "" : common::trim(line.substr(hash + 1))};
+    if (d.words.empty()) continue;
+    if (std::isalpha(static_cast<unsigned char>(d.words[0][0]))) {  // a section keyword
+      current = common::join(d.words, " ");
+      if (keyword.count(current))
+        throw std::invalid_argument(path + ":" + std::to_string(n) + ": section '" + current +
+                                    "' appears twice");
+      keyword[current] = d;
+      sections[current];
+      continue;
+    }
+    (current.empty() ? header : sections[current]).push_back(d);
+  }
+  auto at = [&](const DataLine& d) { return path + ":" + std::to_string(d.number) + ": "; };
+  auto real = [&](const DataLine& d, std::size_t k, const char* what) {
+    double v = 0.0;
+    if (!common::parseReal(d.words[k], v) || !std::isfinite(v))
+      throw std::invalid_argument(at(d) + what + " '" + d.words[k] + "' is not a finite number");
+    return v;
+  };
+  auto integer = [&](const DataLine& d, std::size_t k, const char* what) {
+    const std::string& w = d.words[k];
+    char* end = nullptr;
+    errno = 0;
+    const long long v = std::strtoll(w.c_str(), &end, 10);
+    if (w.empty() || *end != '\0' || errno == ERANGE)
+      throw std::invalid_argument(at(d) + what + " '" + w + "' is not an integer");
+    return v;
+  };
+
+  long long n_atoms = -1;
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  bool has_box[3] = {false, false, false};
+  for (const DataLine& d : header) {
+    const auto& w = d.words;
+    if (w.size() == 2 && w[1] == "atoms") {
+      n_atoms = integer(d, 0, "atom count");
+    } else if (w.size() == 6 && w[3] == "xy") {
+      throw std::invalid_argument(at(d) + "a triclinic box (xy xz yz); granagg's box is cubic");
+    } else if (w.size() == 4 && w[2].size() == 3 && w[2].compare(1, 2, "lo") == 0 &&
+               w[3].size() == 3 && w[3].compare(1, 2, "hi") == 0 && w[2][0] == w[3][0] &&
+               w[2][0] >= 'x' && w[2][0] <= 'z') {  // "xlo xhi"
+      const int a = w[2][0] - 'x';
+      lo[a] = real(d, 0, "box bound");
+      hi[a] = real(d, 1, "box bound");
+      has_box[a] = true;
+    }
+  }
+  if (n_atoms < 0) throw std::invalid_argument(path + ": no 'N atoms' line in the header");
+  for (int a = 0; a < 3; ++a)
+    if (!has_box[a])
+      throw std::invalid_argument(path + ": no '" + std::string(1, "xyz"[a]) + "lo " + "xyz"[a] +
+                                  "hi' line in the header");
+  const double L = hi[0] - lo[0];
+  for (int a = 0; a < 3; ++a)
+    if (!(hi[a] - lo[a] > 0.0) || std::fabs((hi[a] - lo[a]) - L) > 1e-12 * L)
+      throw std::invalid_argument(path + ": the box must be cubic with positive edges (got " +
+                                  common::formatReal(hi[0] - lo[0]) + " x " +
+                                  common::formatReal(hi[1] - lo[1]) + " x " +
+                                  common::formatReal(hi[2] - lo[2]) + ")");
+  if (!sections.count("Atoms")) throw std::invalid_argument(path + ": no Atoms section");
+  if (!sections.count("Velocities"))
+    throw std::invalid_argument(path +
+                                ": no Velocities section (an initial state needs velocities)");
+  const auto& atoms = sections["Atoms"];
+  if (static_cast<long long>(atoms.size()) != n_atoms)
+    throw std::invalid_argument(at(keyword["Atoms"]) + "the Atoms section has " +
+                                std::to_string(atoms.size()) + " lines, the header says " +
+                                std::to_string(n_atoms) + " atoms");
+  checkMinimumSize(atoms.size(), path);
+
+  // the atom style: named after `Atoms #`, else told by the column count (with or without
+  // image flags); columns of x and of diameter, density, q (-1: absent)
+  struct Style {
+    const char* name;
+    std::size_t columns;
+    int x, diameter, density, q;
+  };
+  static const Style STYLES[] = {{"sphere", 7, 4, 2, 3, -1},
+                                 {"charge", 6, 3, -1, -1, 2},
+                                 {"atomic", 5, 2, -1, -1, -1},
+                                 {"hybrid", 8, 2, 5, 6, 7}};
+  const std::string named =
+      words(keyword["Atoms"].comment).empty() ? std::string() : words(keyword["Atoms"].comment)[0];
+  const std::size_t ncol = atoms.front().words.size();
+  const Style* style = nullptr;
+  for (const Style& s : STYLES)
+    if (named.empty() ? (ncol == s.columns || ncol == s.columns + 3) : named == s.name) style = &s;
+  if (!style)
+    throw std::invalid_argument(
+        at(keyword["Atoms"]) +
+        (named.empty() ? "atom style not named and " + std::to_string(ncol) +
+                             " columns fit none of sphere, charge, atomic, hybrid sphere charge"
+                       : "atom style '" + named +
+                             "' is not read (sphere, charge, atomic, hybrid sphere charge)"));
+  const bool images = ncol == style->columns + 3;
+  if (ncol != style->columns && !images)
+    throw std::invalid_argument(at(atoms.front()) + "atom style " + style->name + " has " +
+                                std::to_string(style->columns) + " columns (+3 image flags), " +
+                                "this line " + std::to_string(ncol));
+
+  // type masses (charge, atomic: Masses; sphere: diameter and density)
+  std::map<long long, double> mass;
+  for (const DataLine& d : sections["Masses"]) {
+    if (d.words.size() < 2) throw std::invalid_argument(at(d) + "a Masses line is 'type mass'");
+    mass[integer(d, 0, "atom type")] = real(d, 1, "mass");
+  }
+  constexpr double UNIT_DENSITY = 6.0 / M_PI;  // mass 1 at diameter 1
+  std::map<long long, std::size_t> by_id;      // id -> line index in `atoms`
+  for (std::size_t i = 0; i < atoms.size(); ++i) {
+    const DataLine& d = atoms[i];
+    if (d.words.size() != ncol)
+      throw std::invalid_argument(at(d) + "expected " + std::to_string(ncol) +
+                                  " columns as on the first Atoms line, got " +
+                                  std::to_string(d.words.size()));
+    const long long id = integer(d, 0, "atom id");
+    if (!by_id.emplace(id, i).second)
+      throw std::invalid_argument(at(d) + "atom id " + std::to_string(id) + " appears twice");
+    const long long type = integer(d, 1, "atom type");
+    if (style->diameter >= 0) {
+      const double dia = real(d, style->diameter, "diameter"),
+                   rho = real(d, style->density, "density");
+      if (std::fabs(dia - 1.0) > 1e-9)
+        throw std::invalid_argument(at(d) + "atom " + std::to_string(id) + ": diameter " +
+                                    common::formatReal(dia) +
+                                    " (granagg's particles have diameter 1)");
+      if (std::fabs(rho / UNIT_DENSITY - 1.0) > 1e-6)
+        throw std::invalid_argument(at(d) + "atom " + std::to_string(id) + ": density " +
+                                    common::formatReal(rho) +
+                                    " (granagg's particles have mass 1: density 6/pi = " +
+                                    common::formatReal(UNIT_DENSITY) + ")");
+    } else if (mass.count(type) && std::fabs(mass[type] - 1.0) > 1e-9) {
+      throw std::invalid_argument(
+          at(d) + "atom " + std::to_string(id) + ": type " + std::to_string(type) + " has mass " +
+          common::formatReal(mass[type]) + " (granagg's particles have mass 1)");
+    }
+  }
+  const auto& vels = sections["Velocities"];
+  std::map<long long, const DataLine*> vel_of;
+  for (const DataLine& d : vels) {
+    if (d.words.size() < 4)
+      throw std::invalid_argument(at(d) + "a Velocities line is 'id vx vy vz [...]'");
+    const long long id = integer(d, 0, "atom id");
+    if (!by_id.count(id))
+      throw std::invalid_argument(at(d) + "velocity of atom " + std::to_string(id) +
+                                  ", which is not in the Atoms section");
+    if (!vel_of.emplace(id, &d).second)
+      throw std::invalid_argument(at(d) + "atom " + std::to_string(id) + " has two velocity lines");
+  }
+
+  Frame f;
+  f.box = L;
+  const std::size_t n = atoms.size();
+  for (auto* v : {&f.x, &f.y, &f.z, &f.vx, &f.vy, &f.vz, &f.charge}) v->resize(n);
+  for (auto* v : {&f.ix, &f.iy, &f.iz}) v->assign(n, 0);
+  std::size_t i = 0;
+  for (const auto& [id, k] : by_id) {  // particle i: the i-th smallest id
+    const DataLine& d = atoms[k];
+    f.x[i] = real(d, style->x, "x") - lo[0];
+    f.y[i] = real(d, style->x + 1, "y") - lo[1];
+    f.z[i] = real(d, style->x + 2, "z") - lo[2];
+    f.charge[i] = style->q >= 0 ? real(d, style->q, "q") : 0.0;
+    if (images) {
+      std::int32_t* im[3] = {&f.ix[i], &f.iy[i], &f.iz[i]};
+      for (int a = 0; a < 3; ++a) {
+        const long long v = integer(d, style->columns + a, "image flag");
+        if (v < -(1LL << 30) || v > (1LL << 30))
+          throw std::invalid_argument(at(d) + "image flag " + std::to_string(v) + " too large");
+        *im[a] = static_cast<std::int32_t>(v);
+      }
+    }
+    const auto v = vel_of.find(id);
+    if (v == vel_of.end())
+      throw std::invalid_argument(at(keyword["Velocities"]) + "atom " + std::to_string(id) +
+                                  " has no velocity line");
+    f.vx[i] = real(*v->second, 1, "vx");
+    f.vy[i] = real(*v->second, 2, "vy");
+    f.vz[i] = real(*v->second, 3, "vz");
+    ++i;
+  }
+  try {
+    wrapIntoBox(f);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(path + ": " + e.what());
+  }
+  return f;
+}
+
 Frame readInitialStateH5md(const std::string& path, long frame, const std::string& particle_group) {
   H5mdReader r(path, particle_group);
   const long nf = static_cast<long>(r.frames());
@@ -190,6 +426,7 @@ Frame readInitialState(const std::string& path, double box_if_csv) {
   const htri_t is_h5 = H5Fis_hdf5(path.c_str());
   h5::lastError();  // clear whatever H5Fis_hdf5 left on the stack
   if (is_h5 > 0) return readInitialStateH5md(path);
+  if (isLammpsData(path)) return readInitialStateLammps(path);
   return readInitialStateCsv(path, box_if_csv);
 }
 

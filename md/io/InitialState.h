@@ -17,6 +17,22 @@
 ///
 /// H5MD input: any H5MD 1.1 file H5mdReader accepts (ours or another engine's); the last frame
 /// by default. Velocities are required; missing charges are zero; the box is the file's.
+///
+/// LAMMPS data file (the `read_data` / `write_data` format), so that one starting configuration
+/// runs in LAMMPS and in granagg: a title line, a header with "N atoms" and a cubic box ("xlo xhi"
+/// etc.; no tilt factors), an `Atoms` section and a `Velocities` section (required). Atom styles,
+/// named by the comment after `Atoms` as write_data writes it, or else told by the column count:
+///
+///     sphere   id type diameter density x y z [ix iy iz]
+///     charge   id type q x y z [ix iy iz]
+///     atomic   id type x y z [ix iy iz]
+///     hybrid   id type x y z diameter density q [ix iy iz]   (atom_style hybrid sphere charge)
+///
+/// granagg's particles are unit spheres of unit mass: a diameter must be 1 and a density 6/pi
+/// (sphere), a type's mass in `Masses` 1 (charge, atomic). Atoms are ordered by id (ids need not
+/// be contiguous); velocities are matched by id (angular velocities are ignored); positions are
+/// shifted by -xlo and wrapped, image flags added. Charges are taken as written, in granagg's
+/// reduced charge unit (K q_i q_j / r is the pair energy in T0).
 #include <cstdint>
 #include <string>
 
@@ -25,8 +41,9 @@
 namespace granagg::md {
 
 /// Reads an initial state from `path`, detected by content: an HDF5 file is read as H5MD (its
-/// last frame, its own box; `box_if_csv` is ignored), anything else as CSV in a cubic box of edge
-/// `box_if_csv` (> 0, reduced length units). The result has N >= 2 particles, finite values and
+/// last frame, its own box; `box_if_csv` is ignored), a file whose header holds an "N atoms" line
+/// as a LAMMPS data file (its own box), anything else as CSV in a cubic box of edge `box_if_csv`
+/// (> 0, reduced length units). The result has N >= 2 particles, finite values and
 /// positions wrapped into [0, L) with image counts. Step and time are 0 for CSV and the frame's
 /// for H5MD (the engine may reset them).
 /// Throws std::invalid_argument for bad values (naming the file, line or particle index) and for
@@ -36,6 +53,13 @@ Frame readInitialState(const std::string& path, double box_if_csv);
 /// CSV branch of readInitialState: columns as described above, box edge `box` > 0.
 /// Errors name the file and line ("init.csv:7: particle 4: vx = nan is not finite").
 Frame readInitialStateCsv(const std::string& path, double box);
+
+/// LAMMPS data file branch of readInitialState (format above). Errors name the file and line
+/// ("state.data:14: atom 3: diameter 2 (granagg's particles have diameter 1)").
+Frame readInitialStateLammps(const std::string& path);
+
+/// Whether `path` looks like a LAMMPS data file: an "N atoms" line among its first 50 lines.
+bool isLammpsData(const std::string& path);
 
 /// H5MD branch of readInitialState: frame `frame` (negative counts from the end, -1 = last) of
 /// the particle group `particle_group` ("" = the first group under /particles).

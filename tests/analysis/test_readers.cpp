@@ -179,8 +179,21 @@ TEST_CASE(
         "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 5\n0 6\n0 "
         "5\nITEM: ATOMS id x y z\n",
         "not cubic");
-    expectError(head + "ITEM: ATOMS id x y z\n1 1 1 1\n1 2 2 2\n", "appears twice");
+    // errors found after the frame is read name the atom's own line, not the frame's last
+    expectError(head + "ITEM: ATOMS id x y z\n1 1 1 1\n1 2 2 2\n",
+                "atom id 1 appears twice (also on line 10) (line 11)");
+    expectError(head + "ITEM: ATOMS id x y z\n1 1 1 1\n2 nan 2 2\n",
+                "non-finite position (line 11)");
     expectError("ITEM: TIMESTEP\n0\nITEM: NUMBER OF", "frame 0");
+    // a binary file: said so, its bytes not echoed
+    std::string bytes = "\x01\x02\xff\xfe\x89 garbage\n\x7f\x80";
+    expectError(bytes, "binary data (not a text dump)");
+    const std::string p = (dir / "bad.dump").string();
+    try {
+      analyzeRun(p, fastOptions());
+    } catch (const std::exception& e) {
+      CHECK(std::string(e.what()).find('\x89') == std::string::npos);
+    }
   }
   fs::remove_all(dir);
 }

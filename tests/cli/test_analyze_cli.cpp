@@ -109,6 +109,14 @@ TEST_CASE(
                                (dir / "o4").string() + " -q");
   CHECK(twice.status == 2);
   CHECK_THAT(twice.output, Catch::Contains("given twice"));
+  // runs of different systems (N = 300 and a 3-atom dump) are not one ensemble
+  const std::string other = tinyDump(dir, false);
+  const Run mixed = runGranagg("analyze " + run.string() + " " + other + " --out " +
+                               (dir / "o5").string() + " -q");
+  CHECK(mixed.status == 2);
+  CHECK_THAT(mixed.output, Catch::Contains("(N = 300)") && Catch::Contains("(N = 3)") &&
+                               Catch::Contains("different systems"));
+  CHECK_FALSE(fs::exists(dir / "o5"));
   fs::remove_all(dir);
 }
 

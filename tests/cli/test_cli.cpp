@@ -49,7 +49,13 @@ TEST_CASE("bad input gives one line naming the option and exit status 2", "[cli]
         Case{"smol --ratio 1", "--ratio"},
         Case{"smol --kernel multiplicative --t-end 2", "gel time"},
         Case{"smol zbeta --count 0", "--count"}, Case{"smol zbeta --beta-min -2", "--beta-min"},
-        Case{"smol --no-such-option", "no-such-option"}, Case{"frobnicate", "frobnicate"},
+        Case{"smol --no-such-option", "no-such-option"},
+        // an unknown subcommand is named the same way at every level, with what is available
+        Case{"frobnicate", "unknown subcommand 'frobnicate' of 'granagg' (available: md,"},
+        Case{"kinetic foo",
+             "unknown subcommand 'foo' of 'granagg kinetic' (available: "
+             "restitution, haff"},
+        Case{"smol foo", "unknown subcommand 'foo' of 'granagg smol' (available: zbeta"},
         Case{"kinetic restitution --v 1,,2", "--v"}, Case{"kinetic restitution --v 1,", "--v"},
         Case{"kinetic restitution --v 0", "--v"},
         Case{"smol --method mono --t-end 1e300 --per-decade 10000", "--per-decade"}}) {

@@ -1,10 +1,13 @@
 // User-given initial states: CSV (columns, comments, wrapping into the caller's box, errors
-// naming the line and particle) and H5MD (last frame of a trajectory), plus coordinate wrapping.
+// naming the line and particle), H5MD (last frame of a trajectory) and LAMMPS data files (the
+// same state as a CSV to the bit; styles, ids, image flags, errors), plus coordinate wrapping.
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -190,4 +193,108 @@ TEST_CASE("H5MD initial state: the last frame of a trajectory, exactly", "[md][i
   CHECK_THROWS_WITH(readInitialState(path, 1.0), Catch::Contains("no velocities"));
   std::remove(path.c_str());
   std::remove(H5mdWriter::xdmfPathFor(path).c_str());
+}
+
+TEST_CASE("LAMMPS data initial state: the same state as the CSV written beside it, to the bit",
+          "[md][io]") {
+  // scripts/lammps/make_state.py writes one random state both ways (the LAMMPS benchmarks' input,
+  // repr floats in both): atom_style sphere for a neutral gas, hybrid sphere charge for +-1
+  const std::string dir = tempPath("lmpstate");
+  std::filesystem::create_directories(dir);
+  for (const bool charged : {false, true}) {
+    const std::string cmd = "/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) +
+                            "/scripts/lammps/make_state.py 200 0.076 " + dir +
+                            (charged ? " --charged" : "");
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    const Frame a = readInitialState(dir + "/state_200.data", 1.0);  // box: the file's
+    const double L = std::cbrt(200 * M_PI / (6 * 0.076));
+    const Frame b = readInitialState(dir + "/state_200.csv", L);
+    REQUIRE(a.size() == 200);
+    CHECK(a.box == Approx(L).epsilon(1e-15));
+    bool same = true;
+    for (std::size_t i = 0; i < 200; ++i)
+      same = same && a.x[i] == b.x[i] && a.y[i] == b.y[i] && a.z[i] == b.z[i] &&
+             a.vx[i] == b.vx[i] && a.vy[i] == b.vy[i] && a.vz[i] == b.vz[i] &&
+             a.charge[i] == b.charge[i] && a.ix[i] == 0 && a.iz[i] == 0;
+    CHECK(same);
+    double q2 = 0.0;
+    for (double q : a.charge) q2 += q * q;
+    CHECK(q2 == (charged ? 200.0 : 0.0));
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("LAMMPS data initial state: styles, ids out of order, image flags, shifted box",
+          "[md][io]") {
+  // atom_style charge as write_data writes it: ids out of order, velocities in another order,
+  // image flags, a box from -5 to 5
+  const std::string p = writeText("charge.data",
+                                  "LAMMPS data file via write_data\n\n3 atoms\n1 atom types\n\n"
+                                  "-5 5 xlo xhi\n-5 5 ylo yhi\n-5 5 zlo zhi\n\nMasses\n\n1 1\n\n"
+                                  "Atoms # charge\n\n"
+                                  "7 1 -0.5 1 2 3 0 0 1\n"
+                                  "2 1 0.5 -4 -4 -4 -1 0 0\n"
+                                  "5 1 0 0 0 6 0 0 0\n\n"
+                                  "Velocities\n\n5 0.5 0.6 0.7\n2 0.2 0.3 0.4\n7 0.7 0.8 0.9\n");
+  const Frame f = readInitialState(p, 1.0);
+  REQUIRE(f.size() == 3);
+  CHECK(f.box == 10.0);
+  // particle order: ids 2, 5, 7
+  CHECK(f.x[0] == 1.0);  // -4 - (-5)
+  CHECK(f.ix[0] == -1);
+  CHECK(f.charge[0] == 0.5);
+  CHECK(f.vx[0] == 0.2);
+  CHECK(f.z[1] == 1.0);  // 6 + 5 = 11 wrapped to 1, one more image
+  CHECK(f.iz[1] == 1);
+  CHECK(f.vz[1] == 0.7);
+  CHECK(f.x[2] == 6.0);
+  CHECK(f.iz[2] == 1);
+  CHECK(f.charge[2] == -0.5);
+  CHECK(f.vy[2] == 0.8);
+  std::remove(p.c_str());
+  // no style comment: atomic told by its 5 columns
+  const std::string q = writeText("atomic.data",
+                                  "title\n2 atoms\n0 4 xlo xhi\n0 4 ylo yhi\n0 4 zlo zhi\n"
+                                  "Atoms\n\n1 1 1 1 1\n2 1 2.5 2.5 2.5\n"
+                                  "Velocities\n\n1 1 0 0 0 0 0\n2 -1 0 0 0 0 0\n");
+  const Frame g = readInitialState(q, 1.0);
+  CHECK(g.size() == 2);
+  CHECK(g.x[1] == 2.5);
+  CHECK(g.vx[1] == -1.0);
+  CHECK(g.charge[1] == 0.0);
+  std::remove(q.c_str());
+}
+
+TEST_CASE("LAMMPS data initial state errors name the file, line and atom", "[md][io]") {
+  const std::string box = "title\n\n2 atoms\n\n0 4 xlo xhi\n0 4 ylo yhi\n0 4 zlo zhi\n\n";
+  const std::string vel = "\nVelocities\n\n1 0 0 0\n2 0 0 0\n";
+  struct Case {
+    std::string text, expected;
+  };
+  const Case cases[] = {
+      {box + "Atoms # sphere\n\n1 1 2.0 0.2387 1 1 1\n2 1 1 1.909859 2 2 2\n" + vel,
+       ":11: atom 1: diameter 2 (granagg's particles have diameter 1)"},
+      {box + "Atoms # sphere\n\n1 1 1 1.909859 1 1 1\n2 1 1 1 2 2 2\n" + vel,
+       ":12: atom 2: density 1"},
+      {box + "Masses\n\n1 2.0\n\nAtoms # charge\n\n1 1 0 1 1 1\n2 1 0 2 2 2\n" + vel,
+       "type 1 has mass 2"},
+      {box + "Atoms # full\n\n1 1 1 0 1 1 1\n2 1 1 0 2 2 2\n" + vel, "atom style 'full'"},
+      {box + "Atoms # charge\n\n1 1 0 1 1 1\n1 1 0 2 2 2\n" + vel, "atom id 1 appears twice"},
+      {box + "Atoms # charge\n\n1 1 0 1 1 1\n2 1 0 2 2 2\n", "no Velocities section"},
+      {box + "Atoms # charge\n\n1 1 0 1 1 1\n2 1 0 2 2 2\n\nVelocities\n\n1 0 0 0\n",
+       "atom 2 has no velocity line"},
+      {box + "Atoms # charge\n\n1 1 0 1 1 1\n2 1 0 2 2 nan\n" + vel,
+       ":12: z 'nan' is not a finite number"},
+      {box + "Atoms # charge\n\n1 1 0 1 1 1\n" + vel, "the Atoms section has 1 lines"},
+      {"title\n2 atoms\n0 4 xlo xhi\n0 4 ylo yhi\n0 5 zlo zhi\nAtoms\n\n1 1 1 1 1\n2 1 2 2 2\n" +
+           vel,
+       "the box must be cubic"},
+      {"title\n2 atoms\n0 4 xlo xhi\n0 4 ylo yhi\n0 4 zlo zhi\n0 0.5 0 xy xz yz\n", "triclinic"},
+  };
+  for (const Case& c : cases) {
+    const std::string p = writeText("bad.data", c.text);
+    INFO(c.text);
+    CHECK_THROWS_WITH(readInitialState(p, 1.0), Catch::Contains(c.expected));
+    std::remove(p.c_str());
+  }
 }
