@@ -357,7 +357,10 @@ class Json {
 std::string interval(double v, double lo, double hi) {
   char buf[160];
   if (!std::isfinite(v)) return "n/a";
-  std::snprintf(buf, sizeof buf, "%.4g [%.4g, %.4g]", v, lo, hi);
+  if (!std::isfinite(lo) && !std::isfinite(hi))
+    std::snprintf(buf, sizeof buf, "%.4g", v);  // (no interval)
+  else
+    std::snprintf(buf, sizeof buf, "%.4g [%.4g, %.4g]", v, lo, hi);
   return buf;
 }
 
@@ -655,19 +658,16 @@ void runFitBeta(const FitBetaArgs& a, const CliContext& ctx) {
                  "fit-beta: beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s\n",
                  bzs.S0, bzs.S1, interval(bzs.beta, bzs.beta_low, bzs.beta_high).c_str());
     if (!bzs.note.empty()) std::fprintf(stderr, "fit-beta:   note: %s\n", bzs.note.c_str());
-    if (cf.at_bound)
-      std::fprintf(
-          stderr,
-          "fit-beta: beta from the curve fit: not determined (at the bound %.3g of the search "
-          "range)\n",
-          cf.beta);
-    std::fprintf(
-        stderr,
-        "fit-beta: beta from the curve fit = %s, S_c = %s, tau_c = %s, chi2/dof = %.3g (%s)\n",
-        interval(cf.beta, cf.beta_low, cf.beta_high).c_str(),
-        interval(cf.S_c, cf.S_c_low, cf.S_c_high).c_str(),
-        interval(cf.tau_c, cf.tau_c_low, cf.tau_c_high).c_str(), cf.chi2_dof,
-        cf.interval_method.c_str());
+    const std::string beta_fit = cf.at_bound
+                                     ? "not determined (at the bound " +
+                                           interval(cf.beta, NAN, NAN) + " of the search range)"
+                                     : "= " + interval(cf.beta, cf.beta_low, cf.beta_high);
+    std::fprintf(stderr,
+                 "fit-beta: beta from the curve fit %s, S_c = %s, tau_c = %s, chi2/dof = %.3g "
+                 "(%s)\n",
+                 beta_fit.c_str(), interval(cf.S_c, cf.S_c_low, cf.S_c_high).c_str(),
+                 interval(cf.tau_c, cf.tau_c_low, cf.tau_c_high).c_str(), cf.chi2_dof,
+                 cf.interval_method.c_str());
     if (!cf.note.empty()) std::fprintf(stderr, "fit-beta:   note: %s\n", cf.note.c_str());
   }
   std::fprintf(stderr, "fit-beta: wrote %s, %s%s\n", csvPath.c_str(),

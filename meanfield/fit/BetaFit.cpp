@@ -25,6 +25,14 @@ using common::formatReal;
 
 namespace {
 
+/// A measured number in a note for people: 4 significant digits (formatReal's round-trip digits
+/// are for tables, and for input values echoed in errors).
+std::string rounded(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", x);
+  return buf;
+}
+
 constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 
 double median(std::vector<double> v) {
@@ -503,8 +511,8 @@ BetaFromZ betaAsymptotic(double z, double z_low, double z_high) {
     out.beta = out.beta_low = out.beta_high = NaN;
     out.note =
         std::isfinite(z)
-            ? (z <= 0.0 ? "z = " + formatReal(z) + " <= 0: S does not grow, no beta."
-                        : "z = " + formatReal(z) +
+            ? (z <= 0.0 ? "z = " + rounded(z) + " <= 0: S does not grow, no beta."
+                        : "z = " + rounded(z) +
                               " >= 3: faster than 3 beta/(beta + 3) for every beta, no beta.")
             : "z is not finite: no beta.";
     return out;
@@ -513,9 +521,9 @@ BetaFromZ betaAsymptotic(double z, double z_low, double z_high) {
   out.beta_low = beta(z_low);
   out.beta_high = beta(z_high);
   if (std::isfinite(z_high) && z_high >= 3.0)
-    out.note += "z_high = " + formatReal(z_high) + " >= 3: no upper bound on beta. ";
+    out.note += "z_high = " + rounded(z_high) + " >= 3: no upper bound on beta. ";
   if (std::isfinite(z_low) && z_low <= 0.0)
-    out.note += "z_low = " + formatReal(z_low) + " <= 0: the interval reaches beta = 0. ";
+    out.note += "z_low = " + rounded(z_low) + " <= 0: the interval reaches beta = 0. ";
   if (!out.note.empty()) out.note.pop_back();
   return out;
 }
@@ -527,7 +535,7 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
   std::string note;
   const double S_floor = 1.0001;
   if (S0 < S_floor) {
-    note += "window starts at S = " + formatReal(S0) +
+    note += "window starts at S = " + rounded(S0) +
             " <= 1, the mean field's initial S; compared from S = 1.0001. ";
     S0 = S_floor;
   }
@@ -552,8 +560,8 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
     if (!std::isfinite(zt)) return NaN;
     if (zt <= out.z_at_beta_min || zt >= out.z_at_beta_max) {
       const bool below = zt <= out.z_at_beta_min;
-      note += std::string(what) + " = " + formatReal(zt) + " lies " + (below ? "below" : "above") +
-              " the mean-field z = " + formatReal(below ? out.z_at_beta_min : out.z_at_beta_max) +
+      note += std::string(what) + " = " + rounded(zt) + " lies " + (below ? "below" : "above") +
+              " the mean-field z = " + rounded(below ? out.z_at_beta_min : out.z_at_beta_max) +
               " at beta = " + formatReal(below ? beta_min : beta_max) +
               (central ? ": no beta" : ": clamped to the range") + ". ";
       return central ? NaN : (below ? beta_min : beta_max);
@@ -606,24 +614,34 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
 
 namespace {
 
+/// The fit's parameters are (u, ln S_c, ln tau_c) with beta = beta_min + (beta_max - beta_min) /
+/// (1 + e^-u): the logistic map takes the whole real line onto the open search range, so the fit
+/// needs no clamp and its intervals, formed in u and mapped back, stay inside the range. (Formed
+/// in beta, a covariance interval of a poorly determined beta could reach negative values.) Near
+/// the middle of the range the map is close to linear: intervals are those in beta.
 struct CurveProblem {
   MeanFieldCurves* curves;
   const std::vector<double>* lt;  // ln t_i
   std::vector<double> y;          // ln S_i
   double beta_min, beta_max;
+  double betaOf(double u) const { return beta_min + (beta_max - beta_min) / (1.0 + std::exp(-u)); }
+  /// The inverse, for a start value (kept 1e-3 of the range away from the bounds: finite u).
+  double uOf(double beta) const {
+    const double f = std::min(std::max((beta - beta_min) / (beta_max - beta_min), 1e-3), 1 - 1e-3);
+    return std::log(f / (1.0 - f));
+  }
   double model(double lt_i, double beta, double ln_tau) const {
-    beta = std::min(std::max(beta, beta_min), beta_max);
     return curves->logS(std::exp(lt_i - ln_tau), beta);
   }
 };
 
 int curveResidual(const gsl_vector* x, void* params, gsl_vector* f) {
   auto* p = static_cast<CurveProblem*>(params);
-  const double beta = gsl_vector_get(x, 0), lnSc = gsl_vector_get(x, 1),
-               lntau = gsl_vector_get(x, 2);
-  if (!std::isfinite(beta) || !std::isfinite(lnSc) || !std::isfinite(lntau) ||
+  const double u = gsl_vector_get(x, 0), lnSc = gsl_vector_get(x, 1), lntau = gsl_vector_get(x, 2);
+  if (!std::isfinite(u) || !std::isfinite(lnSc) || !std::isfinite(lntau) ||
       std::fabs(lntau) > 200.0)
     return GSL_EDOM;
+  const double beta = p->betaOf(u);
   try {
     for (std::size_t i = 0; i < p->y.size(); ++i)
       gsl_vector_set(f, i, p->y[i] - lnSc - p->model((*p->lt)[i], beta, lntau));
@@ -634,13 +652,13 @@ int curveResidual(const gsl_vector* x, void* params, gsl_vector* f) {
 }
 
 struct LmResult {
-  double beta, lnSc, lntau, chi2;
+  double u, beta, lnSc, lntau, chi2;  // beta = betaOf(u); cov is of (u, ln S_c, ln tau_c)
   double cov[3][3];
   int iterations;
   bool ok;
 };
 
-LmResult runLm(CurveProblem& prob, double beta0, double lnSc0, double lntau0, bool covariance) {
+LmResult runLm(CurveProblem& prob, double u0, double lnSc0, double lntau0, bool covariance) {
   const std::size_t n = prob.y.size(), p = 3;
   gsl_multifit_nlinear_parameters params = gsl_multifit_nlinear_default_parameters();
   params.trs = gsl_multifit_nlinear_trs_lm;
@@ -655,7 +673,7 @@ LmResult runLm(CurveProblem& prob, double beta0, double lnSc0, double lntau0, bo
   fdf.p = p;
   fdf.params = &prob;
   gsl_vector* x = gsl_vector_alloc(p);
-  gsl_vector_set(x, 0, beta0);
+  gsl_vector_set(x, 0, u0);
   gsl_vector_set(x, 1, lnSc0);
   gsl_vector_set(x, 2, lntau0);
   LmResult r{};
@@ -667,7 +685,8 @@ LmResult runLm(CurveProblem& prob, double beta0, double lnSc0, double lntau0, bo
     r.ok = status == GSL_SUCCESS || status == GSL_EMAXITER || status == GSL_ENOPROG;
   }
   const gsl_vector* xs = gsl_multifit_nlinear_position(w);
-  r.beta = std::min(std::max(gsl_vector_get(xs, 0), prob.beta_min), prob.beta_max);
+  r.u = gsl_vector_get(xs, 0);
+  r.beta = prob.betaOf(r.u);
   r.lnSc = gsl_vector_get(xs, 1);
   r.lntau = gsl_vector_get(xs, 2);
   const gsl_vector* f = gsl_multifit_nlinear_residual(w);
@@ -738,7 +757,7 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   }
 
   gsl_error_handler_t* old = gsl_set_error_handler_off();
-  const LmResult r = runLm(prob, b0, s0, tau0, true);
+  const LmResult r = runLm(prob, prob.uOf(b0), s0, tau0, true);
   if (!r.ok) {
     gsl_set_error_handler(old);
     throw std::runtime_error("the full-curve fit (gsl_multifit_nlinear) failed to converge.");
@@ -760,9 +779,9 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
     for (int b = 0; b < o.bootstrap.replicates_curve; ++b) {
       const std::vector<double> S = resampledMean(data, rng.resample(data.runs.size()));
       for (std::size_t i = 0; i < n; ++i) pb.y[i] = std::log(S[i]);
-      const LmResult rb = runLm(pb, r.beta, r.lnSc, r.lntau, false);
+      const LmResult rb = runLm(pb, r.u, r.lnSc, r.lntau, false);
       if (!rb.ok) continue;
-      bs.push_back(rb.beta);
+      bs.push_back(rb.u);
       ss.push_back(rb.lnSc);
       ts.push_back(rb.lntau);
     }
@@ -771,8 +790,10 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
       throw std::runtime_error("the bootstrap of the full-curve fit failed in most replicates.");
     }
     const std::size_t R = data.runs.size();
-    bootstrapInterval(bs, r.beta, R, conf, fit.beta_low, fit.beta_high);
     double lo, hi;
+    bootstrapInterval(bs, r.u, R, conf, lo, hi);
+    fit.beta_low = prob.betaOf(lo);
+    fit.beta_high = prob.betaOf(hi);
     bootstrapInterval(ss, r.lnSc, R, conf, lo, hi);
     fit.S_c_low = std::exp(lo);
     fit.S_c_high = std::exp(hi);
@@ -785,8 +806,8 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
     const double tq = gsl_cdf_tdist_Pinv(0.5 + conf / 2.0, dof);
     const double scale = fit.chi2_dof;  // covariance scaled by chi^2/dof (unit weights)
     auto half = [&](int k) { return tq * std::sqrt(std::max(r.cov[k][k] * scale, 0.0)); };
-    fit.beta_low = r.beta - half(0);
-    fit.beta_high = r.beta + half(0);
+    fit.beta_low = prob.betaOf(r.u - half(0));
+    fit.beta_high = prob.betaOf(r.u + half(0));
     fit.S_c_low = std::exp(r.lnSc - half(1));
     fit.S_c_high = std::exp(r.lnSc + half(1));
     fit.tau_c_low = std::exp(r.lntau - half(2));
@@ -796,11 +817,13 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   gsl_set_error_handler(old);
   const double edge = 1e-4 * (o.beta_max - o.beta_min);
   fit.at_bound = fit.beta <= o.beta_min + edge || fit.beta >= o.beta_max - edge;
-  if (fit.at_bound)
+  if (fit.at_bound) {  // no interval: the data do not determine beta within the range
+    fit.beta_low = fit.beta_high = std::numeric_limits<double>::quiet_NaN();
     fit.note = "beta_fit lies at the bound " +
                formatReal(fit.beta <= o.beta_min + edge ? o.beta_min : o.beta_max) +
                " of the search range, so beta is not determined there; granagg fit-beta with a "
                "wider --beta-min/--beta-max searches further.";
+  }
   fit.S_fitted.resize(n);
   for (std::size_t i = 0; i < n; ++i)
     fit.S_fitted[i] = fit.S_c * std::exp(prob.model(lt[i], fit.beta, r.lntau));

@@ -199,7 +199,8 @@ struct CurveFit {
   int points = 0;
   int iterations = 0;
   /// "covariance" (Student t, n - 3 dof) or "bootstrap-runs" (as ZFit: estimate -/+ t_{R-1}
-  /// sqrt(R / (R - 1)) x the bootstrap standard deviation; for S_c and tau_c in ln).
+  /// sqrt(R / (R - 1)) x the bootstrap standard deviation; for S_c and tau_c in ln, for beta in
+  /// the logistic parameter of fitCurve).
   std::string interval_method;
   int replicates = 0;
   std::string note;  ///< empty, or e.g. that beta ended at a bound of its range
@@ -211,9 +212,11 @@ struct CurveFit {
 };
 /// Fits (beta, ln S_c, ln tau_c): start from the best point of a coarse scan (beta in steps of 1,
 /// ln tau_c in steps of 0.2, ln S_c profiled out), then gsl_multifit_nlinear (trust region,
-/// Levenberg-Marquardt, finite-difference Jacobian); beta is confined to [beta_min, beta_max]
-/// (the model is evaluated at the nearest bound outside it). Throws std::invalid_argument for a
-/// bad beta range or fewer than 5 samples; std::runtime_error when GSL fails.
+/// Levenberg-Marquardt, finite-difference Jacobian). beta is fitted through a logistic map of the
+/// real line onto (beta_min, beta_max), and its interval is formed there and mapped back: it stays
+/// inside the range. At a bound (at_bound) beta has no interval (NaN). Throws
+/// std::invalid_argument for a bad beta range or fewer than 5 samples; std::runtime_error when
+/// GSL fails.
 CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data,
                   const CurveFitOptions& options = {});
 
