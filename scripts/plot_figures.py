@@ -11,8 +11,8 @@ PAIR_DIR/figures/ (figN_<name>.png and .pdf):
   fig2_snapshots     projected slab (|z - L/2| < 2 d) of run 0 at three times, neutral and charged
   fig3_nstick        N_stick of the tracked particles (contacts within 1 + tolerance)
   fig4_charge        mean |q|(t), its rate against the t^(-a(1/2+kappa)) law, N_s(s) at three times
-  fig5_growth        S(t) with power-law fits (and the fitted mean field), local-slope inset
-  fig6_meanfield     MD against mean-field S(t) (fit-beta's fitted curve), MSD inset
+  fig5_growth        S(t) with power-law fits (and the fitted mean field), local slope below
+  fig6_meanfield     MD against mean-field S(t) (fit-beta's fitted curve), MSD beside
   fig7_speed         f(v~) against the Maxwellian at the first and last frames
   fig8_charge_speed  (q~, v~) scatter of the last analysed frame, charged ensembles
 
@@ -68,6 +68,39 @@ class Study:
 
     def label(self, k):
         return "neutral (K = 0)" if k[1] == 0 else f"charged (K = {k[1]:g})"
+
+
+def readable_log(ax, axis="y"):
+    """A log axis over less than about a decade gets a few plain tick labels ("1.2", not "1.2x10^0"
+    or "10^0" five times); wider ranges keep matplotlib's decades."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter
+
+    lo, hi = ax.get_ylim() if axis == "y" else ax.get_xlim()
+    if not (lo > 0 and hi / lo < 15):
+        return
+    if hi / lo < 1.5:  # (nearly) constant data, e.g. S = 1 before any cluster: show +-25 %
+        mid = np.sqrt(lo * hi)
+        lo, hi = mid / 1.25, mid * 1.25
+        (ax.set_ylim if axis == "y" else ax.set_xlim)(lo, hi)
+    a = ax.yaxis if axis == "y" else ax.xaxis
+    # round numbers inside the range, thinned to at most 6
+    nice = (1, 1.1, 1.2, 1.3, 1.5, 1.7, 2, 2.5, 3, 4, 5, 6, 7, 8, 9)
+    e0 = int(np.floor(np.log10(lo)))
+    ticks = [m * 10.0**e for e in (e0, e0 + 1) for m in nice if lo <= m * 10.0**e <= hi]
+    ticks = ticks[:: max(1, int(np.ceil(len(ticks) / 6)))]
+    a.set_major_locator(FixedLocator(ticks))
+    a.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    a.set_minor_formatter(NullFormatter())
+
+
+def beta_label(e):
+    """The fitted-beta part of a legend entry: the value, or why there is none."""
+    b = (e.get("beta_fit") or {}).get("value")
+    if b is None:
+        return "mean field (no fitted beta)"
+    if not e.get("beta_fit_determined", True):
+        return f"mean field at beta = {b:.3g}: the search bound, beta not determined"
+    return f"mean field, fitted beta = {b:.3g}"
 
 
 def colors(i):
@@ -141,23 +174,33 @@ def fig2(st, fig):
         tt = times[times > 0]
         wanted = [tt[0], np.sqrt(tt[0] * tt[-1]), tt[-1]] if len(tt) else [times[0]]
         L, frames = load_frames(path, wanted)
+        coloured = k[1] > 0 and all(q is not None for _, _, q in frames)
+        # one colour scale for the row, so that the three times compare
+        qs = max(float(np.max(np.abs(q))) for _, _, q in frames) if coloured else 1.0
+        axes = []
         for c, (t, x, q) in enumerate(frames):
             ax = fig.add_subplot(len(rows), 3, 3 * r + c + 1)
+            axes.append(ax)
             slab = np.abs(x[:, 2] - L / 2) < 2.0
             # particles drawn at their true size (diameter 1 in data units)
             ec = EllipseCollection(np.ones(slab.sum()), np.ones(slab.sum()), np.zeros(slab.sum()), units="xy",
                                    offsets=x[slab, :2], offset_transform=ax.transData, edgecolors="k", linewidths=0.3)
-            if q is not None and k[1] > 0:
-                qs = np.max(np.abs(q)) or 1.0
+            if coloured:
                 ec.set_array(q[slab])
                 ec.set_cmap("coolwarm")
-                ec.set_clim(-qs, qs)
+                ec.set_clim(-(qs or 1.0), qs or 1.0)
             else:
                 ec.set_facecolor("0.6")
             ax.add_collection(ec)
-            ax.set(xlim=(0, L), ylim=(0, L), aspect="equal", title=f"{st.label(k)}, t = {t:.3g}")
+            ax.set(xlim=(0, L), ylim=(0, L), aspect="equal", title=f"{st.label(k)}, t = {t:.3g}",
+                   xlabel="x / d")
+            if c == 0:
+                ax.set_ylabel("y / d")
             ax.tick_params(labelsize=7)
-    fig.suptitle("Fig. 2: slab |z - L/2| < 2 d projected on (x, y), run 0 (charged: colour = q)")
+        if coloured:
+            cb = fig.colorbar(ec, ax=axes, shrink=0.8, pad=0.02)
+            cb.set_label("charge q (same scale for the three times)")
+    fig.suptitle("Fig. 2: slab |z - L/2| < 2 d of run 0 projected on (x, y); particles at their true size")
 
 
 def fig3(st, fig):
@@ -199,7 +242,9 @@ def fig4(st, fig):
             ref = tm[good][len(tm[good]) // 2]
             c = np.interp(ref, tm[good], rate[good]) / ref**expo
             tl = np.geomspace(tm[good].min(), tm[good].max(), 50)
-            ax2.loglog(tl, c * tl**expo, "k--", label=rf"$t^{{{expo:.3g}}}$ rate law")
+            ax2.loglog(tl, c * tl**expo, "k--",
+                       label=rf"kinetic theory $t^{{{expo:.3g}}}$, matched to MD at t = {ref:.3g}")
+            ax2.plot([ref], [c * ref**expo], "kx", ms=7)
         drawn = True
     if not drawn:
         note(ax1, "no charged ensemble (K > 0)")
@@ -219,13 +264,17 @@ def fig4(st, fig):
         pick = sorted(set([ts[0], ts[len(ts) // 2], ts[-1]]))
         for j, t in enumerate(pick):
             m = (ng["t"] == t) & (ng["N_s_mean"] > 0)
-            ax3.loglog(ng["s"][m], ng["N_s_mean"][m], "o-"[0] + ["-", "--", ":"][j % 3], ms=3, color=colors(i),
+            # each time its own marker and line style: the legend tells them apart
+            ax3.loglog(ng["s"][m], ng["N_s_mean"][m], marker="os^"[j % 3], ls=["-", "--", ":"][j % 3], ms=4,
+                       mfc="none" if j == 1 else colors(i), lw=1.2, color=colors(i),
                        label=f"{st.label(k)}, t = {t:.3g}")
         drawn = True
     if not drawn:
         note(ax3, "no analysis/K*/N_s_grid.csv")
-    ax3.set(xlabel="s (grid sites)", ylabel=r"$N_s$", title="cluster-size distribution")
-    ax3.legend(fontsize=7)
+    ax3.set(xlabel="s (grid sites)", ylabel=r"$N_s$ (clusters per frame)", title="cluster-size distribution")
+    ax3.legend(fontsize=7, loc="upper right", handlelength=3)
+    for a in (ax1, ax2, ax3):
+        a.tick_params(labelsize=8)
     fig.suptitle("Fig. 4: charge build-up and N_s(s) at three times")
 
 
@@ -238,8 +287,8 @@ def powerfit(t, S, lo, hi):
 
 
 def fig5(st, fig):
-    ax = fig.add_subplot(111)
-    ins = ax.inset_axes([0.58, 0.08, 0.38, 0.32])
+    # the local slope in a panel of its own below (an inset covered the late-time data)
+    ax, ins = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1], "hspace": 0.06})
     drawn = False
     ens = {e["name"]: e for e in st.summary.get("ensembles", [])}
     for i, k in enumerate(st.ks):
@@ -256,39 +305,41 @@ def fig5(st, fig):
             if f:
                 z, c, tw = f
                 zi = e.get("z_analyze", {})
-                lab = f"fit z = {z:.3g}" + (f" [{zi['low']:.3g}, {zi['high']:.3g}]" if zi.get("low") is not None else "")
+                lab = f"power law over t = {win[0]:.3g}..{win[1]:.3g}: z = {z:.3g}" + (
+                    f" [{zi['low']:.3g}, {zi['high']:.3g}]" if zi.get("low") is not None else "")
                 ax.plot(tw, np.exp(c) * tw**z, "-", color=colors(i), lw=2, label=lab)
         fc = read(f"{st.d}/fit/{k[0]}/fit_curve.csv")
         if fc is not None and col(fc, "S_mf_fitted") is not None:
-            b = e.get("beta_fit", {}).get("value")
-            ax.plot(fc["t"], fc["S_mf_fitted"], "--", color=colors(i), label="mean field, fitted beta" + (f" = {b:.3g}" if b else ""))
+            ax.plot(fc["t"], fc["S_mf_fitted"], "--", color=colors(i), label=beta_label(e))
         zl = col(S, "z_local_grid_of_mean")
         if zl is not None:
-            ins.plot(S["t"], zl, ".-", color=colors(i), ms=3)
+            ins.plot(S["t"], zl, ".-", color=colors(i), ms=3, label=st.label(k))
         drawn = True
     if not drawn:
         note(ax, "no analysis/K*/S_t.csv")
     zn, zc = paper()["z_neutral"]["value"], paper()["z_charged"]["value"]
-    ins.axhline(zn, color="C0", ls=":", lw=0.8)
-    ins.axhline(zc, color="C3", ls=":", lw=0.8)
-    ins.set(xscale="log", xlabel="t", ylabel="z(t)")
-    ins.tick_params(labelsize=7)
-    ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S (grid sites)",
-           title=f"Fig. 5: mean cluster size; inset: local slope (paper: {zn} neutral, "
-                 f"{zc} charged)")
+    ins.axhline(zn, color="C0", ls=":", lw=0.8, label=f"paper: z = {zn} (neutral)")
+    ins.axhline(zc, color="C3", ls=":", lw=0.8, label=f"paper: z = {zc} (charged)")
+    ins.set(xscale="log", xlabel="t", ylabel="local slope z(t)")
+    ins.legend(fontsize=7, loc="upper left", ncol=2)
+    ax.set(xscale="log", yscale="log", ylabel="S (grid sites)",
+           title="Fig. 5: mean cluster size S(t); below: its local slope d ln S / d ln t")
+    readable_log(ax)
     ax.legend(fontsize=8, loc="upper left")
 
 
 def fig6(st, fig):
-    ax = fig.add_subplot(111)
-    ins = ax.inset_axes([0.6, 0.08, 0.36, 0.3])
+    # the MSD in a panel of its own at the right (an inset covered the late-time data)
+    ax, ins = fig.subplots(1, 2, gridspec_kw={"width_ratios": [2, 1], "wspace": 0.3})
+    ens = {e["name"]: e for e in st.summary.get("ensembles", [])}
     drawn = False
     for i, k in enumerate(st.ks):
         fc = read(f"{st.d}/fit/{k[0]}/fit_curve.csv")
         S = st.table("S_t", k[0])
         if fc is not None and col(fc, "S_md") is not None:
             ax.plot(fc["t"], fc["S_md"], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
-            ax.plot(fc["t"], fc["S_mf_fitted"], "-", color=colors(i), label="mean field (fitted beta, S_c, tau_c)")
+            ax.plot(fc["t"], fc["S_mf_fitted"], "-", color=colors(i),
+                    label=beta_label(ens.get(k[0], {})) + " (S_c, tau_c fitted)")
             drawn = True
         elif S is not None:
             m = S["t"] > 0
@@ -296,7 +347,7 @@ def fig6(st, fig):
         msd = st.table("msd", k[0])
         if msd is not None:
             m = msd["t"] > 0
-            ins.loglog(msd["t"][m], msd["msd_mean"][m], "-", color=colors(i))
+            ins.loglog(msd["t"][m], msd["msd_mean"][m], "-", color=colors(i), label=st.label(k))
     ax2 = None
     for b, ls in ((2, ":"), (3, "-.")):
         mf = read(f"{st.d}/meanfield/S_beta{b}.csv")
@@ -307,9 +358,11 @@ def fig6(st, fig):
             ax2.legend(fontsize=7, loc="lower right")
     if not drawn:
         note(ax, "fit/K*/fit_curve.csv missing (granagg fit-beta not run):\nMD and mean field shown on their own time axes")
-    ins.set(xlabel="t", ylabel="MSD")
-    ins.tick_params(labelsize=7)
-    ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S", title="Fig. 6: MD against mean-field S(t); inset: MSD")
+    ins.set(xlabel="t", ylabel=r"MSD / $d^2$", title="mean squared displacement")
+    if ins.lines:
+        ins.legend(fontsize=7)
+    ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S (grid sites)", title="Fig. 6: MD against mean-field S(t)")
+    readable_log(ax)
     ax.legend(fontsize=8, loc="upper left")
 
 
@@ -354,7 +407,7 @@ def fig8(st, fig):
 
 
 FIGURES = [("fig1_temperature", fig1, (7, 5)), ("fig2_snapshots", fig2, (12, 8)), ("fig3_nstick", fig3, (7, 5)),
-           ("fig4_charge", fig4, (16, 4.8)), ("fig5_growth", fig5, (7.5, 5.5)), ("fig6_meanfield", fig6, (7.5, 5.5)),
+           ("fig4_charge", fig4, (16, 4.8)), ("fig5_growth", fig5, (7.5, 7)), ("fig6_meanfield", fig6, (12, 5)),
            ("fig7_speed", fig7, (7, 5)), ("fig8_charge_speed", fig8, (6, 5))]
 
 
