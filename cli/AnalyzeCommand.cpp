@@ -208,7 +208,10 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
                                   "' is given twice: an ensemble needs independent runs");
   }
   const fs::path out(a.out);
-  if (fs::exists(out) && (!fs::is_directory(out) || (!fs::is_empty(out) && !a.force)))
+  if (fs::exists(out) && !fs::is_directory(out))
+    throw std::invalid_argument("--out '" + out.string() +
+                                "' is a file, not a folder; analyze writes a folder");
+  if (fs::exists(out) && !fs::is_empty(out) && !a.force)
     throw std::invalid_argument(
         "output folder '" + out.string() +
         "' exists and is not empty; choose another --out or pass --force to overwrite it");

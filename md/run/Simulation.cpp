@@ -214,6 +214,9 @@ Simulation Simulation::start(const MdConfig& config, const fs::path& out,
   d->options = options;
   validateConfig(d->cfg);
   checkSchedule(d->cfg);
+  if (fs::exists(out) && !fs::is_directory(out))  // (--force would not help: say what it is)
+    throw std::invalid_argument("--out '" + out.string() +
+                                "' is a file, not a folder; a run writes a folder");
   if (fs::exists(out) && !fs::is_empty(out) && !options.overwrite)
     throw std::invalid_argument("output folder '" + out.string() +
                                 "' exists and is not empty; choose another --out or pass --force "

@@ -75,7 +75,8 @@ TEST_CASE("md rejects bad configurations with a message naming the key, exit 2",
   fs::remove_all(dir);
 }
 
-TEST_CASE("md --seed takes 0 to 2^64 - 1 and refuses the rest, --threads 0 is refused", "[cli][md]") {
+TEST_CASE("md --seed takes 0 to 2^64 - 1 and refuses the rest, --threads 0 is refused",
+          "[cli][md]") {
   const fs::path dir = tempDir("seeds");
   const std::string cfg = writeConfig(dir, SMALL) + " --set run.t_end=0.01";
   for (const char* bad : {"-1", "18446744073709551616", "1e3", "abc"}) {
@@ -120,6 +121,15 @@ TEST_CASE("md writes a readable trajectory and refuses to overwrite it", "[cli][
   const Run again = runGranagg("md --config " + cfg + " --out " + out.string() + " -q");
   CHECK(again.status == 2);
   CHECK_THAT(again.output, Catch::Contains("--force"));
+  // a file where the run's folder would go is named as such (--force would not help)
+  for (const char* sub : {"md --config ", "analyze "}) {
+    const std::string cmd = std::string(sub) + (sub[0] == 'm' ? cfg : out.string()) + " --out " +
+                            (out / "traj.h5").string() + " --force -q";
+    const Run file = runGranagg(cmd);
+    INFO(cmd);
+    CHECK(file.status == 2);
+    CHECK_THAT(file.output, Catch::Contains("is a file, not a folder"));
+  }
   if (fs::exists("/usr/bin/python3") && sh("/usr/bin/python3 -c 'import h5py'").status == 0) {
     const Run check = sh("/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) +
                          "/scripts/check_h5md.py " + (out / "traj.h5").string());
@@ -136,8 +146,8 @@ TEST_CASE("MDAnalysis reads a granagg run with the README's recipe", "[cli][md][
   // reading our files is part of the contract, so its absence fails the test.
   const fs::path dir = tempDir("mda");
   const std::string cfg = writeConfig(dir, SMALL);
-  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.3 --out " +
-                     (dir / "o").string() + " -q")
+  REQUIRE(runGranagg("md --config " + cfg + " --set run.t_end=0.3 --out " + (dir / "o").string() +
+                     " -q")
               .status == 0);
   const Run r = sh("/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) +
                    "/scripts/check_mdanalysis.py " + (dir / "o" / "traj.h5").string());
