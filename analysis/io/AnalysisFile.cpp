@@ -3,10 +3,11 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "analysis/io/Hdf5Lite.h"
+#include "common/Hdf5.h"
 #include "common/Version.h"
 
 namespace granagg::analysis {
+namespace h5 = common::h5;  // (common/Hdf5.h)
 
 struct AnalysisFile::Impl {
   h5::Handle file;
@@ -114,9 +115,9 @@ void AnalysisFile::writeGridFrame(std::size_t run, const Frame& f, const GridClu
     m.step.reset();
     h5::Handle g = m.group("runs/" + std::to_string(run) + "/grid");
     const std::string c = "'" + m.path + "' grid";
-    h5::writeNumberAttribute(g.get(), "cells_per_side", n, c);
-    h5::writeNumberAttribute(g.get(), "cell_size", gc.cellSize(), c);
-    h5::writeNumberAttribute(g.get(), "min_count", gc.minCount(), c);
+    h5::writeAttribute(g.get(), "cells_per_side", static_cast<double>(n), c);  // (stored as F64)
+    h5::writeAttribute(g.get(), "cell_size", gc.cellSize(), c);
+    h5::writeAttribute(g.get(), "min_count", gc.minCount(), c);
     h5::writeStringAttribute(
         g.get(), "layout",
         "[frame, ix, iy, iz]; labels -1 = empty, clusters from 0 (6-connectivity, periodic)", c);

@@ -4,11 +4,12 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "analysis/io/Hdf5Lite.h"
 #include "common/Box.h"
 #include "common/Csv.h"
+#include "common/Hdf5.h"
 
 namespace granagg::analysis {
+namespace h5 = common::h5;  // (common/Hdf5.h)
 
 namespace {
 
@@ -47,7 +48,7 @@ struct H5mdTrajectory::Impl {
     if (h5::objectType(grp, name) != H5I_DATASET)
       error(0, "missing dataset " + where(elem) + "/" + name + " (required by H5MD)");
     h5::Handle d = h5::check(H5Dopen2(grp, name, H5P_DEFAULT), c);
-    const auto dims = h5::dims(d.get(), c);
+    const auto dims = h5::datasetDims(d.get(), c);
     if (dims.empty()) {  // H5MD fixed increment: value k = offset + k * increment
       const auto inc = h5::readAll<T>(d.get(), mem_type, c);
       T offset = 0;
@@ -76,7 +77,7 @@ struct H5mdTrajectory::Impl {
     e.present = true;
     if (t == H5I_DATASET) {
       e.value = h5::check(H5Dopen2(part, name.c_str(), H5P_DEFAULT), c);
-      e.shape = h5::dims(e.value.get(), c);
+      e.shape = h5::datasetDims(e.value.get(), c);
       return e;
     }
     h5::Handle g = h5::check(H5Gopen2(part, name.c_str(), H5P_DEFAULT), c);
@@ -84,7 +85,7 @@ struct H5mdTrajectory::Impl {
       error(0, "missing dataset " + where(name) + "/value");
     e.time_dependent = true;
     e.value = h5::check(H5Dopen2(g.get(), "value", H5P_DEFAULT), c + "/value");
-    e.shape = h5::dims(e.value.get(), c + "/value");
+    e.shape = h5::datasetDims(e.value.get(), c + "/value");
     if (e.shape.empty()) error(0, where(name) + "/value is a scalar, expected a time series");
     e.steps = readGrid<std::int64_t>(g.get(), name, "step", H5T_NATIVE_INT64, e.shape[0]);
     return e;
@@ -178,7 +179,7 @@ struct H5mdTrajectory::Impl {
   void readParameters() {
     if (h5::objectType(file.get(), "/parameters") != H5I_GROUP) return;
     h5::Handle g = h5::check(H5Gopen2(file.get(), "/parameters", H5P_DEFAULT), path);
-    for (const auto& name : h5::attributeNames(g.get())) {
+    for (const auto& name : h5::attributeNames(g.get(), path + ": /parameters")) {
       try {
         h5::Handle a(H5Aopen(g.get(), name.c_str(), H5P_DEFAULT));
         h5::Handle type(H5Aget_type(a.get()));
@@ -228,7 +229,7 @@ struct H5mdTrajectory::Impl {
       return;
     }
     // Rows are re-checked on every read: a file still being written may have grown.
-    const auto d = h5::dims(e.value.get(), c);
+    const auto d = h5::datasetDims(e.value.get(), c);
     if (static_cast<std::size_t>(row) >= d[0])
       error(k, c + "/value has only " + std::to_string(d[0]) + " rows (truncated write?)");
     out.resize(n * per_particle);
@@ -247,7 +248,7 @@ struct H5mdTrajectory::Impl {
         std::size_t inner = 1;
         for (std::size_t d = 1; d < edges.shape.size(); ++d) inner *= edges.shape[d];
         if (row >= 0 && (inner == 3 || inner == 9)) {
-          const auto d = h5::dims(edges.value.get(), where("box/edges"));
+          const auto d = h5::datasetDims(edges.value.get(), where("box/edges"));
           if (static_cast<std::size_t>(row) >= d[0])
             error(k, where("box/edges") + "/value has only " + std::to_string(d[0]) +
                          " rows (truncated write?)");

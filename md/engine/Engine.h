@@ -134,15 +134,6 @@ class Engine {
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
 
-  /// Random non-overlapping positions at the configured phi, Maxwell velocities rescaled to
-  /// T_g = temperature exactly with zero total momentum, zero charges (design.md section 2).
-  /// Deterministic in config.system.seed (Philox streams RNG_INIT_*).
-  static Frame randomInitialState(const MdConfig& config);
-  /// Sets the charges of an initial state from config.charging.initial: "neutral" (0), "monopolar"
-  /// (+q0), "bipolar" (a random half +q0, the other -q0: zero net charge; Philox stream
-  /// RNG_INIT_CHARGE) or "file" (kept; throws if the state has none).
-  static void assignInitialCharges(const MdConfig& config, Frame& state);
-
   /// Advances `steps` velocity-Verlet steps. Throws RunAborted when a step fails its checks; the
   /// engine is then mid-step and must not be advanced further (a run restarts from its last
   /// checkpoint, as `granagg md` does).

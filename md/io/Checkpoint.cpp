@@ -11,10 +11,11 @@
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/Hdf5.h"
 #include "common/Version.h"
-#include "md/io/Hdf5Util.h"
 
 namespace granagg::md {
+namespace h5 = common::h5;  // (common/Hdf5.h)
 
 namespace {
 

@@ -6,11 +6,12 @@
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/Hdf5.h"
 #include "md/io/H5mdWriter.h"
-#include "md/io/Hdf5Util.h"
 #include "md/io/InitialState.h"
 
 namespace granagg::md {
+namespace h5 = common::h5;  // (common/Hdf5.h)
 
 namespace {
 

@@ -1,6 +1,7 @@
 #include "md/io/InitialState.h"
 
 #include <sys/stat.h>
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -11,14 +12,19 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
+#include "common/Box.h"
 #include "common/Csv.h"
+#include "common/Hdf5.h"
 #include "common/Strings.h"
 #include "md/io/H5mdReader.h"
-#include "md/io/Hdf5Util.h"
+#include "md/rng/RngStreams.h"
 
 namespace granagg::md {
+namespace h5 = common::h5;  // (common/Hdf5.h)
 
 bool wrapCoordinate(double& x, std::int32_t& image, double box) {
   if (!std::isfinite(x)) return false;
@@ -428,6 +434,132 @@ Frame readInitialState(const std::string& path, double box_if_csv) {
   if (is_h5 > 0) return readInitialStateH5md(path);
   if (isLammpsData(path)) return readInitialStateLammps(path);
   return readInitialStateCsv(path, box_if_csv);
+}
+
+Frame randomInitialState(const MdConfig& c) {
+  const int N = c.system.N;
+  const double L = std::cbrt(N * M_PI / (6.0 * c.system.phi));
+  Frame f;
+  f.box = L;
+  f.x.resize(N);
+  f.y.resize(N);
+  f.z.resize(N);
+  // Random sequential insertion on a hash grid of cell >= 1 (a particle overlaps only particles in
+  // the 27 surrounding cells). Deterministic: attempt k of particle i draws Philox(seed, i, k).
+  const int nc = std::max(1, static_cast<int>(std::floor(L)));
+  const double cell = L / nc;
+  std::unordered_multimap<long, int> grid;
+  grid.reserve(2 * N);
+  common::Box box{L};
+  auto key = [nc](int a, int b, int cc) {
+    return (static_cast<long>((a + nc) % nc) * nc + (b + nc) % nc) * nc + (cc + nc) % nc;
+  };
+  const std::uint32_t max_attempts = 100000;
+  for (int i = 0; i < N; ++i) {
+    bool placed = false;
+    for (std::uint32_t k = 0; k < max_attempts && !placed; ++k) {
+      const auto r =
+          philoxDraw(c.system.seed, RNG_INIT_POSITION, static_cast<std::uint32_t>(i), k, 0);
+      const double px = uniform01(r[0]) * L, py = uniform01(r[1]) * L, pz = uniform01(r[2]) * L;
+      const int cx = std::min(nc - 1, static_cast<int>(px / cell)),
+                cy = std::min(nc - 1, static_cast<int>(py / cell)),
+                cz = std::min(nc - 1, static_cast<int>(pz / cell));
+      bool ok = true;
+      for (int a = -1; a <= 1 && ok; ++a)
+        for (int b = -1; b <= 1 && ok; ++b)
+          for (int e = -1; e <= 1 && ok; ++e) {
+            auto range = grid.equal_range(key(cx + a, cy + b, cz + e));
+            for (auto it = range.first; it != range.second && ok; ++it) {
+              const int j = it->second;
+              const double rx = box.minimumImage(px - f.x[j]), ry = box.minimumImage(py - f.y[j]),
+                           rz = box.minimumImage(pz - f.z[j]);
+              ok = rx * rx + ry * ry + rz * rz >= 1.0;
+            }
+          }
+      if (ok) {
+        f.x[i] = px >= L ? 0.0 : px;
+        f.y[i] = py >= L ? 0.0 : py;
+        f.z[i] = pz >= L ? 0.0 : pz;
+        grid.emplace(key(cx, cy, cz), i);
+        placed = true;
+      }
+    }
+    if (!placed)
+      throw std::invalid_argument(
+          "random insertion failed after " + std::to_string(max_attempts) +
+          " attempts for particle " + std::to_string(i) +
+          ": system.phi = " + common::formatReal(c.system.phi) +
+          " is too dense for random sequential insertion (use phi < 0.3 or give an initial file).");
+  }
+  // Maxwell velocities (Box-Muller on Philox words), then zero momentum and T_g = temperature
+  // exactly
+  f.vx.resize(N);
+  f.vy.resize(N);
+  f.vz.resize(N);
+  for (int i = 0; i < N; ++i) {
+    const auto r =
+        philoxDraw(c.system.seed, RNG_INIT_VELOCITY, static_cast<std::uint32_t>(i), 0, 0);
+    const double u1 = uniform01(r[0]), u2 = uniform01(r[1]), u3 = uniform01(r[2]),
+                 u4 = uniform01(r[3]);
+    const double a = std::sqrt(-2.0 * std::log(u1)), b = std::sqrt(-2.0 * std::log(u3));
+    f.vx[i] = a * std::cos(2.0 * M_PI * u2);
+    f.vy[i] = a * std::sin(2.0 * M_PI * u2);
+    f.vz[i] = b * std::cos(2.0 * M_PI * u4);
+  }
+  double m[3] = {0, 0, 0};
+  for (int i = 0; i < N; ++i) {
+    m[0] += f.vx[i];
+    m[1] += f.vy[i];
+    m[2] += f.vz[i];
+  }
+  double s2 = 0.0;
+  for (int i = 0; i < N; ++i) {
+    f.vx[i] -= m[0] / N;
+    f.vy[i] -= m[1] / N;
+    f.vz[i] -= m[2] / N;
+    s2 += f.vx[i] * f.vx[i] + f.vy[i] * f.vy[i] + f.vz[i] * f.vz[i];
+  }
+  const double scale = std::sqrt(c.system.temperature * 3.0 * N / s2);
+  for (int i = 0; i < N; ++i) {
+    f.vx[i] *= scale;
+    f.vy[i] *= scale;
+    f.vz[i] *= scale;
+  }
+  f.charge.assign(N, 0.0);
+  assignInitialCharges(c, f);
+  f.ix.assign(N, 0);
+  f.iy.assign(N, 0);
+  f.iz.assign(N, 0);
+  return f;
+}
+
+void assignInitialCharges(const MdConfig& c, Frame& f) {
+  const std::size_t N = f.size();
+  const std::string& how = c.charging.initial;
+  if (how == "file") {
+    if (f.charge.size() != N)
+      throw std::invalid_argument(
+          "charging.initial = \"file\" but the initial state holds no charges");
+    return;
+  }
+  f.charge.assign(N, 0.0);
+  if (how == "neutral") return;
+  if (how == "monopolar") {
+    f.charge.assign(N, c.charging.q0);
+    return;
+  }
+  if (how != "bipolar")
+    throw std::invalid_argument("charging.initial = \"" + how +
+                                "\" is not one of neutral, monopolar, bipolar, file");
+  // bipolar: a random half +q0, the other half -q0 (exactly zero net; for odd N one particle stays
+  // neutral). The halves come from ordering particles by a Philox key per particle.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> key(N);
+  for (std::size_t i = 0; i < N; ++i)
+    key[i] = {philoxDraw(c.system.seed, RNG_INIT_CHARGE, static_cast<std::uint32_t>(i), 0, 0)[0],
+              static_cast<std::uint32_t>(i)};
+  std::sort(key.begin(), key.end());
+  for (std::size_t k = 0; k < 2 * (N / 2); ++k)
+    f.charge[key[k].second] = k < N / 2 ? c.charging.q0 : -c.charging.q0;
 }
 
 }  // namespace granagg::md

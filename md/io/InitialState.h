@@ -36,6 +36,7 @@
 #include <cstdint>
 #include <string>
 
+#include "md/config/MdConfig.h"
 #include "md/io/Frame.h"
 
 namespace granagg::md {
@@ -65,6 +66,18 @@ bool isLammpsData(const std::string& path);
 /// the particle group `particle_group` ("" = the first group under /particles).
 Frame readInitialStateH5md(const std::string& path, long frame = -1,
                            const std::string& particle_group = "");
+
+/// Random non-overlapping positions at the configured phi (random sequential insertion),
+/// Maxwell velocities rescaled to T_g = temperature exactly with zero total momentum, and the
+/// charges of config.charging.initial (design.md section 2). Deterministic in config.system.seed
+/// (Philox streams RNG_INIT_*, md/rng/RngStreams.h). Throws std::invalid_argument when phi is too
+/// dense for insertion.
+Frame randomInitialState(const MdConfig& config);
+
+/// Sets the charges of an initial state from config.charging.initial: "neutral" (0), "monopolar"
+/// (+q0), "bipolar" (a random half +q0, the other -q0: zero net charge; Philox stream
+/// RNG_INIT_CHARGE) or "file" (kept; throws if the state has none).
+void assignInitialCharges(const MdConfig& config, Frame& state);
 
 /// Wraps one coordinate into [0, box), adding the number of box lengths removed to `image` (so
 /// x + image * box is unchanged up to round-off). Values already in [0, box) are left bit for

@@ -81,13 +81,13 @@ std::vector<std::pair<std::string, std::string>> parameters(const MdConfig& cfg,
 
 /// The initial state of a new run: random, or from system.initial with its charges set.
 Frame initialState(const MdConfig& cfg) {
-  if (cfg.system.initial == "random") return Engine::randomInitialState(cfg);
+  if (cfg.system.initial == "random") return randomInitialState(cfg);
   Frame init = readInitialState(cfg.system.initial, boxLength(cfg.system));
   if (static_cast<int>(init.size()) != cfg.system.N)
     throw std::invalid_argument("system.initial '" + cfg.system.initial + "' holds " +
                                 std::to_string(init.size()) +
                                 " particles but system.N = " + std::to_string(cfg.system.N));
-  Engine::assignInitialCharges(cfg, init);
+  assignInitialCharges(cfg, init);
   return init;
 }
 

@@ -9,12 +9,12 @@
 #include <vector>
 
 #include "analysis/io/Frame.h"
-#include "analysis/io/Hdf5Lite.h"
+#include "common/Hdf5.h"
 
 namespace testtraj {
 
 using granagg::analysis::Frame;
-namespace h5 = granagg::analysis::h5;
+namespace h5 = granagg::common::h5;
 
 struct H5mdLayout {
   bool box = true;  // write /particles/all/box

@@ -226,9 +226,9 @@ TEST_CASE("truncated and malformed H5MD files give errors naming the file and th
   SECTION("missing position") {
     const std::string p = (dir / "nopos.h5").string();
     {
-      granagg::analysis::h5::Handle f(
+      granagg::common::h5::Handle f(
           H5Fcreate(p.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
-      granagg::analysis::h5::createGroup(f.get(), "particles/all/box", "test");
+      granagg::common::h5::createGroup(f.get(), "particles/all/box", "test");
     }
     CHECK_THROWS_WITH(analyzeRun(p, fastOptions()),
                       Catch::Contains("nopos.h5") && Catch::Contains("position"));

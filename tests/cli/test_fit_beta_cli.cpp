@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/io/Hdf5Lite.h"
 #include "common/Csv.h"
+#include "common/Hdf5.h"
 
 #include "TestUtil.h"
 
@@ -275,7 +275,7 @@ TEST_CASE("fit-beta reads run columns, analyze folders and analysis.h5", "[cli][
   writeCsv(dir / "an" / "per_run" / "S_t.csv", "run,t,S_grid", per);
   // (c)
   {
-    namespace h5 = granagg::analysis::h5;
+    namespace h5 = granagg::common::h5;
     h5::silenceErrors();
     h5::Handle f(H5Fcreate((dir / "analysis.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
     REQUIRE(f);

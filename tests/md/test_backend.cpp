@@ -25,6 +25,7 @@
 #include "md/config/MdConfig.h"
 #include "md/engine/Engine.h"
 #include "md/io/Checkpoint.h"
+#include "md/io/InitialState.h"
 #include "md/potentials/HertzViscoelastic.h"
 #include "md/potentials/SpringDashpot.h"
 
@@ -190,8 +191,8 @@ std::vector<ReferenceCase> referenceCases() {
   // the split the reference was written with ("auto" before issue 15 made it 2 d): the file keeps
   // guarding the rest of the trajectory to the bit
   b.config.coulomb.r_fast = 3.5;
-  b.init = Engine::randomInitialState(b.config);
-  Engine::assignInitialCharges(b.config, b.init);
+  b.init = randomInitialState(b.config);
+  assignInitialCharges(b.config, b.init);
   b.allow_contacts = false;
   b.steps = 200;
   return cases;

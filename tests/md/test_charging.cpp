@@ -10,6 +10,7 @@
 
 #include "md/config/MdConfig.h"
 #include "md/engine/Engine.h"
+#include "md/io/InitialState.h"
 #include "md/potentials/ChargeExchange.h"
 
 using namespace granagg::md;
@@ -90,7 +91,7 @@ TEST_CASE(
     "saturation",
     "[md][charging]") {
   const MdConfig c = chargedGas(1000, 5);
-  const Frame init = Engine::randomInitialState(c);
+  const Frame init = randomInitialState(c);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
   Engine one(c, init);
@@ -134,7 +135,7 @@ TEST_CASE("initial charges: monopolar, bipolar with zero net charge, fixed mode 
   MdConfig c = chargedGas(501, 3);
   c.charging.initial = "bipolar";
   c.charging.q0 = 2.0;
-  const Frame f = Engine::randomInitialState(c);
+  const Frame f = randomInitialState(c);
   int plus = 0, minus = 0, zero = 0;
   for (double q : f.charge)
     (q == 2.0 ? plus : q == -2.0 ? minus : zero) += (q == 0.0 || std::fabs(q) == 2.0);
@@ -143,7 +144,7 @@ TEST_CASE("initial charges: monopolar, bipolar with zero net charge, fixed mode 
   CHECK(zero == 1);
   c.charging.initial = "monopolar";
   c.charging.mode = "fixed";
-  const Frame g = Engine::randomInitialState(c);
+  const Frame g = randomInitialState(c);
   CHECK(std::all_of(g.charge.begin(), g.charge.end(), [](double q) { return q == 2.0; }));
   Engine e(c, g);
   e.run(300);
@@ -172,7 +173,7 @@ TEST_CASE(
   MdConfig b = a;
   b.charging.Q = 0.1;
   b.coulomb.K = 1.25;
-  const Frame init = Engine::randomInitialState(a);
+  const Frame init = randomInitialState(a);
   Engine ea(a, init), eb(b, init);
   ea.run(400);
   eb.run(400);

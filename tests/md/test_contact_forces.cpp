@@ -338,8 +338,7 @@ TEST_CASE("pairs screened only once the displacement bound allows a contact: no 
     const ContactStepResult a =
         computeContactForces(screened, nl, box, hertzModel(prm), st, w_screened);
     st.displacement_bound = -1.0;
-    const ContactStepResult b =
-        computeContactForces(every, nl, box, hertzModel(prm), st, w_every);
+    const ContactStepResult b = computeContactForces(every, nl, box, hertzModel(prm), st, w_every);
     REQUIRE(a.worst == 0);
     REQUIRE(a.collisions == b.collisions);
     const std::vector<Vec3> fa(screened.force.begin(), screened.force.end()),

@@ -15,6 +15,7 @@
 
 #include "md/config/MdConfig.h"
 #include "md/engine/Engine.h"
+#include "md/io/InitialState.h"
 #include "meanfield/kinetic/Cooling.h"
 #include "meanfield/kinetic/Restitution.h"
 
@@ -28,7 +29,7 @@ struct Sample {
 };
 /// T_g and collisions per particle of an MD run at `times`.
 std::vector<Sample> mdCooling(const MdConfig& c, const std::vector<double>& times) {
-  Engine e(c, Engine::randomInitialState(c));
+  Engine e(c, randomInitialState(c));
   std::vector<Sample> out;
   for (double t : times) {
     e.run(static_cast<std::int64_t>(std::llround(t / e.dt())) - e.step());

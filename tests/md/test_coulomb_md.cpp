@@ -12,6 +12,7 @@
 #include "md/coulomb/EwaldParams.h"
 #include "md/coulomb/RealSpace.h"
 #include "md/engine/Engine.h"
+#include "md/io/InitialState.h"
 #include "meanfield/kinetic/Cooling.h"
 
 using namespace granagg;
@@ -37,7 +38,7 @@ TEST_CASE("engine forces with PPPM equal converged plain Ewald plus contacts", "
   // A bipolar state: the engine's total force (contacts + real space over the neighbour list +
   // mesh) against contacts (K = 0 engine) + the independent EwaldReference at 1e-10.
   MdConfig c = chargedConfig(600, 7, 2.0, "pppm");
-  const Frame init = Engine::randomInitialState(c);
+  const Frame init = randomInitialState(c);
   Engine pppm(c, init);
   MdConfig c0 = c;
   c0.coulomb.K = 0.0;
@@ -72,7 +73,7 @@ TEST_CASE("fixed charges and elastic contacts: energy drift below 1e-4 over 1e4 
     MdConfig c = chargedConfig(mesh ? 250 : 100, 11, 1.0, method);
     c.contact.D = 0.0;  // elastic: kinetic + elastic + Coulomb energy is conserved
     const int steps = mesh ? 10000 : 2000;
-    Engine e(c, Engine::randomInitialState(c));
+    Engine e(c, randomInitialState(c));
     const auto o0 = e.observables();
     const double E0 = totalEnergy(o0);
     // scale: the kinetic energy (the total can be small when the Coulomb energy is negative)
@@ -108,7 +109,7 @@ TEST_CASE("monopolar charges cool more slowly than Haff's law", "[md][coulomb]")
     c.charging.initial = "monopolar";
     c.coulomb.K = K;
     c.coulomb.accuracy = 1e-3;
-    Engine e(c, Engine::randomInitialState(c));
+    Engine e(c, randomInitialState(c));
     e.run(static_cast<std::int64_t>(std::llround(12.0 / e.dt())));
     return e.observables().temperature;
   };
@@ -235,9 +236,9 @@ TEST_CASE(
   {
     MdConfig c = chargedConfig(600, 7, 2.0, "pppm");
     c.integrator.dt = 0.002;
-    const Frame init = Engine::randomInitialState(c);
+    const Frame init = randomInitialState(c);
     Engine pppm(c, init);
-    REQUIRE(pppm.coulombSetup()->every == 8);  // "auto" at dt = 0.002
+    REQUIRE(pppm.coulombSetup()->every == 8);     // "auto" at dt = 0.002
     REQUIRE(pppm.coulombSetup()->r_fast == 2.0);  // "auto"
     MdConfig c0 = c;
     c0.coulomb.K = 0.0;
@@ -278,7 +279,7 @@ TEST_CASE(
     c.integrator.dt = 0.002;
     c.coulomb.every = sp.every;
     c.coulomb.r_fast = sp.r_fast;
-    Engine e(c, Engine::randomInitialState(c));
+    Engine e(c, randomInitialState(c));
     REQUIRE(e.coulombSetup()->every == (sp.every == 0 ? 8 : 1));
     const auto o0 = e.observables();
     const double E0 = totalEnergy(o0), scale = o0.kinetic_energy;
@@ -302,7 +303,7 @@ TEST_CASE(
     c.charging.initial = "bipolar";
     c.charging.q0 = 0.3;
     c.charging.Q = 0.1;
-    const Frame init = Engine::randomInitialState(c);
+    const Frame init = randomInitialState(c);
     Engine one(c, init);
     one.run(403);
     Engine first(c, init);
@@ -345,7 +346,7 @@ TEST_CASE(
     c.integrator.impact_speed_max = 16.0;
     c.coulomb.every_max = 16;
     c.coulomb.r_fast = 3.5;
-    Engine e(c, Engine::randomInitialState(c));
+    Engine e(c, randomInitialState(c));
     REQUIRE(e.coulombSetup()->every == 8);
     REQUIRE(e.coulombSetup()->every_max == 16);
     const auto o0 = e.observables();
@@ -376,7 +377,7 @@ TEST_CASE(
     c.charging.Q = 0.1;
     c.integrator.impact_speed_max = 40.0;  // the auto dt is then shorter; the interval varies
     c.coulomb.every_max = 20;
-    const Frame init = Engine::randomInitialState(c);
+    const Frame init = randomInitialState(c);
     Engine one(c, init);
     one.run(1003);
     Engine first(c, init);
@@ -404,7 +405,7 @@ TEST_CASE("a restart keeps the split it was written with, whatever \"auto\" mean
   MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
   c.coulomb.r_fast = 2.5;
   c.coulomb.every_max = 12;
-  Engine first(c, Engine::randomInitialState(c));
+  Engine first(c, randomInitialState(c));
   first.run(10);
   Checkpoint ck = first.checkpoint();
   MdConfig automatic = c;

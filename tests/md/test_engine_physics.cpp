@@ -10,6 +10,7 @@
 
 #include "md/config/MdConfig.h"
 #include "md/engine/Engine.h"
+#include "md/io/InitialState.h"
 #include "meanfield/kinetic/Cooling.h"
 #include "meanfield/kinetic/Restitution.h"
 
@@ -87,7 +88,7 @@ TEST_CASE("spring-dashpot collisions rebound with the configured restitution", "
 TEST_CASE("momentum is conserved and elastic energy does not drift", "[md][physics]") {
   SECTION("momentum, dissipative gas") {
     MdConfig c = gasConfig(500, 27.7, 3);
-    Engine e(c, Engine::randomInitialState(c));
+    Engine e(c, randomInitialState(c));
     e.run(3000);
     const auto o = e.observables();
     REQUIRE(o.collisions > 100);
@@ -98,7 +99,7 @@ TEST_CASE("momentum is conserved and elastic energy does not drift", "[md][physi
     c.system.phi = 0.15;  // denser: more collisions per step, a harder test
     auto maxError = [&](double dt, long steps) {
       c.integrator.dt = dt;
-      Engine e(c, Engine::randomInitialState(c));
+      Engine e(c, randomInitialState(c));
       const auto o0 = e.observables();
       const double E0 = o0.kinetic_energy + o0.elastic_energy;
       double worst = 0.0;
@@ -126,7 +127,7 @@ TEST_CASE("momentum is conserved and elastic energy does not drift", "[md][physi
 TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart",
           "[md][determinism]") {
   MdConfig c = gasConfig(1500, 27.7, 9);
-  const Frame init = Engine::randomInitialState(c);
+  const Frame init = randomInitialState(c);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
   Engine one(c, init);
@@ -151,7 +152,7 @@ TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart"
 
   // a different seed gives a different trajectory
   MdConfig c2 = gasConfig(1500, 27.7, 10);
-  Engine other(c2, Engine::randomInitialState(c2));
+  Engine other(c2, randomInitialState(c2));
   other.run(10);
   CHECK_FALSE(other.frame().x == one.frame().x);
 }
@@ -161,7 +162,7 @@ TEST_CASE(
     "input is refused",
     "[md][init]") {
   MdConfig c = gasConfig(3000, 27.7, 1);
-  const Frame f = Engine::randomInitialState(c);
+  const Frame f = randomInitialState(c);
   double p[3] = {0, 0, 0}, s2 = 0;
   for (std::size_t i = 0; i < f.size(); ++i) {
     p[0] += f.vx[i];

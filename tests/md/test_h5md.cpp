@@ -19,9 +19,9 @@
 #include <sstream>
 #include <string>
 
+#include "common/Hdf5.h"
 #include "md/io/H5mdReader.h"
 #include "md/io/H5mdWriter.h"
-#include "md/io/Hdf5Util.h"
 
 #include "TestUtil.h"
 
@@ -30,7 +30,7 @@ using granagg::test::slurp;
 using granagg::test::tempPath;
 
 using namespace granagg::md;
-namespace h5 = granagg::md::h5;
+namespace h5 = granagg::common::h5;
 
 namespace {
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "common/Hdf5.h"
 #include "md/config/MdConfig.h"
 #include "md/io/H5mdReader.h"
-#include "md/io/Hdf5Util.h"
 #include "md/run/Simulation.h"
 
 #include "TestUtil.h"
@@ -122,18 +122,17 @@ TEST_CASE("a resumed Simulation writes the uninterrupted trajectory to the bit",
   requireSameTrajectory(dir / "a", dir / "b", stop);
   // the trajectory records its continuation; /parameters still describes the start
   {
-    namespace h5 = granagg::md::h5;
+    namespace h5 = granagg::common::h5;
     h5::silenceErrors();
-    const h5::Handle f = h5::check(
-        H5Fopen((dir / "b" / "traj.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open");
+    const h5::Handle f =
+        h5::check(H5Fopen((dir / "b" / "traj.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open");
     REQUIRE(h5::exists(f.get(), "/granagg/restarts/0"));
     CHECK_FALSE(h5::exists(f.get(), "/granagg/restarts/1"));
     const h5::Handle g = h5::check(H5Gopen2(f.get(), "/granagg/restarts/0", H5P_DEFAULT), "g");
     const h5::Handle cmd = h5::openAttribute(g.get(), "command");
     CHECK(h5::readString(cmd.get(), true, "command") == "test --restart");
     const h5::Handle st = h5::openAttribute(g.get(), "step");
-    CHECK(h5::readNumericAttribute<std::int64_t>(st.get(), H5T_NATIVE_INT64, "step").at(0) ==
-          stop);
+    CHECK(h5::readNumericAttribute<std::int64_t>(st.get(), H5T_NATIVE_INT64, "step").at(0) == stop);
   }
   if (std::getenv("GRANAGG_KEEP_TEST_FILES") == nullptr) fs::remove_all(dir);
 }

@@ -1,10 +1,10 @@
 #pragma once
-/// \file Hdf5Util.h
-/// Thin helpers over the HDF5 C API shared by the H5MD writer and reader, the checkpoint and the
-/// tests: an RAII handle, attribute and dataset helpers, and the text of the last HDF5 error.
-/// Debian ships no HDF5 C++ wrapper (design.md section 6), hence this file. Internal to md/io and
-/// tests: public headers (H5mdWriter.h, H5mdReader.h, Checkpoint.h) do not include it, so users
-/// of the engine need no HDF5 include path.
+/// \file Hdf5.h
+/// The one layer of helpers over the HDF5 C API, for every module that reads or writes HDF5 (md's
+/// H5MD writer, reader and checkpoint; analysis's trajectory reader and analysis.h5; fit-beta; the
+/// tests): an RAII handle, attribute and dataset helpers, and the text of the last HDF5 error.
+/// Debian ships no HDF5 C++ wrapper (design.md section 6), hence this file. Included by .cpp files
+/// only: the modules' public headers do not include it, so their users need no HDF5 include path.
 ///
 /// Every helper that can fail throws std::runtime_error whose message starts with the context
 /// the caller passes (usually "'<file>': <object>") and ends with HDF5's own description.
@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-namespace granagg::md::h5 {
+namespace granagg::common::h5 {
 
 /// Turns off HDF5's automatic printing of its error stack to stderr; our exceptions carry the
 /// message instead. Affects the calling thread's default error stack (HDF5 keeps one per thread).
@@ -481,4 +481,29 @@ std::vector<T> readAll(hid_t dset, hid_t mem_type, const std::string& ctx) {
   return out;
 }
 
-}  // namespace granagg::md::h5
+/// A scalar string attribute `name` of `obj` (fixed or variable length) as text; "" when it is not
+/// a string. Throws when the attribute does not exist or cannot be read.
+inline std::string readStringAttribute(hid_t obj, const std::string& name,
+                                       const std::string& context) {
+  Handle attr = openAttribute(obj, name);
+  if (!attr) fail(context + ": cannot open attribute '" + name + "'");
+  Handle type = check(H5Aget_type(attr.get()), context);
+  if (H5Tget_class(type.get()) != H5T_STRING) return "";
+  return readString(attr.get(), true, context + ": attribute '" + name + "'");
+}
+
+/// Writes a whole dataset of shape `shape` (file type `file_type`, memory type `mem_type`).
+inline void writeDataset(hid_t loc, const std::string& name, hid_t file_type, hid_t mem_type,
+                         const std::vector<hsize_t>& shape, const void* data,
+                         const std::string& context) {
+  Handle space(shape.empty()
+                   ? H5Screate(H5S_SCALAR)
+                   : H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr));
+  Handle d = check(
+      H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      context + ": cannot create dataset '" + name + "'");
+  checkStatus(H5Dwrite(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
+              context + ": cannot write '" + name + "'");
+}
+
+}  // namespace granagg::common::h5
