@@ -1,6 +1,4 @@
 /// `granagg analyze`: trajectory analysis of one run or an ensemble (analysis/, docs/analysis.md).
-#include <unistd.h>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -19,6 +17,7 @@
 #include "analysis/pipeline/RunAnalyzer.h"
 #include "cli/CliContext.h"
 #include "common/Csv.h"
+#include "common/ProgressLine.h"
 
 namespace granagg::cli {
 namespace an = granagg::analysis;
@@ -51,30 +50,6 @@ struct AnalyzeArgs {
   double onset_baseline = 10.0;
   double fisher_bin_ratio = 2.0;
   int threads = 0;
-};
-
-/// Progress line on a terminal only (stderr), at most twice a second.
-class Progress {
- public:
-  explicit Progress(bool on) : m_on(on && ::isatty(2)) {}
-  void update(std::size_t run, std::size_t runs, std::size_t frame, std::size_t hint) {
-    if (!m_on) return;
-    const auto now = std::chrono::steady_clock::now();
-    if (frame > 1 && std::chrono::duration<double>(now - m_last).count() < 0.5) return;
-    m_last = now;
-    if (hint)
-      std::fprintf(stderr, "\ranalyze: run %zu/%zu, frame %zu/%zu   ", run + 1, runs, frame, hint);
-    else
-      std::fprintf(stderr, "\ranalyze: run %zu/%zu, frame %zu   ", run + 1, runs, frame);
-    std::fflush(stderr);
-  }
-  void done() {
-    if (m_on) std::fprintf(stderr, "\r%60s\r", "");
-  }
-
- private:
-  bool m_on;
-  std::chrono::steady_clock::time_point m_last{};
 };
 
 an::AnalysisOptions toOptions(const AnalyzeArgs& a) {
@@ -223,12 +198,15 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
   const std::string h5path = (out / "analysis.h5").string();
   auto file = std::make_unique<an::AnalysisFile>(h5path, a.force, provenanceOf(a, o, ctx, {}));
   std::vector<an::RunResult> results;
-  Progress progress(!a.quiet);
+  common::ProgressLine progress("analyze", !a.quiet);  // in place, or a line a minute in a log
   try {
     for (std::size_t k = 0; k < a.runs.size(); ++k) {
       an::RunCallbacks cb;
       cb.progress = [&](std::size_t frame, std::size_t hint) {
-        progress.update(k, a.runs.size(), frame, hint);
+        if (progress.due())
+          progress.show("run " + std::to_string(k + 1) + "/" + std::to_string(a.runs.size()) +
+                        ", frame " + std::to_string(frame) +
+                        (hint ? "/" + std::to_string(hint) : std::string()));
       };
       if (a.write_grid)
         cb.grid = [&](const an::Frame& f, const an::GridClusters& g) {
@@ -238,7 +216,7 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
       an::checkSameSystem(results.front(), results.back());  // before analysing the rest
     }
   } catch (...) {
-    progress.done();
+    progress.finish();
     file.reset();
     std::error_code ec;
     fs::remove(h5path, ec);
@@ -249,7 +227,7 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
       fs::remove(out / "per_run", ec);
     throw;
   }
-  progress.done();
+  progress.finish();
   const std::vector<an::Table> ensemble = an::analyzeEnsemble(results, o);
   const common::Provenance prov = provenanceOf(a, o, ctx, results);
 

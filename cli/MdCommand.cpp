@@ -17,6 +17,7 @@
 
 #include "cli/CliContext.h"
 #include "common/Csv.h"
+#include "common/ProgressLine.h"
 #include "common/Version.h"
 #include "md/config/ConfigParser.h"
 #include "md/engine/Engine.h"
@@ -41,39 +42,46 @@ struct MdArgs {
 };
 
 /// The progress line on a terminal (stderr), at most twice a second.
+/// The progress line (common/ProgressLine.h): in place on a terminal, a line a minute in a log.
 class ProgressReporter : public md::Reporter {
  public:
   explicit ProgressReporter(const md::Simulation& sim)
-      : m_on(::isatty(2)),
+      : m_line("md", true),
         m_t_end(sim.config().run.t_end),
+        m_t_start(sim.engine().time()),
         m_first_step(sim.engine().step()),
-        m_start(Clock::now()),
-        m_last(m_start) {}
+        m_start(Clock::now()) {}
   void report(const md::Simulation& sim) override {
-    if (!m_on) return;
-    const auto now = Clock::now();
-    if (std::chrono::duration<double>(now - m_last).count() < 0.5) return;
-    m_last = now;
+    if (!m_line.due()) return;
     const md::Engine& e = sim.engine();
-    const double el = std::chrono::duration<double>(now - m_start).count();
-    const double rate = (e.step() - m_first_step) / std::max(el, 1e-9);
-    const double frac = e.time() / m_t_end;
-    const double eta = frac > 0 ? el * (1 - frac) / frac : 0.0;
-    std::fprintf(stderr, "\rmd: t = %.4g / %.4g  T_g = %.4g  %.3g steps/s  ETA %.0f s   ", e.time(),
-                 m_t_end, sim.lastObservables().temperature, rate, eta);
-    std::fflush(stderr);
-    m_printed = true;
+    const double el = std::chrono::duration<double>(Clock::now() - m_start).count();
+    const double rate = static_cast<double>(e.step() - m_first_step) / std::max(el, 1e-9);
+    const double done = (e.time() - m_t_start) / std::max(m_t_end - m_t_start, 1e-300);
+    const double eta = done > 0 ? el * (1 - done) / done : 0.0;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "t = %.4g / %.4g  T_g = %.4g  %.3g particle-steps/s  ETA %s",
+                  e.time(), m_t_end, sim.lastObservables().temperature,
+                  rate * static_cast<double>(e.size()), duration(eta).c_str());
+    m_line.show(buf);
   }
-  void finish(const md::Simulation&) override {
-    if (m_printed) std::fprintf(stderr, "\n");
-  }
+  void finish(const md::Simulation&) override { m_line.finish(); }
 
  private:
   using Clock = std::chrono::steady_clock;
-  bool m_on, m_printed = false;
-  double m_t_end;
+  static std::string duration(double s) {
+    char b[32];
+    if (s < 120)
+      std::snprintf(b, sizeof b, "%.0f s", s);
+    else if (s < 7200)
+      std::snprintf(b, sizeof b, "%.0f min", s / 60);
+    else
+      std::snprintf(b, sizeof b, "%.1f h", s / 3600);
+    return b;
+  }
+  common::ProgressLine m_line;
+  double m_t_end, m_t_start;
   std::int64_t m_first_step;
-  Clock::time_point m_start, m_last;
+  Clock::time_point m_start;
 };
 
 /// `--profile`: the loop's wall time by phase, as a table on stderr (profile.csv has the same).

@@ -104,9 +104,9 @@ const std::vector<std::string> FITS_COLUMNS = {"z_grid",
 const char* FITS_DESCRIPTION =
     "growth exponent z of S(t) ~ t^z (grid and particle clusters) by least squares of ln S on ln t "
     "over "
-    "[fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; bootstrap "
-    "over runs, percentile "
-    "interval, for the ensemble); err = standard error (bootstrap: std of replicates); "
+    "[fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; for the "
+    "ensemble the bootstrap over runs, z -/+ t_{R-1} sqrt(R/(R-1)) sd of the replicates, the "
+    "rule of fit-beta); err = standard error (bootstrap: sd of the replicates); "
     "charging_rate_exponent: "
     "the same fit to d<|q|>/dt over [charge_fit_t_min, charge_fit_t_max], beside the expected -5/6 "
     "- 5 kappa/3; "

@@ -1,12 +1,12 @@
 #include "analysis/stats/GrowthMarkers.h"
 
+#include "common/Statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
-
-#include <gsl/gsl_fit.h>
 
 namespace granagg::analysis {
 
@@ -39,12 +39,11 @@ LogBinnedFit fitLogBinnedPowerLaw(const std::map<std::uint64_t, std::uint64_t>& 
   }
   fit.bins = x.size();
   if (x.size() < min_bins) return fit;
-  double c0, c1, cov00, cov01, cov11, sumsq;
-  gsl_fit_linear(x.data(), 1, y.data(), 1, x.size(), &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
-  // gsl_fit_linear's covariance assumes unit variance; scale by the residual variance.
-  const double s2 = sumsq / static_cast<double>(x.size() - 2);
-  fit.tau = -c1;
-  fit.tau_err = std::sqrt(cov11 * s2);
+  // (gsl_fit_linear's covariance is already estimated from the scatter about the line; this fit
+  // used to scale it by the residual variance a second time, so tau_err was off by that factor)
+  const common::stats::LineFit f = common::stats::fitLine(x, y);
+  fit.tau = -f.slope;
+  fit.tau_err = f.slope_se;
   fit.valid = std::isfinite(fit.tau);
   return fit;
 }

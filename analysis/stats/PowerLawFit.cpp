@@ -1,12 +1,11 @@
 #include "analysis/stats/PowerLawFit.h"
 
+#include "common/Statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
-
-#include <gsl/gsl_cdf.h>
-#include <gsl/gsl_fit.h>
 
 namespace granagg::analysis {
 
@@ -27,16 +26,15 @@ PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<do
   PowerLawFitResult r;
   r.points = lx.size();
   if (r.points < 3) return r;
-  double c0, c1, cov00, cov01, cov11, sumsq;
-  gsl_fit_linear(lx.data(), 1, ly.data(), 1, lx.size(), &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
-  // gsl_fit_linear's cov11 is sumsq/(n-2) * 1/sum (x - <x>)^2: the usual OLS variance of the slope.
-  r.exponent = c1;
-  r.amplitude = std::exp(c0);
-  r.stderr_z = std::sqrt(cov11);
-  const double q = gsl_cdf_tdist_Pinv(0.5 + confidence / 2, static_cast<double>(r.points - 2));
-  r.low = c1 - q * r.stderr_z;
-  r.high = c1 + q * r.stderr_z;
-  r.valid = std::isfinite(c1);
+  const common::stats::LineFit f = common::stats::fitLine(lx, ly);
+  r.exponent = f.slope;
+  r.amplitude = std::exp(f.intercept);
+  r.stderr_z = f.slope_se;
+  const double half =
+      common::stats::studentHalfWidth(r.stderr_z, static_cast<double>(r.points - 2), confidence);
+  r.low = f.slope - half;
+  r.high = f.slope + half;
+  r.valid = std::isfinite(f.slope);
   return r;
 }
 
@@ -70,15 +68,11 @@ PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t,
     const PowerLawFitResult f = fitPowerLaw(t, meanOver(pick), t_min, t_max, confidence);
     if (f.valid) z.push_back(f.exponent);
   }
-  std::sort(z.begin(), z.end());
-  auto quantile = [&](double q) {
-    const double pos = q * static_cast<double>(z.size() - 1);
-    const std::size_t i = static_cast<std::size_t>(pos);
-    const double w = pos - static_cast<double>(i);
-    return i + 1 < z.size() ? z[i] * (1 - w) + z[i + 1] * w : z[i];
-  };
-  out.low = quantile(0.5 - confidence / 2);
-  out.high = quantile(0.5 + confidence / 2);
+  // the interval rule of common/Statistics.h (the same as fit-beta's); err: the replicates' sd
+  const common::stats::Interval in =
+      common::stats::bootstrapInterval(z, out.exponent, runs.size(), confidence);
+  out.low = in.low;
+  out.high = in.high;
   double mean = 0, var = 0;
   for (double v : z) mean += v;
   mean /= static_cast<double>(z.size());
@@ -89,30 +83,7 @@ PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t,
 
 std::vector<double> localSlope(const std::vector<double>& t, const std::vector<double>& y,
                                double p) {
-  if (t.size() != y.size()) throw std::invalid_argument("localSlope: t and y differ in length.");
-  if (!(p > 1.0)) throw std::invalid_argument("localSlope requires p > 1.");
-  std::vector<double> z(t.size(), std::nan(""));
-  const double lp = std::log(p);
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    if (!(t[k] > 0) || !(y[k] > 0)) continue;
-    const double tp = t[k] / p;
-    // bracketing samples a <= tp <= b with positive t and y
-    std::size_t b = 0;
-    while (b < k && t[b] < tp) ++b;
-    if (b > k) continue;
-    double yp;
-    if (t[b] == tp) {
-      yp = y[b];
-    } else {
-      if (b == 0) continue;
-      const std::size_t a = b - 1;
-      if (!(t[a] > 0) || !(y[a] > 0) || !(y[b] > 0)) continue;
-      const double w = (std::log(tp) - std::log(t[a])) / (std::log(t[b]) - std::log(t[a]));
-      yp = std::exp(std::log(y[a]) * (1 - w) + std::log(y[b]) * w);
-    }
-    if (yp > 0) z[k] = std::log(y[k] / yp) / lp;
-  }
-  return z;
+  return common::stats::localSlope(t, y, p);
 }
 
 }  // namespace granagg::analysis

@@ -30,8 +30,9 @@ PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<do
 
 /// Bootstrap over runs: `runs[r][k]` is run r's y at time t[k]. Each replicate draws the runs with
 /// replacement (std::mt19937_64 seeded with `seed`, so results are reproducible), averages y over
-/// them and fits the power law; the interval is the percentile interval of the replicate
-/// exponents. `exponent` is the fit to the mean over all runs. Needs 2 runs.
+/// them and fits the power law. `exponent` is the fit to the mean over all runs; the interval is
+/// common/Statistics.h's bootstrap rule (exponent -/+ t_{R-1} sqrt(R/(R-1)) sd of the replicate
+/// exponents, the rule fit-beta uses); stderr_z is that sd. Needs 2 runs.
 PowerLawFitResult bootstrapPowerLaw(const std::vector<double>& t,
                                     const std::vector<std::vector<double>>& runs, double t_min,
                                     double t_max, int replicates = 2000, std::uint64_t seed = 20091,

@@ -5,16 +5,14 @@
 #include <limits>
 #include <stdexcept>
 
-#include <gsl/gsl_cdf.h>
 #include <gsl/gsl_errno.h>
-#include <gsl/gsl_fit.h>
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_rng.h>
 #include <gsl/gsl_roots.h>
 #include <gsl/gsl_spline.h>
-#include <gsl/gsl_statistics_double.h>
 
 #include "common/Csv.h"
+#include "common/Statistics.h"
 #include "meanfield/kernels/Kernel.h"
 #include "meanfield/solvers/SectionalSolver.h"
 #include "meanfield/solvers/SmolResult.h"
@@ -35,27 +33,7 @@ std::string rounded(double x) {
 
 constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NaN;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-/// Interval from bootstrap replicates over R runs: estimate -/+ t_{R-1} sqrt(R / (R - 1))
-/// sd(replicates). The bootstrap standard deviation of a mean over R resampled runs is biased low
-/// by sqrt((R - 1) / R), and with few runs the quantile must be Student's t with R - 1 degrees of
-/// freedom: a percentile interval over 5 runs covers only about 1.75 standard errors where 2.78 are
-/// needed.
-void bootstrapInterval(const std::vector<double>& values, double estimate, std::size_t runs,
-                       double confidence, double& low, double& high) {
-  const double sd = gsl_stats_sd(values.data(), 1, values.size());
-  const double R = static_cast<double>(runs);
-  const double tq = gsl_cdf_tdist_Pinv(0.5 + confidence / 2.0, R - 1.0);
-  const double half = tq * std::sqrt(R / (R - 1.0)) * sd;
-  low = estimate - half;
-  high = estimate + half;
-}
+using common::stats::median;
 
 /// Mean over the runs chosen by `pick` (indices into data.runs), at every time.
 std::vector<double> resampledMean(const GrowthData& data, const std::vector<std::size_t>& pick) {
@@ -82,14 +60,22 @@ struct Rng {
   }
 };
 
-/// OLS slope and intercept of y on x.
+/// OLS slope and intercept of y on x (common/Statistics.h).
 void ols(const std::vector<double>& x, const std::vector<double>& y, double& slope,
          double& intercept, double& se_slope) {
-  double c0, c1, cov00, cov01, cov11, sumsq;
-  gsl_fit_linear(x.data(), 1, y.data(), 1, x.size(), &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
-  slope = c1;
-  intercept = c0;
-  se_slope = std::sqrt(std::max(cov11, 0.0));
+  const common::stats::LineFit f = common::stats::fitLine(x, y);
+  slope = f.slope;
+  intercept = f.intercept;
+  se_slope = f.slope_se;
+}
+
+/// The bootstrap interval rule of common/Statistics.h, into low and high.
+void bootstrapInterval(const std::vector<double>& values, double estimate, std::size_t runs,
+                       double confidence, double& low, double& high) {
+  const common::stats::Interval in =
+      common::stats::bootstrapInterval(values, estimate, runs, confidence);
+  low = in.low;
+  high = in.high;
 }
 
 }  // namespace
@@ -324,9 +310,9 @@ ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window,
     f.interval_method = "bootstrap-runs";
     f.replicates = o.replicates_z;
   } else {
-    const double tq =
-        gsl_cdf_tdist_Pinv(0.5 + o.confidence / 2.0, static_cast<double>(idx.size() - 2));
-    const double half = std::max(tq * se, ROUNDOFF);
+    const double half = std::max(
+        common::stats::studentHalfWidth(se, static_cast<double>(idx.size() - 2), o.confidence),
+        ROUNDOFF);
     f.z_low = f.z - half;
     f.z_high = f.z + half;
     f.interval_method = "student-t";
@@ -803,9 +789,11 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
     fit.interval_method = "bootstrap-runs";
     fit.replicates = static_cast<int>(bs.size());
   } else {
-    const double tq = gsl_cdf_tdist_Pinv(0.5 + conf / 2.0, dof);
     const double scale = fit.chi2_dof;  // covariance scaled by chi^2/dof (unit weights)
-    auto half = [&](int k) { return tq * std::sqrt(std::max(r.cov[k][k] * scale, 0.0)); };
+    auto half = [&](int k) {
+      return common::stats::studentHalfWidth(std::sqrt(std::max(r.cov[k][k] * scale, 0.0)), dof,
+                                             conf);
+    };
     fit.beta_low = prob.betaOf(r.u - half(0));
     fit.beta_high = prob.betaOf(r.u + half(0));
     fit.S_c_low = std::exp(r.lnSc - half(1));

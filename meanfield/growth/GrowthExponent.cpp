@@ -4,10 +4,8 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include <gsl/gsl_cdf.h>
-#include <gsl/gsl_fit.h>
-
 #include "common/Csv.h"
+#include "common/Statistics.h"
 
 namespace granagg::meanfield {
 
@@ -33,24 +31,14 @@ LocalSlope localSlope(const std::vector<double>& t, const std::vector<double>& S
     throw std::invalid_argument("the local-slope ratio p must be > 1 (got " +
                                 common::formatReal(p) + ").");
   checkSeries(t, S);
+  // (common/Statistics.h; NaN only where t_i / p precedes the first time: left out here)
+  const std::vector<double> z = common::stats::localSlope(t, S, p);
   LocalSlope out;
-  const double lp = std::log(p);
-  std::size_t j = 0;  // bracket index for t_i / p, moves forward monotonically
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    const double tp = t[i] / p;
-    if (tp < t.front()) continue;
-    while (j + 1 < t.size() && t[j + 1] < tp) ++j;
-    const std::size_t k = std::min(j + 1, t.size() - 1);
-    double logSp;
-    if (k == j) {
-      logSp = std::log(S[j]);
-    } else {  // linear in (log t, log S): exact for a power law
-      const double f = std::log(tp / t[j]) / std::log(t[k] / t[j]);
-      logSp = (1.0 - f) * std::log(S[j]) + f * std::log(S[k]);
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (!std::isnan(z[i])) {
+      out.t.push_back(t[i]);
+      out.z.push_back(z[i]);
     }
-    out.t.push_back(t[i]);
-    out.z.push_back((std::log(S[i]) - logSp) / lp);
-  }
   return out;
 }
 
@@ -70,20 +58,20 @@ PowerLawFit fitPowerLaw(const std::vector<double>& t, const std::vector<double>&
     throw std::invalid_argument("power-law fit needs at least 3 points in the window [" +
                                 common::formatReal(t_min) + ", " + common::formatReal(t_max) +
                                 "], found " + std::to_string(x.size()) + ".");
-  double c0, c1, cov00, cov01, cov11, sumsq;
-  gsl_fit_linear(x.data(), 1, y.data(), 1, x.size(), &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
+  const common::stats::LineFit line = common::stats::fitLine(x, y);
   PowerLawFit f;
-  f.z = c1;
-  f.z_stderr = std::sqrt(cov11);  // gsl_fit_linear scales the covariance by the residual variance
-  const double tq = gsl_cdf_tdist_Pinv(0.5 + confidence / 2.0, static_cast<double>(x.size() - 2));
-  f.z_low = c1 - tq * f.z_stderr;
-  f.z_high = c1 + tq * f.z_stderr;
-  f.prefactor = std::exp(c0);
+  f.z = line.slope;
+  f.z_stderr = line.slope_se;
+  const double half =
+      common::stats::studentHalfWidth(f.z_stderr, static_cast<double>(x.size() - 2), confidence);
+  f.z_low = f.z - half;
+  f.z_high = f.z + half;
+  f.prefactor = std::exp(line.intercept);
   f.confidence = confidence;
   f.points = static_cast<int>(x.size());
   f.t_min = std::exp(x.front());
   f.t_max = std::exp(x.back());
-  f.chi2 = sumsq;
+  f.chi2 = line.sumsq;
   return f;
 }
 
@@ -106,9 +94,7 @@ AsymptoticExponent asymptoticExponent(const std::vector<double>& t, const std::v
   a.z_last = ls.z.back();
   a.points = static_cast<int>(x.size());
   if (x.size() >= 3) {
-    double c0, c1, cov00, cov01, cov11, sumsq;
-    gsl_fit_linear(x.data(), 1, y.data(), 1, x.size(), &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
-    a.z = c0;  // intercept at 1/t -> 0
+    a.z = common::stats::fitLine(x, y).intercept;  // at 1/t -> 0
   } else {
     a.z = a.z_last;
   }

@@ -79,6 +79,23 @@ TEST_CASE("log-binned least squares: too few bins, bad options", "[analysis][fis
   const LogBinnedFit three = fitLogBinnedPowerLaw({{1, 100}, {2, 10}, {5, 1}});
   CHECK(three.valid);
   CHECK(three.bins == 3);
+  {  // against the textbook OLS by hand: bins [1,2) [2,4) [4,8) hold densities 100, 5, 0.25 at
+     // x = ln sqrt(lo (hi - 1)); se(slope) = sqrt(SSR / (n - 2) / Sxx). (Until 2026-12-02 the
+     // error was scaled by the residual variance twice.)
+    const double x[3] = {0.0, 0.5 * std::log(2.0 * 3.0), 0.5 * std::log(4.0 * 7.0)};
+    const double y[3] = {std::log(100.0), std::log(5.0), std::log(0.25)};
+    const double mx = (x[0] + x[1] + x[2]) / 3, my = (y[0] + y[1] + y[2]) / 3;
+    double sxx = 0, sxy = 0;
+    for (int i = 0; i < 3; ++i) {
+      sxx += (x[i] - mx) * (x[i] - mx);
+      sxy += (x[i] - mx) * (y[i] - my);
+    }
+    const double slope = sxy / sxx, icpt = my - slope * mx;
+    double ssr = 0;
+    for (int i = 0; i < 3; ++i) ssr += std::pow(y[i] - icpt - slope * x[i], 2);
+    CHECK(three.tau == Approx(-slope).epsilon(1e-12));
+    CHECK(three.tau_err == Approx(std::sqrt(ssr / 1.0 / sxx)).epsilon(1e-12));
+  }
   CHECK_THROWS_AS(fitLogBinnedPowerLaw({{1, 1}}, 1.0), std::invalid_argument);
   CHECK_THROWS_AS(fitLogBinnedPowerLaw({{1, 1}}, 2.0, 2), std::invalid_argument);
 }
