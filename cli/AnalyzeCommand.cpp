@@ -13,8 +13,7 @@
 #include <omp.h>
 #endif
 
-#include "analysis/io/AnalysisFile.h"
-#include "analysis/pipeline/RunAnalyzer.h"
+#include "analysis/pipeline/AnalysisFolder.h"
 #include "cli/CliContext.h"
 #include "common/Csv.h"
 #include "common/ProgressLine.h"
@@ -122,188 +121,31 @@ an::AnalysisOptions toOptions(const AnalyzeArgs& a) {
   return o;
 }
 
-common::Provenance provenanceOf(const AnalyzeArgs& a, const an::AnalysisOptions& o,
-                                const CliContext& ctx, const std::vector<an::RunResult>& runs) {
-  common::Provenance p(ctx.command_line);
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    p.add(
-        "run." + std::to_string(k),
-        runs[k].source + " (" + runs[k].format + ", " + std::to_string(runs[k].frames) +
-            " frames, N = " + std::to_string(runs[k].particles) +
-            (runs[k].grid_cells > 0
-                 ? ", grid " + std::to_string(runs[k].grid_cells) +
-                       "^3 cells of h = " + common::formatReal(runs[k].grid_cell_size) +
-                       ", occupied at >= " + common::formatReal(runs[k].grid_min_count) + " centres"
-                 : std::string()) +
-            (runs[k].partial ? ", PARTIAL" : "") + ")");
-  }
-  p.add("grid_spacing", o.grid.spacing);
-  p.add("grid_min_fill", o.grid.min_fill);
-  p.add("grid_min_count_option", o.grid.min_count);
-  p.add("grid_assign", a.grid_assign);
-  p.add("particle_tolerance", o.particle.tolerance);
-  p.add("slope_ratio_p", o.slope_ratio);
-  p.add("fit_window", o.fit_t_min > 0 || o.fit_t_max > 0
-                          ? common::formatReal(o.fit_t_min) + " " + common::formatReal(o.fit_t_max)
-                          : std::string("last decade [t_last/10, t_last]"));
-  p.add("charge_fit_window",
-        common::formatReal(o.charge_fit_t_min) + " " + common::formatReal(o.charge_fit_t_max));
-  p.add("mle_min_tail", static_cast<long long>(o.mle_min_tail));
-  p.add("speed_max", o.speed_max);
-  p.add("speed_bins", o.speed_bins);
-  p.add("msd_origins", o.msd_origins);
-  p.add("kappa", runs.empty() ? o.kappa : runs.front().kappa);
-  p.add("kappa_source", runs.empty() ? std::string("option") : runs.front().kappa_source);
-  p.add("track", static_cast<long long>(o.track));
-  p.add("bootstrap_replicates", o.bootstrap_replicates);
-  p.add("bootstrap_seed", static_cast<long long>(o.bootstrap_seed));
-  p.add("onset_factor", o.onset_factor);
-  p.add("onset_baseline", o.onset_t_base);
-  p.add("fisher_bin_ratio", o.fisher_bin_ratio);
-  return p;
-}
-
 void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
-  if (a.runs.empty())
-    throw std::invalid_argument("give at least one RUN (traj.h5, a run folder or a LAMMPS dump).");
   if (a.threads < 0) throw std::invalid_argument("--threads must be >= 1.");
 #ifdef _OPENMP
   if (a.threads > 0) omp_set_num_threads(a.threads);
 #endif
   const an::AnalysisOptions o = toOptions(a);
-  std::set<fs::path> seen;
-  for (const auto& r : a.runs) {
-    if (!fs::exists(r))
-      throw std::invalid_argument("no such trajectory or run folder: '" + r + "'");
-    // the ensemble statistics treat runs as independent samples: one run twice is not two
-    fs::path canonical = fs::weakly_canonical(r);
-    if (canonical.filename().empty()) canonical = canonical.parent_path();  // "dir/" = "dir"
-    if (!seen.insert(canonical).second)
-      throw std::invalid_argument("run '" + r +
-                                  "' is given twice: an ensemble needs independent runs");
-  }
-  const fs::path out(a.out);
-  if (fs::exists(out) && !fs::is_directory(out))
-    throw std::invalid_argument("--out '" + out.string() +
-                                "' is a file, not a folder; analyze writes a folder");
-  if (fs::exists(out) && !fs::is_empty(out) && !a.force)
-    throw std::invalid_argument(
-        "output folder '" + out.string() +
-        "' exists and is not empty; choose another --out or pass --force to overwrite it");
-  const bool created = !fs::exists(out);
-  fs::create_directories(out / "per_run");
-
-  // analysis.h5 is opened first so that --write-grid streams one frame at a time into it; a
-  // failed analysis removes it (no half-written file is left behind).
-  const std::string h5path = (out / "analysis.h5").string();
-  auto file = std::make_unique<an::AnalysisFile>(h5path, a.force, provenanceOf(a, o, ctx, {}));
-  std::vector<an::RunResult> results;
+  an::AnalysisFolderRequest request;
+  request.runs = a.runs;
+  request.out = a.out;
+  request.force = a.force;
+  request.write_grid = a.write_grid;
+  request.command_line = ctx.command_line;
   common::ProgressLine progress("analyze", !a.quiet);  // in place, or a line a minute in a log
-  try {
-    for (std::size_t k = 0; k < a.runs.size(); ++k) {
-      an::RunCallbacks cb;
-      cb.progress = [&](std::size_t frame, std::size_t hint) {
+  const an::AnalysisFolder folder =
+      an::analyseIntoFolder(request, o, [&](std::size_t run, std::size_t frame, std::size_t hint) {
         if (progress.due())
-          progress.show("run " + std::to_string(k + 1) + "/" + std::to_string(a.runs.size()) +
+          progress.show("run " + std::to_string(run + 1) + "/" + std::to_string(a.runs.size()) +
                         ", frame " + std::to_string(frame) +
                         (hint ? "/" + std::to_string(hint) : std::string()));
-      };
-      if (a.write_grid)
-        cb.grid = [&](const an::Frame& f, const an::GridClusters& g) {
-          file->writeGridFrame(k, f, g);
-        };
-      results.push_back(an::analyzeRun(a.runs[k], o, cb));
-      an::checkSameSystem(results.front(), results.back());  // before analysing the rest
-    }
-  } catch (...) {
-    progress.finish();
-    file.reset();
-    std::error_code ec;
-    fs::remove(h5path, ec);
-    // nothing left that would block the rerun: a folder made here goes, an empty per_run too
-    if (created)
-      fs::remove_all(out, ec);
-    else
-      fs::remove(out / "per_run", ec);
-    throw;
-  }
+      });
   progress.finish();
-  const std::vector<an::Table> ensemble = an::analyzeEnsemble(results, o);
-  const common::Provenance prov = provenanceOf(a, o, ctx, results);
-
-  // Per-run tables (long format, leading run column) and ensemble tables.
-  for (const an::Table& t : results.front().tables) {
-    std::vector<const an::Table*> all;
-    for (const auto& r : results)
-      if (r.hasTable(t.name)) all.push_back(&r.table(t.name));
-    an::writeCsv(an::stackRuns(all), (out / "per_run" / (t.name + ".csv")).string(), prov, a.force);
-  }
-  for (const an::Table& t : ensemble)
-    an::writeCsv(t, (out / (t.name + ".csv")).string(), prov, a.force);
-
-  for (std::size_t k = 0; k < results.size(); ++k) {
-    const auto& r = results[k];
-    const std::string g = "runs/" + std::to_string(k);
-    for (const auto& t : r.tables) file->writeTable(g, t);
-    std::map<std::string, std::string> attrs{
-        {"source", r.source},
-        {"format", r.format},
-        {"frames", std::to_string(r.frames)},
-        {"particles", std::to_string(r.particles)},
-        {"partial", r.partial ? r.partial_reason : "no"},
-        {"kappa", common::formatReal(r.kappa) + " (" + r.kappa_source + ")"},
-        {"grid_cells_per_side", std::to_string(r.grid_cells)},
-        {"grid_cell_size", common::formatReal(r.grid_cell_size)},
-        {"grid_min_count", common::formatReal(r.grid_min_count)}};
-    std::string notes;
-    for (const auto& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
-    attrs["notes"] = notes;
-    for (const auto& [key, v] : r.parameters) attrs["parameters." + key] = v;
-    file->writeAttributes(g, attrs);
-  }
-  for (const auto& t : ensemble) file->writeTable("ensemble", t);
-  std::map<std::string, std::string> root;
-  for (const auto& [key, v] : prov.parameters()) root[key] = v;
-  file->writeAttributes("ensemble", root);
-  file->close();
-
   if (a.quiet) return;
-  for (std::size_t k = 0; k < results.size(); ++k) {
-    const auto& r = results[k];
-    std::fprintf(stderr, "analyze: run %zu: %s (%s): %zu frames, N = %zu%s\n", k, r.source.c_str(),
-                 r.format.c_str(), r.frames, r.particles, r.partial ? " [PARTIAL]" : "");
-    if (r.grid_cells > 0)
-      std::fprintf(
-          stderr, "analyze:   grid: %d^3 cells of h = %.4g d, occupied at >= %g centres per cell\n",
-          r.grid_cells, r.grid_cell_size, r.grid_min_count);
-    for (const auto& n : r.notes) std::fprintf(stderr, "analyze:   note: %s\n", n.c_str());
-  }
-  for (const auto& t : ensemble)
-    if (t.name == "fits" && !t.rows.empty()) {
-      const auto& row = t.rows.front();
-      auto c = [&](const char* name) { return row[t.column(name)]; };
-      std::fprintf(
-          stderr,
-          "analyze: z (grid) = %.4g [%.4g, %.4g], z (particle) = %.4g [%.4g, %.4g] over t in "
-          "[%.4g, %.4g] (%s)\n",
-          c("z_grid"), c("z_grid_low"), c("z_grid_high"), c("z_particle"), c("z_particle_low"),
-          c("z_particle_high"), c("fit_t_min"), c("fit_t_max"),
-          results.size() > 1 ? "95% bootstrap over runs" : "95% Student t");
-      if (std::isfinite(c("charging_rate_exponent")))
-        std::fprintf(
-            stderr,
-            "analyze: d<|q|>/dt ~ t^%.4g [%.4g, %.4g]; expected -5/6 - 5 kappa/3 = %.4g (kappa = "
-            "%g, %s)\n",
-            c("charging_rate_exponent"), c("charging_rate_low"), c("charging_rate_high"),
-            c("charging_rate_expected"), c("kappa"), results.front().kappa_source.c_str());
-      if (std::isfinite(c("onset_time_grid")))
-        std::fprintf(
-            stderr,
-            "analyze: onset (S_grid reaches %g x its median %.4g over t <= %g) at t_c = %.4g\n",
-            c("onset_factor"), c("onset_S_base_grid"), c("onset_t_base"), c("onset_time_grid"));
-    }
-  std::fprintf(stderr, "analyze: wrote %s (CSV tables, per_run/, analysis.h5)\n",
-               out.string().c_str());
+  for (const std::string& line : an::analysisReport(folder))
+    std::fprintf(stderr, "analyze: %s\n", line.c_str());
+  std::fprintf(stderr, "analyze: wrote %s (CSV tables, per_run/, analysis.h5)\n", a.out.c_str());
 }
 
 }  // namespace
