@@ -25,7 +25,11 @@ done
 CTEST_CASES=$(ctest --test-dir "$BUILD_DIR" -N | sed -n 's/^Total Tests: //p')
 if [ "$CATCH_CASES" != "$CTEST_CASES" ]; then
   echo "scripts/test.sh: the suites hold $CATCH_CASES test cases but CTest registered" \
-    "$CTEST_CASES: a test name with ';' or '[' (see tests/CMakeLists.txt)" >&2
+    "$CTEST_CASES: a test name with ';' or '[' (see tests/CMakeLists.txt). Such names:" >&2
+  for t in "$BUILD_DIR"/tests/test_*; do
+    [ -x "$t" ] && [ -f "$t" ] || continue
+    { "$t" --list-test-names-only || true; } | grep '[;[]' | sed "s|^|  $(basename "$t"): |" >&2
+  done
   exit 1
 fi
 set +e

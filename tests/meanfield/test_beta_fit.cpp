@@ -202,7 +202,7 @@ TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S
   }
 }
 
-TEST_CASE("fit-beta full-curve intervals stay inside the search range; at a bound there is none",
+TEST_CASE("fit-beta full-curve intervals stay inside the search range, at a bound there is none",
           "[meanfield][fitbeta]") {
   // Few noisy samples early in the growth (10 samples up to S = 20, 15 % noise): beta is barely
   // determined, and an interval formed in beta itself reached below 0 ("1.50 [-4.36, 7.36]",

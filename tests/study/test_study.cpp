@@ -192,7 +192,7 @@ TEST_CASE("Slurm script: one array task per run, the stop signal and the follow-
   fs::remove_all(dir);
 }
 
-TEST_CASE("PairStudy: runs, seeds and records; bad requests refused before anything is written",
+TEST_CASE("PairStudy: runs, seeds and records, bad requests refused before anything is written",
           "[study]") {
   const fs::path dir = tempDir("study_plan");
   StudyRequest req;
