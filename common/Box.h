@@ -2,6 +2,8 @@
 /// \file Box.h
 /// Cubic periodic box [0, L)^3 and the minimum-image convention (design.md section 2).
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "common/HostDevice.h"
 
@@ -68,5 +70,35 @@ struct Box {
     return static_cast<int>(n);
   }
 };
+
+/// Wraps x into [0, box) and adds the box lengths removed to `image`, exactly: a coordinate
+/// already inside is left bit for bit. Returns false, leaving both untouched, if x is not finite
+/// or the image count would overflow int32. For readers and writers (host only); the MD hot
+/// loops use Box::wrap.
+inline bool wrapCoordinate(double& x, std::int32_t& image, double box) {
+  if (!std::isfinite(x)) return false;
+  if (x >= 0.0 && x < box) return true;  // already wrapped: leave it bit for bit
+  const double shift = std::floor(x / box);
+  const double img = static_cast<double>(image) + shift;
+  // +-1 headroom for the round-off corrections below
+  if (!(std::fabs(img) < static_cast<double>(std::numeric_limits<std::int32_t>::max()) - 1.0))
+    return false;
+  double w = x - shift * box;
+  std::int64_t im = static_cast<std::int64_t>(img);
+  // x / box may round across an integer: bring w back into [0, box). A tiny negative w becomes
+  // box after adding box and is then mapped to 0 (the nearest wrapped value).
+  if (w < 0.0) {
+    w += box;
+    --im;
+  }
+  if (w >= box) {
+    w -= box;
+    ++im;
+  }
+  if (w < 0.0) w = 0.0;
+  x = w;
+  image = static_cast<std::int32_t>(im);
+  return true;
+}
 
 }  // namespace granagg::common

@@ -1,5 +1,7 @@
 #include "common/Strings.h"
 
+#include <cstdarg>
+#include <cstdio>
 #include <cstdlib>
 
 namespace granagg::common {
@@ -38,6 +40,18 @@ bool parseReal(const std::string& s, double& out) {
   char* end = nullptr;
   out = std::strtod(s.c_str(), &end);
   return end == s.c_str() + s.size();
+}
+
+std::string printfString(const char* fmt, ...) {
+  va_list ap, again;
+  va_start(ap, fmt);
+  va_copy(again, ap);
+  const int n = std::vsnprintf(nullptr, 0, fmt, ap);
+  va_end(ap);
+  std::string out(n > 0 ? static_cast<std::size_t>(n) : 0, '\0');
+  if (n > 0) std::vsnprintf(out.data(), out.size() + 1, fmt, again);
+  va_end(again);
+  return out;
 }
 
 }  // namespace granagg::common

@@ -10,4 +10,6 @@ std::vector<std::string> split(const std::string& s, char sep);
 std::string join(const std::vector<std::string>& parts, const std::string& sep);
 /// Parses a whole string as a double (also "nan", "inf"); false if anything is left over.
 bool parseReal(const std::string& s, double& out);
+/// printf into a std::string, of any length (the compiler checks the arguments against fmt).
+std::string printfString(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 }  // namespace granagg::common

@@ -1,10 +1,8 @@
 #pragma once
 /// \file H5mdTrajectory.h
-/// Streams frames from an H5MD 1.1 file (de Buyl et al., Comput. Phys. Commun. 185, 1546 (2014)):
-/// /particles/<group>/{position, box} required; image, velocity, charge optional. Time-dependent
-/// elements are groups {value [F,...], step, time}; step/time may be arrays or the H5MD
-/// fixed-increment scalar (with an `offset` attribute). A time-independent charge (dataset [N])
-/// is accepted. Box edges: [3] or [3x3] per frame (or one fixed value); cubic boxes only.
+/// Streams the frames of an H5MD 1.1 file through common::H5mdReader (common/H5mdReader.h says
+/// what is required, optional and tolerated). Errors are TrajectoryErrors naming the file and
+/// the frame; a file without image counts gives frames without them (MSD skipped).
 #include <map>
 #include <memory>
 #include <string>
@@ -16,8 +14,7 @@ namespace granagg::analysis {
 class H5mdTrajectory final : public TrajectoryReader {
  public:
   /// Opens `path`; `group` selects /particles/<group> (empty: "all" if present, else the
-  /// alphabetically first, which is what MDAnalysis reads). Throws TrajectoryError (frame 0)
-  /// for an unreadable or truncated file and for missing required datasets.
+  /// first in name order, which is what MDAnalysis reads).
   explicit H5mdTrajectory(const std::string& path, const std::string& group = "");
   ~H5mdTrajectory() override;
   bool next(Frame& f) override;

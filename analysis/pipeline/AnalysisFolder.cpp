@@ -3,8 +3,6 @@
 #include "analysis/pipeline/AnalysisFolder.h"
 
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -12,22 +10,10 @@
 #include <stdexcept>
 
 #include "analysis/io/AnalysisFile.h"
+#include "common/Strings.h"
 
 namespace granagg::analysis {
 namespace fs = std::filesystem;
-
-namespace {
-
-std::string format(const char* fmt, ...) {
-  char buf[1024];
-  va_list ap;
-  va_start(ap, fmt);
-  std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  return buf;
-}
-
-}  // namespace
 
 void checkAnalysisFolderRequest(const AnalysisFolderRequest& request) {
   if (request.runs.empty())
@@ -177,31 +163,33 @@ std::vector<std::string> analysisReport(const AnalysisFolder& folder) {
   std::vector<std::string> lines;
   for (std::size_t k = 0; k < folder.runs.size(); ++k) {
     const auto& r = folder.runs[k];
-    lines.push_back(format("run %zu: %s (%s): %zu frames, N = %zu%s", k, r.source.c_str(),
-                           r.format.c_str(), r.frames, r.particles, r.partial ? " [PARTIAL]" : ""));
+    lines.push_back(common::printfString("run %zu: %s (%s): %zu frames, N = %zu%s", k,
+                                         r.source.c_str(), r.format.c_str(), r.frames, r.particles,
+                                         r.partial ? " [PARTIAL]" : ""));
     if (r.grid_cells > 0)
-      lines.push_back(format("  grid: %d^3 cells of h = %.4g d, occupied at >= %g centres per cell",
-                             r.grid_cells, r.grid_cell_size, r.grid_min_count));
+      lines.push_back(common::printfString(
+          "  grid: %d^3 cells of h = %.4g d, occupied at >= %g centres per cell", r.grid_cells,
+          r.grid_cell_size, r.grid_min_count));
     for (const auto& n : r.notes) lines.push_back("  note: " + n);
   }
   for (const auto& t : folder.ensemble)
     if (t.name == "fits" && !t.rows.empty()) {
       const auto& row = t.rows.front();
       auto c = [&](const char* name) { return row[t.column(name)]; };
-      lines.push_back(
-          format("z (grid) = %.4g [%.4g, %.4g], z (particle) = %.4g [%.4g, %.4g] over t in "
-                 "[%.4g, %.4g] (%s)",
-                 c("z_grid"), c("z_grid_low"), c("z_grid_high"), c("z_particle"),
-                 c("z_particle_low"), c("z_particle_high"), c("fit_t_min"), c("fit_t_max"),
-                 folder.runs.size() > 1 ? "95% bootstrap over runs" : "95% Student t"));
+      lines.push_back(common::printfString(
+          "z (grid) = %.4g [%.4g, %.4g], z (particle) = %.4g [%.4g, %.4g] over t in "
+          "[%.4g, %.4g] (%s)",
+          c("z_grid"), c("z_grid_low"), c("z_grid_high"), c("z_particle"), c("z_particle_low"),
+          c("z_particle_high"), c("fit_t_min"), c("fit_t_max"),
+          folder.runs.size() > 1 ? "95% bootstrap over runs" : "95% Student t"));
       if (std::isfinite(c("charging_rate_exponent")))
-        lines.push_back(format(
+        lines.push_back(common::printfString(
             "d<|q|>/dt ~ t^%.4g [%.4g, %.4g]; expected -5/6 - 5 kappa/3 = %.4g (kappa = "
             "%g, %s)",
             c("charging_rate_exponent"), c("charging_rate_low"), c("charging_rate_high"),
             c("charging_rate_expected"), c("kappa"), folder.runs.front().kappa_source.c_str()));
       if (std::isfinite(c("onset_time_grid")))
-        lines.push_back(format(
+        lines.push_back(common::printfString(
             "onset (S_grid reaches %g x its median %.4g over t <= %g) at t_c = %.4g",
             c("onset_factor"), c("onset_S_base_grid"), c("onset_t_base"), c("onset_time_grid")));
     }

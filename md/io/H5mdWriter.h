@@ -45,23 +45,23 @@
 ///
 /// Robustness: the HDF5 file is flushed after every frame, so a killed run leaves a readable
 /// file with all complete frames (step/time are extended last: a frame counts only once they
-/// are written; H5mdReader takes the shortest of value/step/time). Not thread-safe.
+/// are written; common::H5mdReader takes the shortest of value/step/time). Not thread-safe.
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "common/H5mdReader.h"
 #include "md/io/Frame.h"
 
 namespace granagg::md {
 
-/// Name of the particle group written under /particles.
-inline constexpr const char* H5MD_PARTICLE_GROUP = "all";
-/// Group holding the finely sampled scalar observables (not the H5MD /observables group).
-inline constexpr const char* H5MD_OBSERVABLES_GROUP = "/granagg/observables";
-/// Dataset under /parameters holding the TOML text of the resolved configuration.
-inline constexpr const char* H5MD_CONFIG_DATASET = "config_toml";
+// The layout names readers look for (common/H5mdReader.h): particle group, observables group,
+// configuration dataset.
+using common::H5MD_CONFIG_DATASET;
+using common::H5MD_OBSERVABLES_GROUP;
+using common::H5MD_PARTICLE_GROUP;
 
 /// Streams frames and scalar observables of one run into an H5MD 1.1 file.
 class H5mdWriter {

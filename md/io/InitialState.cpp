@@ -12,45 +12,20 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "common/Box.h"
 #include "common/Csv.h"
+#include "common/H5mdReader.h"
 #include "common/Hdf5.h"
 #include "common/Strings.h"
-#include "md/io/H5mdReader.h"
 #include "md/rng/RngStreams.h"
 
 namespace granagg::md {
 namespace h5 = common::h5;  // (common/Hdf5.h)
-
-bool wrapCoordinate(double& x, std::int32_t& image, double box) {
-  if (!std::isfinite(x)) return false;
-  if (x >= 0.0 && x < box) return true;  // already wrapped: leave it bit for bit
-  const double shift = std::floor(x / box);
-  const double img = static_cast<double>(image) + shift;
-  // +-1 headroom for the round-off corrections below
-  if (!(std::fabs(img) < static_cast<double>(std::numeric_limits<std::int32_t>::max()) - 1.0))
-    return false;
-  double w = x - shift * box;
-  std::int64_t im = static_cast<std::int64_t>(img);
-  // x / box may round across an integer: bring w back into [0, box). A tiny negative w becomes
-  // box after adding box and is then mapped to 0 (the nearest wrapped value).
-  if (w < 0.0) {
-    w += box;
-    --im;
-  }
-  if (w >= box) {
-    w -= box;
-    ++im;
-  }
-  if (w < 0.0) w = 0.0;
-  x = w;
-  image = static_cast<std::int32_t>(im);
-  return true;
-}
 
 void wrapIntoBox(Frame& f) {
   const std::size_t n = f.size();
@@ -398,8 +373,41 @@ Frame readInitialStateLammps(const std::string& path) {
   return f;
 }
 
+Frame engineFrame(const common::TrajectoryFrame& in) {
+  const std::size_t n = in.size();
+  Frame f;
+  f.step = in.step;
+  f.time = in.time;
+  f.box = in.box;
+  auto split = [n](const std::vector<double>& aos, std::vector<double>& a, std::vector<double>& b,
+                   std::vector<double>& c) {
+    a.resize(n);
+    b.resize(n);
+    c.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      a[k] = aos[3 * k];
+      b[k] = aos[3 * k + 1];
+      c[k] = aos[3 * k + 2];
+    }
+  };
+  split(in.position, f.x, f.y, f.z);
+  if (in.hasVelocities()) split(in.velocity, f.vx, f.vy, f.vz);
+  f.charge = in.hasCharges() ? in.charge : std::vector<double>(n, 0.0);
+  f.ix.assign(n, 0);
+  f.iy.assign(n, 0);
+  f.iz.assign(n, 0);
+  if (in.hasImages())
+    for (std::size_t k = 0; k < n; ++k) {
+      f.ix[k] = in.image[3 * k];
+      f.iy[k] = in.image[3 * k + 1];
+      f.iz[k] = in.image[3 * k + 2];
+    }
+  return f;
+}
+
 Frame readInitialStateH5md(const std::string& path, long frame, const std::string& particle_group) {
-  H5mdReader r(path, particle_group);
+  common::H5mdReader r(path, particle_group);
+  r.keepWrapCrossings(true);  // unwrapped positions keep their crossings as image counts
   const long nf = static_cast<long>(r.frames());
   if (nf == 0) throw std::invalid_argument("initial state '" + path + "' holds no complete frame");
   const long idx = frame < 0 ? nf + frame : frame;
@@ -409,7 +417,15 @@ Frame readInitialStateH5md(const std::string& path, long frame, const std::strin
   if (!r.hasVelocity())
     throw std::invalid_argument("initial state '" + path + "' has no velocities (particles/" +
                                 r.particleGroup() + "/velocity); an initial state needs them");
-  Frame f = r.readFrame(static_cast<std::size_t>(idx));  // positions wrapped, images filled
+  const common::TrajectoryFrame in = r.readFrame(static_cast<std::size_t>(idx));
+  for (const auto& [has_file, has_frame, name] :
+       {std::tuple{r.hasVelocity(), in.hasVelocities(), "velocity"},
+        std::tuple{r.hasCharge(), in.hasCharges(), "charge"}})
+    if (has_file && !has_frame)
+      throw std::invalid_argument("initial state '" + path + "' frame " + std::to_string(idx) +
+                                  ": particles/" + r.particleGroup() + "/" + name +
+                                  " has no sample at step " + std::to_string(in.step));
+  Frame f = engineFrame(in);  // positions wrapped, images filled
   checkMinimumSize(f.size(), path);
   const std::vector<double>* arrays[4] = {&f.vx, &f.vy, &f.vz, &f.charge};
   const char* names[4] = {"vx", "vy", "vz", "charge"};

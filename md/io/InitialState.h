@@ -15,8 +15,8 @@
 /// other columns are rejected. A CSV has no box: the caller passes L (from N and phi); positions
 /// outside [0, L) are wrapped and the crossings recorded as image counts.
 ///
-/// H5MD input: any H5MD 1.1 file H5mdReader accepts (ours or another engine's); the last frame
-/// by default. Velocities are required; missing charges are zero; the box is the file's.
+/// H5MD input: any H5MD 1.1 file common::H5mdReader accepts (ours or another engine's); the last
+/// frame by default. Velocities are required; missing charges are zero; the box is the file's.
 ///
 /// LAMMPS data file (the `read_data` / `write_data` format), so that one starting configuration
 /// runs in LAMMPS and in granagg: a title line, a header with "N atoms" and a cubic box ("xlo xhi"
@@ -36,6 +36,8 @@
 #include <cstdint>
 #include <string>
 
+#include "common/Box.h"
+#include "common/TrajectoryFrame.h"
 #include "md/config/MdConfig.h"
 #include "md/io/Frame.h"
 
@@ -79,15 +81,17 @@ Frame randomInitialState(const MdConfig& config);
 /// RNG_INIT_CHARGE) or "file" (kept; throws if the state has none).
 void assignInitialCharges(const MdConfig& config, Frame& state);
 
-/// Wraps one coordinate into [0, box), adding the number of box lengths removed to `image` (so
-/// x + image * box is unchanged up to round-off). Values already in [0, box) are left bit for
-/// bit. Returns false, leaving both untouched, if x is not finite or the image count would
-/// overflow int32.
-bool wrapCoordinate(double& x, std::int32_t& image, double box);
+/// Wraps one coordinate into [0, box), adding the box lengths removed to `image`
+/// (common/Box.h).
+using common::wrapCoordinate;
 
 /// Wraps every position of `frame` into [0, frame.box) with wrapCoordinate; missing image arrays
 /// (empty) are created as zeros first. Throws std::invalid_argument naming the particle index if
 /// a position is not finite or the box is not positive.
 void wrapIntoBox(Frame& frame);
+
+/// A frame read from a trajectory file (common::H5mdReader) in the engine's layout, one array per
+/// component: absent charges and image counts become zeros, absent velocities stay empty.
+Frame engineFrame(const common::TrajectoryFrame& frame);
 
 }  // namespace granagg::md

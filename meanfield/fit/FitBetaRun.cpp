@@ -5,14 +5,13 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/Strings.h"
 #include "common/Version.h"
 
 namespace granagg::meanfield {
@@ -27,21 +26,11 @@ nlohmann::ordered_json num(double x) {
   return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(nullptr);
 }
 
-/// printf into a string.
-std::string format(const char* fmt, ...) {
-  char buf[1024];
-  va_list ap;
-  va_start(ap, fmt);
-  std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  return buf;
-}
-
 /// "v [lo, hi]" to 4 digits; "v" alone without an interval; "n/a" without a value.
 std::string interval(double v, double lo, double hi) {
   if (!std::isfinite(v)) return "n/a";
-  if (!std::isfinite(lo) && !std::isfinite(hi)) return format("%.4g", v);
-  return format("%.4g [%.4g, %.4g]", v, lo, hi);
+  if (!std::isfinite(lo) && !std::isfinite(hi)) return common::printfString("%.4g", v);
+  return common::printfString("%.4g [%.4g, %.4g]", v, lo, hi);
 }
 
 /// Writes `path.partial` and renames it: no half-written JSON is left by a failure.
@@ -338,48 +327,52 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
 
 std::vector<std::string> fitBetaReport(const FitBetaResult& r, const common::PaperValues& paper) {
   std::vector<std::string> lines;
-  lines.push_back(format("%s column %s: %zu samples, %zu run%s", r.input.source.c_str(),
-                         r.input.column.c_str(), r.data.t.size(), r.input.runs.size(),
-                         r.input.runs.size() == 1 ? "" : "s"));
-  for (const auto& n : r.input.notes) lines.push_back(format("  note: %s", n.c_str()));
-  lines.push_back(format("window [%.4g, %.4g], %d samples (%s)", r.z.t0, r.z.t1, r.z.points,
-                         r.window.rule.c_str()));
-  lines.push_back(format("z = %s (95 %%, %s)   paper: %.2f +- %.2f neutral, %.2f +- %.3f charged",
-                         interval(r.z.z, r.z.z_low, r.z.z_high).c_str(),
-                         r.z.interval_method.c_str(), paper.z_neutral, paper.z_neutral_pm,
-                         paper.z_charged, paper.z_charged_pm));
-  lines.push_back(format(
+  lines.push_back(common::printfString(
+      "%s column %s: %zu samples, %zu run%s", r.input.source.c_str(), r.input.column.c_str(),
+      r.data.t.size(), r.input.runs.size(), r.input.runs.size() == 1 ? "" : "s"));
+  for (const auto& n : r.input.notes)
+    lines.push_back(common::printfString("  note: %s", n.c_str()));
+  lines.push_back(common::printfString("window [%.4g, %.4g], %d samples (%s)", r.z.t0, r.z.t1,
+                                       r.z.points, r.window.rule.c_str()));
+  lines.push_back(common::printfString(
+      "z = %s (95 %%, %s)   paper: %.2f +- %.2f neutral, %.2f +- %.3f charged",
+      interval(r.z.z, r.z.z_low, r.z.z_high).c_str(), r.z.interval_method.c_str(), paper.z_neutral,
+      paper.z_neutral_pm, paper.z_charged, paper.z_charged_pm));
+  lines.push_back(common::printfString(
       "beta from z = %s (full Smoluchowski z(beta) over S = %.4g..%.4g, where it gives z "
       "= %.4f at "
       "beta = 2, %.4f at beta = 3)   paper: mean field z = %.2f at beta = 2, %.2f at beta = 3",
       interval(r.from_z.beta, r.from_z.beta_low, r.from_z.beta_high).c_str(), r.from_z.S0,
       r.from_z.S1, r.z_mf_beta2, r.z_mf_beta3, paper.z_meanfield_beta2, paper.z_meanfield_beta3));
-  if (!r.from_z.note.empty()) lines.push_back(format("  note: %s", r.from_z.note.c_str()));
-  lines.push_back(
-      format("beta from the asymptotic law z = 3 beta/(beta + 3) = %s (no S scale; valid where "
-             "the local "
-             "slope is flat)",
-             interval(r.asymptotic.beta, r.asymptotic.beta_low, r.asymptotic.beta_high).c_str()));
-  if (!r.asymptotic.note.empty()) lines.push_back(format("  note: %s", r.asymptotic.note.c_str()));
+  if (!r.from_z.note.empty())
+    lines.push_back(common::printfString("  note: %s", r.from_z.note.c_str()));
+  lines.push_back(common::printfString(
+      "beta from the asymptotic law z = 3 beta/(beta + 3) = %s (no S scale; valid where "
+      "the local "
+      "slope is flat)",
+      interval(r.asymptotic.beta, r.asymptotic.beta_low, r.asymptotic.beta_high).c_str()));
+  if (!r.asymptotic.note.empty())
+    lines.push_back(common::printfString("  note: %s", r.asymptotic.note.c_str()));
   if (r.request.curve_fit) {
-    lines.push_back(
-        format("beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s",
-               r.from_z_scaled.S0, r.from_z_scaled.S1,
-               interval(r.from_z_scaled.beta, r.from_z_scaled.beta_low, r.from_z_scaled.beta_high)
-                   .c_str()));
+    lines.push_back(common::printfString(
+        "beta from z at S / S_c = %.4g..%.4g (S_c from the curve fit) = %s", r.from_z_scaled.S0,
+        r.from_z_scaled.S1,
+        interval(r.from_z_scaled.beta, r.from_z_scaled.beta_low, r.from_z_scaled.beta_high)
+            .c_str()));
     if (!r.from_z_scaled.note.empty())
-      lines.push_back(format("  note: %s", r.from_z_scaled.note.c_str()));
+      lines.push_back(common::printfString("  note: %s", r.from_z_scaled.note.c_str()));
     const std::string beta_fit =
         r.curve.at_bound ? "not determined (at the bound " + interval(r.curve.beta, NAN, NAN) +
                                " of the search range)"
                          : "= " + interval(r.curve.beta, r.curve.beta_low, r.curve.beta_high);
-    lines.push_back(
-        format("beta from the curve fit %s, S_c = %s, tau_c = %s, chi2/dof = %.3g "
-               "(%s)",
-               beta_fit.c_str(), interval(r.curve.S_c, r.curve.S_c_low, r.curve.S_c_high).c_str(),
-               interval(r.curve.tau_c, r.curve.tau_c_low, r.curve.tau_c_high).c_str(),
-               r.curve.chi2_dof, r.curve.interval_method.c_str()));
-    if (!r.curve.note.empty()) lines.push_back(format("  note: %s", r.curve.note.c_str()));
+    lines.push_back(common::printfString(
+        "beta from the curve fit %s, S_c = %s, tau_c = %s, chi2/dof = %.3g "
+        "(%s)",
+        beta_fit.c_str(), interval(r.curve.S_c, r.curve.S_c_low, r.curve.S_c_high).c_str(),
+        interval(r.curve.tau_c, r.curve.tau_c_low, r.curve.tau_c_high).c_str(), r.curve.chi2_dof,
+        r.curve.interval_method.c_str()));
+    if (!r.curve.note.empty())
+      lines.push_back(common::printfString("  note: %s", r.curve.note.c_str()));
   }
   return lines;
 }

@@ -12,7 +12,8 @@
 #include <fstream>
 #include <string>
 
-#include "md/io/H5mdReader.h"
+#include "common/H5mdReader.h"
+#include "md/io/InitialState.h"
 
 #include "TestUtil.h"
 
@@ -95,9 +96,9 @@ TEST_CASE("md --seed takes 0 to 2^64 - 1 and refuses the rest, --threads 0 is re
     REQUIRE(runGranagg("md --config " + cfg + " --seed " + seed + " --out " +
                        (dir / seed).string() + " -q")
                 .status == 0);
-  granagg::md::H5mdReader a((dir / "9223372036854775807" / "traj.h5").string()),
+  granagg::common::H5mdReader a((dir / "9223372036854775807" / "traj.h5").string()),
       b((dir / "18446744073709551615" / "traj.h5").string());
-  CHECK(a.readFrame(0).x != b.readFrame(0).x);
+  CHECK(granagg::md::engineFrame(a.readFrame(0)).x != granagg::md::engineFrame(b.readFrame(0)).x);
   fs::remove_all(dir);
 }
 
@@ -112,10 +113,10 @@ TEST_CASE("md writes a readable trajectory and refuses to overwrite it", "[cli][
   CHECK_THAT(r.output, Catch::Contains("dt = "));
   REQUIRE(fs::exists(out / "traj.h5"));
   REQUIRE(fs::exists(out / "checkpoint.h5"));
-  granagg::md::H5mdReader reader((out / "traj.h5").string());
+  granagg::common::H5mdReader reader((out / "traj.h5").string());
   CHECK(reader.size() == 300);
   CHECK(reader.frames() >= 3);
-  const auto last = reader.readFrame(reader.frames() - 1);
+  const auto last = granagg::md::engineFrame(reader.readFrame(reader.frames() - 1));
   CHECK(last.time == Approx(1.0).margin(0.01));
 
   const Run again = runGranagg("md --config " + cfg + " --out " + out.string() + " -q");
@@ -169,9 +170,10 @@ TEST_CASE("md --restart continues bit for bit", "[cli][md]") {
   const Run r = runGranagg("md --restart " + (dir / "b").string() + " --set run.t_end=1.0 -q");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()),
+  granagg::common::H5mdReader ra((dir / "a" / "traj.h5").string()),
       rb((dir / "b" / "traj.h5").string());
-  const auto fa = ra.readFrame(ra.frames() - 1), fb = rb.readFrame(rb.frames() - 1);
+  const auto fa = granagg::md::engineFrame(ra.readFrame(ra.frames() - 1)),
+             fb = granagg::md::engineFrame(rb.readFrame(rb.frames() - 1));
   CHECK(fa.step == fb.step);
   CHECK(fa.x == fb.x);
   CHECK(fa.y == fb.y);
@@ -240,8 +242,9 @@ TEST_CASE(
   const Run resumed = runGranagg("md --restart " + b + " -q");
   INFO(resumed.output);
   REQUIRE(resumed.status == 0);
-  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()), rb(b + "/traj.h5");
-  const auto fa = ra.readFrame(ra.frames() - 1), fb = rb.readFrame(rb.frames() - 1);
+  granagg::common::H5mdReader ra((dir / "a" / "traj.h5").string()), rb(b + "/traj.h5");
+  const auto fa = granagg::md::engineFrame(ra.readFrame(ra.frames() - 1)),
+             fb = granagg::md::engineFrame(rb.readFrame(rb.frames() - 1));
   CHECK(fa.step == fb.step);
   CHECK(granagg::test::sameBits(fa.x, fb.x));
   CHECK(granagg::test::sameBits(fa.vz, fb.vz));
@@ -283,9 +286,10 @@ TEST_CASE("md --restart continues bit for bit with charging and PPPM, and writes
   const Run r = runGranagg("md --restart " + (dir / "b").string() + " --set run.t_end=1.0 -q");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  granagg::md::H5mdReader ra((dir / "a" / "traj.h5").string()),
+  granagg::common::H5mdReader ra((dir / "a" / "traj.h5").string()),
       rb((dir / "b" / "traj.h5").string());
-  const auto fa = ra.readFrame(ra.frames() - 1), fb = rb.readFrame(rb.frames() - 1);
+  const auto fa = granagg::md::engineFrame(ra.readFrame(ra.frames() - 1)),
+             fb = granagg::md::engineFrame(rb.readFrame(rb.frames() - 1));
   CHECK(fa.step == fb.step);
   CHECK(fa.x == fb.x);
   CHECK(fa.vz == fb.vz);

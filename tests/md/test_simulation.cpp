@@ -10,9 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "common/H5mdReader.h"
 #include "common/Hdf5.h"
 #include "md/config/MdConfig.h"
-#include "md/io/H5mdReader.h"
+#include "md/io/InitialState.h"
 #include "md/run/Simulation.h"
 
 #include "TestUtil.h"
@@ -21,6 +22,8 @@ using granagg::test::sameBits;
 using granagg::test::tempDir;
 
 using namespace granagg::md;
+using granagg::common::H5mdReader;
+using granagg::common::ObservableSeries;
 namespace fs = std::filesystem;
 
 namespace {
@@ -53,12 +56,12 @@ void requireSameTrajectory(const fs::path& a, const fs::path& b, std::int64_t st
   std::size_t j = 0;
   for (std::size_t i = 0; i < ra.frames(); ++i, ++j) {
     INFO("frame " << i);
-    Frame fa = ra.readFrame(i);
+    Frame fa = engineFrame(ra.readFrame(i));
     REQUIRE(j < rb.frames());
-    Frame fb = rb.readFrame(j);
+    Frame fb = engineFrame(rb.readFrame(j));
     if (fb.step == stop && fa.step != stop) {  // the frame b wrote when it stopped
       REQUIRE(++j < rb.frames());
-      fb = rb.readFrame(j);
+      fb = engineFrame(rb.readFrame(j));
     }
     CHECK(fa.step == fb.step);
     CHECK(sameBits(fa.x, fb.x));
