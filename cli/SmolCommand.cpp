@@ -1,263 +1,34 @@
-/// `granagg smol`: mean-field Smoluchowski solutions and the z(beta) table.
-#include <algorithm>
-#include <chrono>
-#include <cmath>
+/// `granagg smol`: mean-field Smoluchowski solutions and the z(beta) table
+/// (meanfield/solvers/SmolTables.h solves and writes). This file wires the options.
 #include <cstdio>
-#include <limits>
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include "cli/CliContext.h"
-#include "common/Csv.h"
-#include "meanfield/growth/GrowthExponent.h"
-#include "meanfield/kernels/Kernel.h"
-#include "meanfield/solvers/DiscreteSolver.h"
-#include "meanfield/solvers/MonodisperseSolver.h"
-#include "meanfield/solvers/SectionalSolver.h"
+#include "meanfield/solvers/SmolTables.h"
 
 namespace granagg::cli {
 namespace mf = granagg::meanfield;
 
 namespace {
 
-struct SmolArgs {
-  std::string kernel = "beta";
-  double beta = 2.0;
-  double K0 = 1.0;
-  std::string method = "sectional";
-  double t_min = 1e-2;
-  double t_end = 1e6;
-  int per_decade = 20;
-  double s_end = std::numeric_limits<double>::infinity();
-  int max_size = 1 << 21;
-  double ratio = 1.05;
-  double rtol = 1e-8;
-  double atol = 1e-14;
-  std::string integrator = "adams";
-  double p = 2.0;
-  double z_tolerance = 1e-3;
-  std::string out = "-";
-  bool force = false;
-  bool quiet = false;
-};
-
-struct ZbetaArgs {
-  double beta_min = 2.0;
-  double beta_max = 4.0;
-  int count = 21;
-  std::string method = "sectional";
-  double s_end = 1e8;
-  double ratio = 1.05;
-  std::string out = "-";
-  bool force = false;
-};
-
-void requireRange(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument(what);
+/// Adds -o/--force to `cmd`; the target carries the command line for the provenance header.
+std::shared_ptr<common::CsvTarget> addOutOptions(CLI::App* cmd, const CliContext& ctx) {
+  auto target = std::make_shared<common::CsvTarget>();
+  target->command_line = ctx.command_line;
+  cmd->add_option("-o,--out", target->path, "Output CSV ('-' = standard output)")
+      ->capture_default_str();
+  cmd->add_flag("--force", target->force, "Overwrite an existing output file");
+  return target;
 }
 
-std::vector<double> outputTimes(double t_min, double t_end, int per_decade) {
-  requireRange(t_min > 0.0 && std::isfinite(t_min),
-               "--t-min must be positive (got " + common::formatReal(t_min) + ").");
-  requireRange(t_end > t_min && std::isfinite(t_end),
-               "--t-end must be larger than --t-min = " + common::formatReal(t_min) + " (got " +
-                   common::formatReal(t_end) + ").");
-  requireRange(per_decade >= 1 && per_decade <= 10000, "--per-decade must lie in [1, 10000].");
-  const double count = std::max(2.0, std::ceil(std::log10(t_end / t_min) * per_decade) + 1.0);
-  // (t_end = 1e300 at 10000 per decade wrote 357 MB)
-  requireRange(count <= 1e6, "--t-end = " + common::formatReal(t_end) +
-                                 " and --per-decade = " + std::to_string(per_decade) +
-                                 " ask for more than 1e6 output "
-                                 "times: lower one of them.");
-  return mf::logSpacedTimes(t_min, t_end, static_cast<int>(count));
-}
-
-/// Runs the chosen method; all three return moments on the same output times.
-mf::SmolResult solve(const mf::Kernel& kernel, const std::string& method,
-                     const std::vector<double>& times, double s_end, int max_size, double ratio,
-                     double rtol, double atol, const std::string& integrator) {
-  if (method == "discrete") {
-    mf::DiscreteOptions o;
-    o.times = times;
-    o.s_end = s_end;
-    o.max_size = max_size;
-    o.rtol = rtol;
-    o.atol = atol;
-    o.integrator = integrator;
-    return mf::solveDiscrete(kernel, o);
-  }
-  if (method == "sectional") {
-    mf::SectionalOptions o;
-    o.times = times;
-    o.s_end = s_end;
-    o.ratio = ratio;
-    o.rtol = rtol;
-    o.atol = atol;
-    return mf::solveSectional(kernel, o);
-  }
-  if (method == "mono") {
-    mf::MonodisperseOptions o;
-    o.times = times;
-    o.s_end = s_end;
-    return mf::solveMonodisperse(kernel, o);
-  }
-  throw std::invalid_argument("--method must be one of sectional, discrete, mono (got '" + method +
-                              "').");
-}
-
-/// Times and S of the valid samples only (a truncated solution never enters a fit).
-void validSeries(const mf::SmolResult& r, std::vector<double>& t, std::vector<double>& S) {
-  t.clear();
-  S.clear();
-  for (const auto& s : r.samples)
-    if (s.valid) {
-      t.push_back(s.t);
-      S.push_back(s.S);
-    }
-}
-
-void runSmol(const SmolArgs& a, const CliContext& ctx) {
-  const mf::Kernel kernel = mf::Kernel::fromName(a.kernel, a.beta, a.K0);
-  requireRange(a.max_size >= 2, "--M must be at least 2 (got " + std::to_string(a.max_size) + ").");
-  requireRange(a.ratio > 1.0, "--ratio must be > 1 (got " + common::formatReal(a.ratio) + ").");
-  requireRange(a.rtol > 0.0 && a.rtol < 1.0, "--rtol must lie in (0, 1).");
-  requireRange(a.atol > 0.0, "--atol must be positive.");
-  requireRange(a.p > 1.0, "--p must be > 1.");
-  if (kernel.gels() && a.t_end >= 1.0 / a.K0)
-    throw std::invalid_argument("--t-end must be below the gel time 1/K0 = " +
-                                common::formatReal(1.0 / a.K0) + " for the multiplicative kernel.");
-  const auto times = outputTimes(a.t_min, a.t_end, a.per_decade);
-  common::refuseToOverwrite(a.out == "-" ? std::string() : a.out, a.force);
-
-  const auto wall0 = std::chrono::steady_clock::now();
-  const mf::SmolResult r =
-      solve(kernel, a.method, times, a.s_end, a.max_size, a.ratio, a.rtol, a.atol, a.integrator);
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-
-  std::vector<double> t, S;
-  validSeries(r, t, S);
-  const mf::LocalSlope ls = t.size() >= 2 ? mf::localSlope(t, S, a.p) : mf::LocalSlope{};
-
-  common::Provenance prov(ctx.command_line);
-  prov.add("kernel", kernel.name());
-  if (kernel.type() == mf::KernelType::Beta) prov.add("beta", a.beta);
-  prov.add("K0", a.K0);
-  prov.add("method", a.method);
-  if (a.method == "sectional") prov.add("ratio", a.ratio);
-  if (a.method == "discrete") {
-    prov.add("M", a.max_size);
-    prov.add("integrator", a.integrator);
-  }
-  prov.add("rtol", a.rtol);
-  prov.add("atol", a.atol);
-  prov.add("initial_state", std::string("monodisperse n_1(0) = 1"));
-  prov.add("local_slope_ratio_p", a.p);
-  prov.add("columns",
-           std::string("t: time in 1/(K0 n_1(0)); M_p = sum k^p n_k; S = M2/M1; z_local = "
-                       "log[S(t)/S(t/p)]/log p; "
-                       "mass_loss = (M1(0)-M1(t))/M1(0); valid = 0 where truncation lost mass"));
-  common::CsvWriter w(a.out, prov,
-                      {"t", "S", "M0", "M1", "M2", "z_local", "mass_loss", "valid", "max_size"},
-                      a.force);
-  std::size_t j = 0;
-  for (const auto& s : r.samples) {
-    if (!std::isfinite(s.S))  // (the table used to end in NaN rows, with exit status 0)
-      throw std::runtime_error("S(t) is no longer finite at t = " + common::formatReal(s.t) +
-                               " (the solver's numbers overflowed): lower --t-end");
-    double z = std::nan("");
-    if (s.valid && j < ls.t.size() && ls.t[j] == s.t) z = ls.z[j++];
-    w.row({s.t, s.S, s.M0, s.M1, s.M2, z, s.mass_loss, s.valid ? 1.0 : 0.0, s.max_size});
-  }
-  if (!r.stopped_early.empty()) w.comment("stopped early: " + r.stopped_early);
-  w.close();
-
-  if (a.quiet) return;
-  std::FILE* info = stderr;  // the log; stdout carries only tables written to "-"
-  std::fprintf(
-      info,
-      "smol: kernel %s%s, method %s: %zu samples to t = %.4g, S = %.6g (%.2f s, %ld steps, %ld "
-      "RHS)\n",
-      kernel.name().c_str(),
-      kernel.type() == mf::KernelType::Beta ? (" beta=" + common::formatReal(a.beta)).c_str() : "",
-      a.method.c_str(), r.samples.size(), r.samples.empty() ? 0.0 : r.samples.back().t,
-      r.samples.empty() ? 0.0 : r.samples.back().S, wall, r.stats.steps, r.stats.rhs_evaluations);
-  if (!r.stopped_early.empty())
-    std::fprintf(info, "smol: stopped early: %s\n", r.stopped_early.c_str());
-  if (kernel.homogeneity() < 1.0) {
-    std::fprintf(info, "smol: scaling prediction z = 1/(1 - lambda) = %.6f\n",
-                 kernel.scalingExponent());
-    try {
-      const auto az = mf::asymptoticExponent(t, S, a.p, a.z_tolerance);
-      std::fprintf(info, "smol: asymptotic %s\n", az.describe().c_str());
-    } catch (const std::invalid_argument& e) {
-      std::fprintf(info, "smol: no asymptotic z: %s\n", e.what());
-    }
-  }
-  if (a.out != "-") std::fprintf(info, "smol: wrote %s\n", a.out.c_str());
-}
-
-void runZbeta(const ZbetaArgs& a, const CliContext& ctx) {
-  requireRange(a.beta_min > 0.0,
-               "--beta-min must be positive (got " + common::formatReal(a.beta_min) + ").");
-  requireRange(a.beta_max >= a.beta_min, "--beta-max must be >= --beta-min.");
-  requireRange(a.count >= 1 && a.count <= 1000, "--count must lie in [1, 1000].");
-  requireRange(a.s_end >= 1e3, "--s-end must be at least 1e3 for an asymptotic exponent.");
-  requireRange(a.method == "sectional" || a.method == "discrete",
-               "--method must be sectional or discrete for zbeta (got '" + a.method + "').");
-  common::refuseToOverwrite(a.out == "-" ? std::string() : a.out, a.force);
-
-  common::Provenance prov(ctx.command_line);
-  prov.add("method", a.method);
-  prov.add("s_end", a.s_end);
-  if (a.method == "sectional") prov.add("ratio", a.ratio);
-  prov.add("columns",
-           std::string(
-               "z_asymptotic: 1/t-extrapolated local slope of S(t) (GrowthExponent.h); "
-               "z_scaling = 3 beta/(beta+3); z_local_S250 and z_local_S2500: local slopes (p = 2) "
-               "where S first exceeds 250 and 2500 (the paper's 1.19 and 1.49 are such)"));
-  common::CsvWriter w(a.out, prov,
-                      {"beta", "z_asymptotic", "z_scaling", "difference", "converged", "S_final",
-                       "z_local_S250", "z_local_S2500"},
-                      a.force);
-  std::FILE* info = stderr;  // the log; stdout carries only tables written to "-"
-  // t_end from the scaling law S ~ t^z with a generous margin; s_end stops the solve.
-  for (int i = 0; i < a.count; ++i) {
-    const double beta =
-        a.count == 1 ? a.beta_min : a.beta_min + (a.beta_max - a.beta_min) * i / (a.count - 1);
-    const mf::Kernel kernel = mf::Kernel::beta(beta);
-    const double z_th = kernel.scalingExponent();
-    const double t_end = 100.0 * std::pow(a.s_end, 1.0 / z_th);
-    const auto times = outputTimes(1e-2, t_end, 20);
-    const auto r = solve(kernel, a.method, times, a.s_end, 1 << 21, a.ratio, 1e-8, 1e-14, "adams");
-    std::vector<double> t, S;
-    validSeries(r, t, S);
-    const auto az = mf::asymptoticExponent(t, S, 2.0, 1e-3);
-    const auto ls = mf::localSlope(t, S, 2.0);
-    auto slopeAt = [&](double s_target) {
-      for (std::size_t j = 0; j < ls.t.size(); ++j) {
-        // S at ls.t[j]: same index in (t, S) as the local-slope time
-        const auto it = std::lower_bound(t.begin(), t.end(), ls.t[j]);
-        if (S[it - t.begin()] >= s_target) return ls.z[j];
-      }
-      return std::nan("");
-    };
-    w.row({beta, az.z, z_th, az.z - z_th, az.converged ? 1.0 : 0.0, S.back(), slopeAt(250.0),
-           slopeAt(2500.0)});
-    std::fprintf(
-        info,
-        "zbeta: beta = %.4f  z = %.5f  3beta/(beta+3) = %.5f  diff = %+.1e  (S_final = %.3g%s)\n",
-        beta, az.z, z_th, az.z - z_th, S.back(), az.converged ? "" : ", NOT converged");
-  }
-  w.close();
-  if (a.out != "-") std::fprintf(info, "zbeta: wrote %s\n", a.out.c_str());
-}
+/// The log: stderr, one line each (stdout carries only tables written to "-").
+void logLine(const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); }
 
 }  // namespace
 
 void registerSmolCommand(CLI::App& app, const CliContext& ctx) {
-  auto args = std::make_shared<SmolArgs>();
+  auto args = std::make_shared<mf::SmolRequest>();
   CLI::App* smol = app.add_subcommand(
       "smol",
       "Solve the Smoluchowski coagulation equation from a monodisperse start (n_1(0) = 1) and "
@@ -298,12 +69,11 @@ void registerSmolCommand(CLI::App& app, const CliContext& ctx) {
       ->capture_default_str();
   smol->add_option("--z-tolerance", args->z_tolerance, "Convergence criterion of the asymptotic z")
       ->capture_default_str();
-  smol->add_option("-o,--out", args->out, "Output CSV ('-' = standard output)")
-      ->capture_default_str();
-  smol->add_flag("--force", args->force, "Overwrite an existing output file");
-  smol->add_flag("-q,--quiet", args->quiet, "No summary on the terminal");
+  auto target = addOutOptions(smol, ctx);
+  auto quiet = std::make_shared<bool>(false);
+  smol->add_flag("-q,--quiet", *quiet, "No summary on the terminal");
 
-  auto zargs = std::make_shared<ZbetaArgs>();
+  auto zargs = std::make_shared<mf::ZbetaRequest>();
   CLI::App* zbeta = smol->add_subcommand("zbeta",
                                          "Table of the asymptotic growth exponent z(beta) from the "
                                          "full Smoluchowski equation beside 3 beta/(beta+3).");
@@ -315,14 +85,12 @@ void registerSmolCommand(CLI::App& app, const CliContext& ctx) {
       ->capture_default_str();
   zbeta->add_option("--ratio", zargs->ratio, "sectional: geometric grid ratio")
       ->capture_default_str();
-  zbeta->add_option("-o,--out", zargs->out, "Output CSV ('-' = standard output)")
-      ->capture_default_str();
-  zbeta->add_flag("--force", zargs->force, "Overwrite an existing output file");
+  auto ztarget = addOutOptions(zbeta, ctx);
 
-  zbeta->callback([zargs, ctx]() { runZbeta(*zargs, ctx); });
-  smol->callback([args, ctx, zbeta]() {
+  zbeta->callback([zargs, ztarget]() { mf::writeZbetaTable(*zargs, *ztarget, logLine); });
+  smol->callback([args, target, quiet, zbeta]() {
     if (zbeta->parsed()) return;  // `smol zbeta` ran its own callback
-    runSmol(*args, ctx);
+    mf::writeSmolTable(*args, *target, *quiet ? mf::LogLine() : mf::LogLine(logLine));
   });
 }
 

@@ -73,6 +73,17 @@ class CsvWriter {
 /// Throws std::invalid_argument if `path` exists and `overwrite` is false.
 void refuseToOverwrite(const std::string& path, bool overwrite);
 
+/// Where a command's table goes: a path ("-" = standard output), whether an existing file may be
+/// replaced, and the command line its provenance header starts with.
+struct CsvTarget {
+  std::string path = "-";
+  bool force = false;
+  std::string command_line;
+  /// Throws std::invalid_argument if the table would replace a file without `force` (so that a
+  /// command can refuse before it computes anything).
+  void refuseToOverwrite() const { common::refuseToOverwrite(path == "-" ? "" : path, force); }
+};
+
 /// A CSV table read back: provenance comments, column names and rows.
 struct CsvTable {
   std::vector<std::pair<std::string, std::string>> meta;  ///< "# key = value" lines
