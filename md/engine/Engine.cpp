@@ -31,6 +31,7 @@
 #include "common/Csv.h"
 #include "md/compute/ContactForce.h"
 #include "md/compute/CoulombRealSpace.h"
+#include "md/coulomb/CoulombDesign.h"
 #include "md/coulomb/Ewald.h"
 #include "md/coulomb/EwaldParams.h"
 #include "md/coulomb/Pppm.h"
@@ -65,13 +66,9 @@ constexpr double SLOW_INTERVAL = 0.016;
 // the setting the ensemble comparison found indistinguishable from the tight reference
 // (docs/benchmarks-coulomb.md, "Accuracy behind the settings")
 constexpr int SLOW_INTERVAL_GROWTH = 4;
-// coulomb.r_fast = "auto": the pair force within this is fast. 2 d since issue 15: the ensemble
-// of the paper's K = 5 gas is indistinguishable from the tight reference and the cold gas runs
-// 1.5x faster; energy drift 4x that of 3.5 d, 0.1 % of the cold gas's dissipation
-// (docs/coulomb.md, docs/benchmarks-coulomb.md).
-constexpr double R_FAST_AUTO = 2.0;
-// what "auto" meant for checkpoints that do not record their split (written before issue 15's
-// change of R_FAST_AUTO; they continue with the split they were written with)
+// coulomb.r_fast = "auto" is R_FAST_AUTO (md/coulomb/CoulombDesign.h). What "auto" meant for
+// checkpoints that do not record their split (written before issue 15's change of R_FAST_AUTO; they
+// continue with the split they were written with)
 constexpr double R_FAST_AUTO_BEFORE_RECORDED = 3.5;
 
 /// The run's configuration with the multiple-time-step split that wrote `ck`: its "auto"
@@ -285,8 +282,8 @@ struct Engine::Impl {
     }
   }
 
-  /// Chooses the Coulomb method's parameters for the configured accuracy (docs/coulomb.md) and
-  /// builds the solver; the neighbour list then reaches the real-space cutoff. The error estimates
+  /// Builds the Coulomb solvers from designCoulomb's parameters for the configured accuracy
+  /// (md/coulomb/CoulombDesign.h, docs/coulomb.md); the contact list then reaches r_fast. The error estimates
   /// scale with sum q^2: parameters are chosen for sum_q2_design (the engine uses the larger of the
   /// initial sum q^2 and N, i.e. charges of order the unit q_ref at least, since an exchanging gas
   /// starts neutral) and stored, so that a restart reuses them.
@@ -294,9 +291,6 @@ struct Engine::Impl {
     const CoulombConfig& cc = cfg.coulomb;
     const std::size_t N = p.size();
     const double L = box.L, skin = cfg.neighbor.skin;
-    csetup = CoulombSetup{};
-    csetup.method = cc.method;
-    csetup.sum_q2_design = sum_q2_design;
     pppm.reset();
     ewald.reset();
     nl_coul.reset();
@@ -305,71 +299,23 @@ struct Engine::Impl {
     fast_table.clear();
     nl = NeighborList(1.0, skin);
     nl.keepPairs(true);
+    const CoulombDesign d = designCoulomb(cc, N, L, skin, every_base, every_cap, sum_q2_design);
+    csetup = d.setup;
+    fast_switch = d.fast_switch;
     if (cc.method == "pppm") {
-      // "auto": a longer skin than the contact list's when the list is used every k-th step only
-      // (fewer builds of a long list; measured optimum at N = 1e4, K = 5:
-      // docs/benchmarks-coulomb.md)
-      const double coul_skin = cc.skin > 0.0 ? cc.skin : (every_base > 1 ? 0.8 : skin);
-      const double rc_max = 0.5 * L - coul_skin;  // the list must reach r_cut + skin within L/2
-      if (cc.r_cut > rc_max)
-        throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) +
-                                    " exceeds L/2 - coulomb.skin = " + common::formatReal(rc_max) +
-                                    " for this box (L = " + common::formatReal(L) + ")");
-      PppmParams prm;
-      if (cc.r_cut > 0.0) {
-        prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut,
-                               cc.order > 0 ? cc.order : 5);
-      } else {
-        if (!(rc_max >= 1.0))
-          throw std::invalid_argument(
-              "box too small for PPPM with this coulomb.skin (L/2 - skin < 1)");
-        prm = optimizePppmParams(cc.accuracy, N, L, sum_q2_design, 1.0, rc_max);
-        if (cc.order > 0 && cc.order != prm.order)
-          prm = choosePppmParams(cc.accuracy, N, L, sum_q2_design, prm.r_cut, cc.order);
-      }
-      if (cc.mesh >
-          0) {  // a mesh given explicitly overrides the chosen one (its error is reported)
-        prm.mesh = cc.mesh;
-        prm.estimated_error_kspace =
-            pppmKspaceError(prm.alpha, prm.mesh, prm.order, N, L, sum_q2_design);
-      }
-      pppm = std::make_unique<Pppm>(prm, L, cc.K);
+      pppm = std::make_unique<Pppm>(d.pppm, L, cc.K);
       pppm->setPhaseTimer(&timer);
-      csetup.alpha = prm.alpha;
-      csetup.r_cut = prm.r_cut;
-      csetup.mesh = prm.mesh;
-      csetup.order = prm.order;
-      csetup.estimated_error = prm.estimatedError();
-      nl_coul = std::make_unique<NeighborList>(prm.r_cut, coul_skin);
-      // multiple time stepping: the near real space, which changes as fast as pairs approach, is
-      // computed at every step in the contact pass (its list then reaches r_fast), the rest is slow
-      fast_switch = RealSpaceSwitch{};
-      if (every_base > 1) {
-        const double r2 = std::min(cc.r_fast > 0.0 ? cc.r_fast : R_FAST_AUTO, prm.r_cut);
-        if (r2 < 2.0)
-          throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(prm.r_cut) +
-                                      " leaves coulomb.r_fast = " + common::formatReal(r2) +
-                                      " < 2 for the multiple time stepping (coulomb.every > 1): "
-                                      "use a larger r_cut or coulomb.every = 1");
-        fast_switch = RealSpaceSwitch{std::max(0.0, r2 - 1.0), r2};
-        csetup.r_fast = r2;
-        csetup.every = every_base;
-        csetup.every_max = every_cap;
-        const auto t = slowPairTableValues(prm.alpha, fast_switch, prm.r_cut * prm.r_cut);
+      nl_coul = std::make_unique<NeighborList>(d.pppm.r_cut, d.coulomb_skin);
+      if (fast_switch.r2 > 0.0) {
+        const auto t = slowPairTableValues(d.pppm.alpha, fast_switch, d.pppm.r_cut * d.pppm.r_cut);
         slow_table.assign(t.begin(), t.end());
         const auto f = fastPairTableValues(fast_switch);
         fast_table.assign(f.begin(), f.end());
       }
-      nl = NeighborList(std::max(1.0, fast_switch.r2), skin);
-      nl.keepPairs(fast_switch.r2 ==
-                   0.0);  // with a fast Coulomb part every entry has work: per-row loops
+      nl = NeighborList(d.contact_list_cutoff, skin);
+      nl.keepPairs(d.contact_list_keeps_pairs);
     } else {
-      const EwaldParams prm = chooseEwaldParams(cc.accuracy, N, L, sum_q2_design, cc.r_cut);
-      ewald = std::make_unique<EwaldReference>(prm, L, cc.K);
-      csetup.alpha = prm.alpha;
-      csetup.r_cut = prm.r_cut;
-      csetup.k_max = prm.k_max;
-      csetup.estimated_error = prm.estimatedError();
+      ewald = std::make_unique<EwaldReference>(d.ewald, L, cc.K);
     }
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(N, 0.0);
     kspace_step = -1;

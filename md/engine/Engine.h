@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "md/config/MdConfig.h"
+#include "md/coulomb/CoulombDesign.h"
 #include "md/io/Checkpoint.h"
 #include "md/io/Frame.h"
 
@@ -73,21 +74,6 @@ struct Observables {
 };
 
 /// The Coulomb method's parameters as chosen for a run (docs/coulomb.md), logged and stored.
-struct CoulombSetup {
-  std::string method;            ///< "pppm" or "ewald"
-  double alpha = 0.0;            ///< Ewald splitting parameter (1/d)
-  double r_cut = 0.0;            ///< real-space cutoff (d)
-  int mesh = 0, order = 0;       ///< PPPM mesh points per side, assignment order
-  int k_max = 0;                 ///< plain Ewald reciprocal cutoff
-  double estimated_error = 0.0;  ///< estimated relative RMS force error at sum_q2_design
-  double sum_q2_design = 0.0;    ///< sum q^2 the parameters were chosen for
-  double r_fast =
-      0.0;  ///< multiple time stepping: real space within this is fast (switched over 1 d); 0: none
-  int every = 1;  ///< multiple time stepping: steps between evaluations of the slow part
-  /// > every: the interval follows the gas up to this many steps (coulomb.every_max);
-  /// = every: fixed
-  int every_max = 1;
-};
 
 /// Which velocities and forces a host copy holds. They differ only with Coulomb forces on a
 /// multiple-time-step schedule (coulomb.every = k > 1; see Engine), and there only between
