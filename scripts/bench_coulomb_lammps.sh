@@ -241,11 +241,30 @@ write_velocities = false
 EOF
   local t0 t1
   t0=$(now)
-  OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" > "$TMP/g.log" 2>&1 \
-    || { cat "$TMP/g.log" >&2; exit 1; }
+  OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" \
+    --profile > "$TMP/g.log" 2>&1 || { cat "$TMP/g.log" >&2; exit 1; }
   t1=$(now)
-  grep -q "$n steps to t_end" "$TMP/g.log" || { echo "granagg did not run $n steps:" >&2; cat "$TMP/g.log" >&2; exit 1; }
-  grep -m1 'md: Coulomb' "$TMP/g.log" | sed 's/^md: //' > "$TMP/g_coulomb_$N.txt"
+  # the step count and the Coulomb set-up from profile.csv (machine-readable; the log is for
+  # people): a line for the notes into g_coulomb_N.txt, the run's counts into g_run.txt
+  /usr/bin/python3 - "$ROOT/scripts" "$TMP/gout/profile.csv" "$n" "$TMP/g_coulomb_$N.txt" \
+    "$TMP/g_run.txt" <<'PY' || { cat "$TMP/g.log" >&2; exit 1; }
+import sys
+sys.path.insert(0, sys.argv[1])
+import granagg_tables as gt
+r, m = gt.read(sys.argv[2]), gt.meta(sys.argv[2])
+if r is None or int(r["steps"][0]) != int(sys.argv[3]):
+    sys.exit(f"granagg did not run {sys.argv[3]} steps ({sys.argv[2]})")
+with open(sys.argv[4], "w") as f:
+    f.write(f"{m['coulomb_method']}: alpha = {float(m['coulomb_alpha']):.6g}, "
+            f"r_cut = {float(m['coulomb_r_cut']):.6g}, mesh {m.get('coulomb_mesh', '?')}^3, "
+            f"order {m.get('coulomb_order', '?')}; estimated relative force error "
+            f"{float(m['coulomb_estimated_error']):.2g}; slow part every {m['coulomb_every']} "
+            f"(at most {m['coulomb_every_max']}), r_fast {m['coulomb_r_fast']}\n")
+with open(sys.argv[5], "w") as f:
+    f.write(f"{int(r['steps'][0])} steps to t = {float(m['t_end']):.6g} in "
+            f"{float(r['loop_s'][0]):.4g} s, {int(r['neighbor_builds'][0])} list builds, "
+            f"{int(r['slow_evaluations'][0])} slow Coulomb evaluations\n")
+PY
   calc "$t1 - $t0"
 }
 
@@ -362,8 +381,7 @@ for N in $SIZES; do
     done
   done
   NOTES+=("- N = $N, granagg: $(cat "$TMP/g_coulomb_$N.txt")")
-  last=$(grep -h 'md: done' "$TMP/g.log" | sed 's/^md: //')
-  NOTES+=("- N = $N, steps $n1..$n2; granagg at step $n2: $last; $(grep -h 'steps in' "$TMP/g.log" | sed 's/^md: //')")
+  NOTES+=("- N = $N, steps $n1..$n2; granagg's last run: $(cat "$TMP/g_run.txt")")
 done
 
 if [ -n "$SIZES" ]; then

@@ -74,16 +74,27 @@ checkpoint_wall_seconds = 0.0
 write_velocities = false
 EOF
 
-run_time() {  # method N steps -> wall seconds of the whole process; the Coulomb line into $TMP/coul
+run_time() {  # method N steps -> wall seconds of the whole process; the set-up into $TMP/coul
   local t0 t1
   t0=$(now)
   OMP_NUM_THREADS=$THREADS "$G" md --config "$TMP/base.toml" --set system.N="$2" --set coulomb.method="$1" \
-    --set run.t_end="$(calc "$3 * $DT")" --threads "$THREADS" --out "$TMP/out" --force > "$TMP/log" 2>&1 \
-    || { cat "$TMP/log" >&2; exit 1; }
+    --set run.t_end="$(calc "$3 * $DT")" --threads "$THREADS" --out "$TMP/out" --force --profile \
+    > "$TMP/log" 2>&1 || { cat "$TMP/log" >&2; exit 1; }
   t1=$(now)
-  grep -q "$3 steps to t_end" "$TMP/log" || { echo "granagg did not run $3 steps:" >&2; cat "$TMP/log" >&2; exit 1; }
-  grep -m1 'md: Coulomb' "$TMP/log" > "$TMP/coul"
-  grep -m1 'box L' "$TMP/log" | sed 's/.*box L = \([0-9.e+]*\).*/\1/' > "$TMP/L"
+  # steps, box and the Coulomb parameters from profile.csv (machine-readable; the log is for
+  # people): "L alpha r_cut mesh-or-k_max order" into $TMP/coul
+  /usr/bin/python3 - "$ROOT/scripts" "$TMP/out/profile.csv" "$3" > "$TMP/coul" <<'PY' \
+    || { cat "$TMP/log" >&2; exit 1; }
+import sys
+sys.path.insert(0, sys.argv[1])
+import granagg_tables as gt
+r, m = gt.read(sys.argv[2]), gt.meta(sys.argv[2])
+if r is None or int(r["steps"][0]) != int(sys.argv[3]):
+    sys.exit(f"granagg did not run {sys.argv[3]} steps ({sys.argv[2]})")
+pppm = m["coulomb_method"] == "pppm"
+print(m["box_L"], m["coulomb_alpha"], m["coulomb_r_cut"],
+      m["coulomb_mesh"] if pppm else m["coulomb_k_max"], m.get("coulomb_order", ""))
+PY
   calc "$t1 - $t0"
 }
 steps_for() {  # method N -> "n1 n2": about 1-2 s of timed work where affordable
@@ -111,15 +122,13 @@ for method in pppm ewald; do
     done
     best=$(printf '%s\n' "${per[@]}" | sort -g | head -n 1)
     worst=$(printf '%s\n' "${per[@]}" | sort -g | tail -n 1)
-    coul=$(sed 's/^md: Coulomb K = [0-9.e+]*, //; s/; estimated.*//' "$TMP/coul")
-    alpha=$(sed -n 's/.*alpha = \([0-9.e+-]*\).*/\1/p' "$TMP/coul")
-    rc=$(sed -n 's/.*r_cut = \([0-9.e+-]*\).*/\1/p' "$TMP/coul")
+    read -r L alpha rc mk order < "$TMP/coul"
     if [ "$method" = pppm ]; then
-      mk=$(sed -n 's/.*mesh \([0-9]*\)^3.*/\1/p' "$TMP/coul"); order=$(sed -n 's/.*order \([0-9]*\).*/\1/p' "$TMP/coul")
+      coul="pppm: alpha = $alpha, r_cut = $rc, mesh $mk^3, order $order"
     else
-      mk=$(sed -n 's/.*k_max \([0-9]*\).*/\1/p' "$TMP/coul"); order=""
+      coul="ewald: alpha = $alpha, r_cut = $rc, k_max $mk"
     fi
-    echo "$method,$N,$(cat "$TMP/L"),$THREADS,$alpha,$rc,$mk,$order,$n1,$n2,$best,$best,$worst" >> "$CSV"
+    echo "$method,$N,$L,$THREADS,$alpha,$rc,$mk,$order,$n1,$n2,$best,$best,$worst" >> "$CSV"
     printf '| %s | %s | %s | %s..%s | %.4g | %.3g-%.3g |\n' "$method" "$N" "$coul" "$n1" "$n2" "$best" "$best" "$worst"
     echo "  $method N = $N: $best s/step (load $(cut -d' ' -f1 /proc/loadavg))" >&2
     if [ "$method" = ewald ] && awk "BEGIN {exit !($best > $EWALD_MAX_STEP_S)}"; then

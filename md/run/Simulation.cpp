@@ -92,9 +92,12 @@ Frame initialState(const MdConfig& cfg) {
 }
 
 /// profile.csv: one row, seconds per phase of the loop (`other` = the loop's time in no phase:
-/// observables, output, checkpoints). Column names are the phase names in snake case.
+/// observables, output, checkpoints; column names are the phase names in snake case), then the
+/// list builds and slow Coulomb evaluations; the provenance holds box, dt, the end time and the
+/// Coulomb set-up, so that benchmark scripts need not read the log.
 void writeProfile(const Engine& engine, const fs::path& path, const std::string& command_line,
-                  std::int64_t steps, double loop_seconds) {
+                  std::int64_t steps, double loop_seconds, std::int64_t neighbor_builds,
+                  std::int64_t slow_evaluations) {
   std::vector<std::string> columns = {"steps", "N", "loop_s"};
   std::vector<double> row = {static_cast<double>(steps), static_cast<double>(engine.size()),
                              loop_seconds};
@@ -111,9 +114,32 @@ void writeProfile(const Engine& engine, const fs::path& path, const std::string&
   }
   columns.push_back("other_s");
   row.push_back(loop_seconds - sum);
+  columns.push_back("neighbor_builds");
+  row.push_back(static_cast<double>(neighbor_builds));
+  columns.push_back("slow_evaluations");
+  row.push_back(static_cast<double>(slow_evaluations));
   common::Provenance prov(command_line);
   prov.add("version", common::versionString());
   prov.add("backend", Engine::backendDescription());
+  // the set-up the timings belong to, for scripts (the log lines are for people)
+  prov.add("box_L", engine.box());
+  prov.add("dt", engine.dt());
+  prov.add("t_end", engine.time());
+  if (const CoulombSetup* cs = engine.coulombSetup()) {
+    prov.add("coulomb_method", cs->method);
+    prov.add("coulomb_alpha", cs->alpha);
+    prov.add("coulomb_r_cut", cs->r_cut);
+    if (cs->method == "pppm") {
+      prov.add("coulomb_mesh", cs->mesh);
+      prov.add("coulomb_order", cs->order);
+    } else {
+      prov.add("coulomb_k_max", cs->k_max);
+    }
+    prov.add("coulomb_estimated_error", cs->estimated_error);
+    prov.add("coulomb_r_fast", cs->r_fast);
+    prov.add("coulomb_every", cs->every);
+    prov.add("coulomb_every_max", cs->every_max);
+  }
   common::CsvWriter w(path.string(), prov, columns, /*overwrite=*/true);
   w.row(row);
   w.close();
@@ -340,7 +366,8 @@ RunSummary Simulation::run() {
   d.checkpoint();
   d.writer->close();
   if (d.options.profile)
-    writeProfile(engine, d.out / "profile.csv", d.options.command_line, s.steps, s.loop_seconds);
+    writeProfile(engine, d.out / "profile.csv", d.options.command_line, s.steps, s.loop_seconds,
+                 s.neighbor_builds, s.slow_evaluations);
   return s;
 }
 

@@ -10,8 +10,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
+#include "common/Csv.h"
 #include "common/H5mdReader.h"
 #include "md/io/InitialState.h"
 
@@ -323,5 +325,38 @@ TEST_CASE("md --threads sets the OpenMP thread count", "[cli][md]") {
   REQUIRE(r.status == 0);
   if (r.output.find("OpenMP backend") != std::string::npos)
     CHECK_THAT(r.output, Catch::Contains("1 thread(s)"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("md --profile writes the phases, counts and Coulomb set-up to profile.csv", "[cli][md]") {
+  // profile.csv is what benchmark scripts read (scripts/bench_*.sh): the step count, the time by
+  // phase adding up to the loop, and the set-up the log states for people.
+  const fs::path dir = tempDir("profile");
+  const std::string cfg = writeConfig(
+      dir, std::string(SMALL) + "[charging]\nmode = \"exchange\"\nQ = 0.1\n[coulomb]\nK = 1.0\n");
+  const Run r = runGranagg("md --config " + cfg + " --set run.t_end=0.3 --profile --out " +
+                           (dir / "a").string());
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const granagg::common::CsvTable t =
+      granagg::common::readCsv((dir / "a" / "profile.csv").string());
+  REQUIRE(t.rows.size() == 1);
+  const auto& row = t.rows[0];
+  CHECK(row[t.column("steps")] > 0);
+  double phases = 0.0;
+  for (std::size_t c = 0; c < t.columns.size(); ++c)
+    if (t.columns[c] != "loop_s" && t.columns[c].size() > 2 &&
+        t.columns[c].compare(t.columns[c].size() - 2, 2, "_s") == 0)
+      phases += row[c];
+  CHECK(phases == Approx(row[t.column("loop_s")]).epsilon(1e-9));  // other_s closes the sum
+  CHECK(row[t.column("neighbor_builds")] >= 1);
+  CHECK(row[t.column("slow_evaluations")] >= 1);
+  std::map<std::string, std::string> meta(t.meta.begin(), t.meta.end());
+  CHECK(meta["coulomb_method"] == "pppm");
+  CHECK(std::stod(meta["coulomb_alpha"]) > 0);
+  CHECK(std::stoi(meta["coulomb_mesh"]) >= 8);
+  // the log's line says the same (the log is for people, the table for scripts)
+  CHECK_THAT(r.output, Catch::Contains("mesh " + meta["coulomb_mesh"] + "^3"));
+  CHECK(std::stod(meta["t_end"]) == Approx(0.3).margin(0.01));
   fs::remove_all(dir);
 }
