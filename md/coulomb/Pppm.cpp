@@ -195,13 +195,22 @@ struct ScatterTile {
         for (int k = start[row + z0]; k < start[row + z1]; ++k) {
           const long kp = static_cast<long>(k) * P;
           const double qk = qs[k];
-          // mesh points j_max - p, wrapped by comparison (integer division is slow)
+          // mesh points j_max - p, wrapped by comparison (integer division is slow). A stencil
+          // that does not wrap in z (j_max >= P - 1: most particles) runs over one contiguous
+          // block without the test; every mesh point still gets the same adds in the same order.
+          const bool z_inside = jz[k] >= P - 1;
           for (int px = 0, gx = jx[k]; px < P; ++px, gx = gx == 0 ? M - 1 : gx - 1)
             for (int py = 0, gy = jy[k]; py < P; ++py, gy = gy == 0 ? M - 1 : gy - 1) {
               const double qw = qk * wx[kp + px] * wy[kp + py];
               const long mrow = (static_cast<long>(gx) * M + gy) * M;
-              for (int pz = 0, gz = jz[k]; pz < P; ++pz, gz = gz == 0 ? M - 1 : gz - 1)
-                mesh[mrow + gz] += qw * wz[kp + pz];
+              if (z_inside) {
+                double* m = mesh + mrow + jz[k];
+                const double* w = wz + kp;
+                for (int pz = 0; pz < P; ++pz) m[-pz] += qw * w[pz];
+              } else {
+                for (int pz = 0, gz = jz[k]; pz < P; ++pz, gz = gz == 0 ? M - 1 : gz - 1)
+                  mesh[mrow + gz] += qw * wz[kp + pz];
+              }
             }
         }
       }
@@ -271,11 +280,22 @@ struct Interpolate {
   HD void operator()(int k) const {
     const long kp = static_cast<long>(k) * P;
     double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+    const bool z_inside = jz[k] >= P - 1;
     // mesh points j_max - p, wrapped by comparison (integer division is slow)
     for (int px = 0, gx = jx[k]; px < P; ++px, gx = gx == 0 ? M - 1 : gx - 1) {
       for (int py = 0, gy = jy[k]; py < P; ++py, gy = gy == 0 ? M - 1 : gy - 1) {
         const double wxy = wx[kp + px] * wy[kp + py];
         const long row = (static_cast<long>(gx) * M + gy) * M;
+        if (z_inside) {  // no wrap in z: the same terms in the same order, without the test
+          const long g0 = row + jz[k];
+          for (int pz = 0; pz < P; ++pz) {
+            const double w = wxy * wz[kp + pz];
+            f0 += w * ex[g0 - pz];
+            f1 += w * ey[g0 - pz];
+            f2 += w * ez[g0 - pz];
+          }
+          continue;
+        }
         for (int pz = 0, gz = jz[k]; pz < P; ++pz, gz = gz == 0 ? M - 1 : gz - 1) {
           const long g = row + gz;
           const double w = wxy * wz[kp + pz];
