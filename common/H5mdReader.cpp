@@ -129,8 +129,8 @@ struct H5mdReader::Impl {
     return it == e.row_of_step.end() ? -1 : static_cast<long long>(it->second);
   }
 
-  /// Reads frame k of element e into out (`count` values per row); false when e has no sample
-  /// at that frame's step.
+  /// Reads frame k of element e (one row of its value, or the whole fixed dataset) into out;
+  /// false when e has no sample at that frame's step.
   bool readElement(const Element& e, std::size_t k, hid_t mem_type, void* out) const {
     const std::string c = ctx(where(e) + (e.time_dependent ? "/value" : ""));
     if (!e.time_dependent) {

@@ -283,25 +283,22 @@ struct Engine::Impl {
   }
 
   /// Builds the Coulomb solvers from designCoulomb's parameters for the configured accuracy
-  /// (md/coulomb/CoulombDesign.h, docs/coulomb.md); the contact list then reaches r_fast. The error estimates
-  /// scale with sum q^2: parameters are chosen for sum_q2_design (the engine uses the larger of the
-  /// initial sum q^2 and N, i.e. charges of order the unit q_ref at least, since an exchanging gas
-  /// starts neutral) and stored, so that a restart reuses them.
+  /// (md/coulomb/CoulombDesign.h, docs/coulomb.md); the contact list then reaches r_fast. The
+  /// error estimates scale with sum q^2: parameters are chosen for sum_q2_design (the engine uses
+  /// the larger of the initial sum q^2 and N, i.e. charges of order the unit q_ref at least, since
+  /// an exchanging gas starts neutral) and stored, so that a restart reuses them.
   void setupCoulomb(double sum_q2_design) {
     const CoulombConfig& cc = cfg.coulomb;
     const std::size_t N = p.size();
     const double L = box.L, skin = cfg.neighbor.skin;
-    pppm.reset();
-    ewald.reset();
-    nl_coul.reset();
-    fast_switch = RealSpaceSwitch{};
-    slow_table.clear();
-    fast_table.clear();
-    nl = NeighborList(1.0, skin);
-    nl.keepPairs(true);
     const CoulombDesign d = designCoulomb(cc, N, L, skin, every_base, every_cap, sum_q2_design);
     csetup = d.setup;
     fast_switch = d.fast_switch;
+    pppm.reset();
+    ewald.reset();
+    nl_coul.reset();
+    slow_table.clear();
+    fast_table.clear();
     if (cc.method == "pppm") {
       pppm = std::make_unique<Pppm>(d.pppm, L, cc.K);
       pppm->setPhaseTimer(&timer);
@@ -312,11 +309,11 @@ struct Engine::Impl {
         const auto f = fastPairTableValues(fast_switch);
         fast_table.assign(f.begin(), f.end());
       }
-      nl = NeighborList(d.contact_list_cutoff, skin);
-      nl.keepPairs(d.contact_list_keeps_pairs);
     } else {
       ewald = std::make_unique<EwaldReference>(d.ewald, L, cc.K);
     }
+    nl = NeighborList(d.contact_list_cutoff, skin);
+    nl.keepPairs(d.contact_list_keeps_pairs);
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(N, 0.0);
     kspace_step = -1;
   }
