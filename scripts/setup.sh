@@ -28,7 +28,12 @@ fi
 
 BUILD_DIR=${GRANAGG_BUILD_DIR:-build}
 JOBS=${GRANAGG_JOBS:-$(nproc)}
-if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+# Configure every time (a second configure takes about a second): a folder left by a configure
+# that failed (say, before the packages above were installed) holds a CMakeCache.txt but no
+# Makefile, and skipping the configure then failed the build with "No rule to make target".
+if [ -f "$BUILD_DIR/CMakeCache.txt" ]; then
+  cmake -S . -B "$BUILD_DIR" >/dev/null
+else
   cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
 cmake --build "$BUILD_DIR" -j "$JOBS"
