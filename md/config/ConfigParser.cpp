@@ -69,7 +69,7 @@ const std::vector<Section>& schema() {
         GRANAGG_KEY(integrator, steps_per_contact),
         Key{"impact_speed_max",
             +[](MdConfig& c) -> double& { return c.integrator.impact_speed_max; }, true}}},
-      {"neighbor", {GRANAGG_KEY(neighbor, skin)}},
+      {"neighbor", {Key{"skin", +[](MdConfig& c) -> double& { return c.neighbor.skin; }, true}}},
       {"charging",
        {GRANAGG_KEY(charging, mode), GRANAGG_KEY(charging, initial), GRANAGG_KEY(charging, q0),
         GRANAGG_KEY(charging, Q), GRANAGG_KEY(charging, kappa), GRANAGG_KEY(charging, psi1_min),
@@ -554,8 +554,8 @@ void validateConfig(const MdConfig& c) {
   if (!(g.impact_speed_max >= 0.0 && finite(g.impact_speed_max)))
     invalid("integrator.impact_speed_max", formatReal(g.impact_speed_max), "be > 0 or \"auto\"");
 
-  if (!(c.neighbor.skin > 0.0 && c.neighbor.skin <= 2.0))
-    invalid("neighbor.skin", formatReal(c.neighbor.skin), "lie in (0, 2]");
+  if (!(c.neighbor.skin >= 0.0 && c.neighbor.skin <= 2.0))  // 0: "auto"
+    invalid("neighbor.skin", formatReal(c.neighbor.skin), "lie in (0, 2] or be \"auto\"");
 
   const ChargingConfig& q = c.charging;
   if (q.mode != "exchange" && q.mode != "fixed")

@@ -52,7 +52,12 @@ struct IntegratorConfig {
 };
 
 struct NeighborConfig {
-  double skin = 0.3;  ///< Verlet skin; lists rebuilt when a particle moved skin/2
+  /// Verlet skin of the contact list; lists rebuilt when a particle moved skin/2. 0 = "auto": 0.3,
+  /// except where the list carries the fast Coulomb pairs, whose skin follows the gas between
+  /// 0.05 and 0.3 (md/neighbor/Skin.h)
+  double skin = 0.0;
+  /// The skin a list built now uses at most: the number, or 0.3 for "auto".
+  double skinCap() const { return skin > 0.0 ? skin : 0.3; }
 };
 
 /// Collisional charging (design.md section 2): at the first step of a contact, |dq| =
@@ -90,8 +95,9 @@ struct CoulombConfig {
   /// The slow interval follows the gas, from every up to this many steps (Engine.h, "multiple
   /// time stepping"); <= every: fixed; 0 = "auto": 4 x every (docs/benchmarks-coulomb.md)
   int every_max = 0;
-  double skin = 0.0;  ///< Verlet skin of the real-space (PPPM) list; 0 = "auto" (0.8, or
-                      ///< neighbor.skin when every = 1)
+  /// Verlet skin of the real-space (PPPM) list; 0 = "auto": with every > 1 it follows the gas
+  /// between 0.2 and 0.8 (md/neighbor/Skin.h); with every = 1 neighbor.skin's cap
+  double skin = 0.0;
   double r_fast =
       0.0;  ///< every > 1: Coulomb pair force within this is fast (every step); 0 = "auto" (2)
 };

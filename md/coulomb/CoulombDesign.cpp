@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "md/neighbor/Skin.h"
 
 namespace granagg::md {
 
@@ -26,7 +27,8 @@ CoulombDesign designCoulomb(const CoulombConfig& cc, std::size_t N, double L, do
   // "auto": a longer skin than the contact list's when the list is used every k-th step only
   // (fewer builds of a long list; measured optimum at N = 1e4, K = 5:
   // docs/benchmarks-coulomb.md)
-  d.coulomb_skin = cc.skin > 0.0 ? cc.skin : (every_base > 1 ? 0.8 : skin);
+  d.coulomb_skin = cc.skin > 0.0 ? cc.skin : (every_base > 1 ? COULOMB_SKIN_AUTO_MAX : skin);
+  d.coulomb_skin_follows = cc.skin == 0.0 && every_base > 1;
   const double rc_max = 0.5 * L - d.coulomb_skin;  // the list must reach r_cut + skin within L/2
   if (cc.r_cut > rc_max)
     throw std::invalid_argument("coulomb.r_cut = " + common::formatReal(cc.r_cut) +

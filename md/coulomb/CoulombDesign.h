@@ -42,7 +42,9 @@ struct CoulombDesign {
   CoulombSetup setup;
   PppmParams pppm;                       ///< method "pppm"
   EwaldParams ewald;                     ///< method "ewald"
-  double coulomb_skin = 0.0;             ///< skin of the Coulomb (r_cut) list, pppm only
+  double coulomb_skin = 0.0;             ///< skin of the Coulomb (r_cut) list, pppm only; with
+                                         ///< coulomb_skin_follows its largest value
+  bool coulomb_skin_follows = false;     ///< "auto" with every > 1: the skin follows the gas
   RealSpaceSwitch fast_switch;           ///< the near/far split; r2 = 0: none
   double contact_list_cutoff = 1.0;      ///< the contact list's reach: max(1, r_fast)
   bool contact_list_keeps_pairs = true;  ///< false when every entry has fast Coulomb work

@@ -40,6 +40,7 @@
 #include "md/engine/PhaseTimer.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/neighbor/NeighborList.h"
+#include "md/neighbor/Skin.h"
 #include "md/potentials/ContactModels.h"
 #include "md/rng/RngStreams.h"
 
@@ -205,7 +206,14 @@ struct Engine::Impl {
   ContactModel contact;  // the contact model and its parameters (md/potentials/ContactModels.h)
   PhaseTimer timer;      // Engine::enableProfile
 
-  explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skin) {
+  // Skins that follow the gas (md/neighbor/Skin.h), chosen at each build from the fastest drift
+  // velocity of the last step; they change no result, only the cost of the passes and builds
+  bool contact_skin_follows = false;  // neighbor.skin "auto" and the list has fast Coulomb pairs
+  bool coulomb_skin_follows = false;  // coulomb.skin "auto" with multiple time stepping
+  double coulomb_skin_cap = 0.0;      // the Coulomb list's skin when fixed, its largest otherwise
+  double u_max_last = -1.0;           // max |u| of the last step; < 0: none in this process yet
+
+  explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skinCap()) {
     nl.keepPairs(
         true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
     exchange = c.charging.mode == "exchange";
@@ -252,6 +260,7 @@ struct Engine::Impl {
   /// A re-sort moves slots, so it rebuilds every list.
   void rebuildList(bool sort) {
     PhaseTimer::Scope phase(&timer, nl_coul ? PhaseTimer::CoulombList : PhaseTimer::ContactList);
+    chooseSkins(true, true);
     const bool sorted = sort && sortByCell();
     if (nl_coul) {
       nl_coul->build(p, box);
@@ -271,6 +280,7 @@ struct Engine::Impl {
   /// a pair within R now was within R + 2 d when the Coulomb list was built, d bounding every
   /// displacement since.
   void rebuildContactList() {
+    chooseSkins(true, false);
     if (!nl_coul) {
       rebuildList(true);
     } else if (nl.listRange() <= nl_coul->listRange() - 2.0 * drift_since_coul_build) {
@@ -282,6 +292,22 @@ struct Engine::Impl {
     }
   }
 
+  /// Sets the skins of the lists about to be rebuilt (only those: a list reports its new skin at
+  /// once, NeighborList::setSkin) where they follow the gas: md/neighbor/Skin.h's optimum for the
+  /// displacement bound of one use, dt max|u| of the last step for the contact list (used every
+  /// step) and `every` times that for the Coulomb list (used at slow steps). Before the first step
+  /// of this process (also after a restart) the skins keep their caps.
+  void chooseSkins(bool contact_list, bool coulomb_list) {
+    if (u_max_last < 0.0) return;
+    const double delta = dt * u_max_last;
+    if (contact_list && contact_skin_follows)
+      nl.setSkin(followingSkin(fast_switch.r2, delta, CONTACT_LIST_BUILD_OVER_USE,
+                               NEIGHBOR_SKIN_AUTO_MIN, cfg.neighbor.skinCap()));
+    if (coulomb_list && nl_coul && coulomb_skin_follows)
+      nl_coul->setSkin(followingSkin(csetup.r_cut, every * delta, COULOMB_LIST_BUILD_OVER_USE,
+                                     COULOMB_SKIN_AUTO_MIN, coulomb_skin_cap));
+  }
+
   /// Builds the Coulomb solvers from designCoulomb's parameters for the configured accuracy
   /// (md/coulomb/CoulombDesign.h, docs/coulomb.md); the contact list then reaches r_fast. The
   /// error estimates scale with sum q^2: parameters are chosen for sum_q2_design (the engine uses
@@ -290,7 +316,7 @@ struct Engine::Impl {
   void setupCoulomb(double sum_q2_design) {
     const CoulombConfig& cc = cfg.coulomb;
     const std::size_t N = p.size();
-    const double L = box.L, skin = cfg.neighbor.skin;
+    const double L = box.L, skin = cfg.neighbor.skinCap();
     const CoulombDesign d = designCoulomb(cc, N, L, skin, every_base, every_cap, sum_q2_design);
     csetup = d.setup;
     fast_switch = d.fast_switch;
@@ -303,6 +329,8 @@ struct Engine::Impl {
       pppm = std::make_unique<Pppm>(d.pppm, L, cc.K);
       pppm->setPhaseTimer(&timer);
       nl_coul = std::make_unique<NeighborList>(d.pppm.r_cut, d.coulomb_skin);
+      coulomb_skin_cap = d.coulomb_skin;
+      coulomb_skin_follows = d.coulomb_skin_follows;
       if (fast_switch.r2 > 0.0) {
         const auto t = slowPairTableValues(d.pppm.alpha, fast_switch, d.pppm.r_cut * d.pppm.r_cut);
         slow_table.assign(t.begin(), t.end());
@@ -314,6 +342,7 @@ struct Engine::Impl {
     }
     nl = NeighborList(d.contact_list_cutoff, skin);
     nl.keepPairs(d.contact_list_keeps_pairs);
+    contact_skin_follows = cfg.neighbor.skin == 0.0 && fast_switch.r2 > 0.0;
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(N, 0.0);
     kspace_step = -1;
   }
@@ -498,6 +527,7 @@ struct Engine::Impl {
     if (!coulomb) return 0.0;
     if (pppm) {
       if (nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build)) {
+        chooseSkins(false, true);
         nl_coul->build(p, box);
         drift_since_coul_build = 0.0;
       }
@@ -564,6 +594,7 @@ struct Engine::Impl {
         dt * std::sqrt(max_u2) + 2.0 * (std::nextafter(box.L, 2.0 * box.L) - box.L);
     drift_since_build += moved;
     drift_since_coul_build += moved;
+    u_max_last = std::sqrt(max_u2);
     ++step;
     time = step * dt;  // no accumulated round-off in t
   }
@@ -933,6 +964,8 @@ double Engine::time() const { return m_impl->time; }
 double Engine::box() const { return m_impl->box.L; }
 std::size_t Engine::size() const { return m_impl->p.size(); }
 std::int64_t Engine::neighborBuilds() const { return m_impl->nl.builds(); }
+double Engine::contactListSkin() const { return m_impl->nl.skin(); }
+double Engine::coulombListSkin() const { return m_impl->nl_coul ? m_impl->nl_coul->skin() : 0.0; }
 
 const CoulombSetup* Engine::coulombSetup() const {
   return m_impl->coulomb ? &m_impl->csetup : nullptr;

@@ -149,6 +149,10 @@ class Engine {
   std::size_t size() const;
   /// Number of neighbour-list builds so far (diagnostics).
   std::int64_t neighborBuilds() const;
+  /// Skins of the current contact list and Coulomb (PPPM real-space) list, 0 for none; they
+  /// follow the gas where neighbor.skin and coulomb.skin are "auto" (md/neighbor/Skin.h).
+  double contactListSkin() const;
+  double coulombListSkin() const;
   /// Times the phases of every following step (md/engine/PhaseTimer.h; `granagg md --profile`).
   /// Changes no result; on the CUDA backend each phase then waits for the device.
   void enableProfile(bool on);

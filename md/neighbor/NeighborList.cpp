@@ -348,6 +348,11 @@ NeighborList::NeighborList(double cutoff, double skin) : m_cutoff(cutoff), m_ski
     throw std::invalid_argument("neighbour list needs cutoff > 0 and skin > 0.");
 }
 
+void NeighborList::setSkin(double skin) {
+  if (!(skin > 0.0)) throw std::invalid_argument("neighbour list needs skin > 0.");
+  m_skin = skin;
+}
+
 bool NeighborList::needsRebuild(const ParticleData& p, double max_displacement2) const {
   return m_builds == 0 || m_built_n != p.size() ||
          !(max_displacement2 <= 0.25 * m_skin * m_skin);  // NaN: rebuild

@@ -70,6 +70,11 @@ class NeighborList {
   int capacity() const { return m_capacity; }
   std::int64_t builds() const { return m_builds; }
   double listRange() const { return m_cutoff + m_skin; }
+  double skin() const { return m_skin; }
+  /// A new skin (> 0) for the next build (md/neighbor/Skin.h). Call it right before rebuilding:
+  /// the list reports and tests the new skin at once, and its entries are complete for it only
+  /// after the build. The cell order is computed for it too (computeCellOrder).
+  void setSkin(double skin);
 
  private:
   int cellsPerSide(const common::Box& box) const;

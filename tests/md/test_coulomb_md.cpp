@@ -13,6 +13,7 @@
 #include "md/coulomb/RealSpace.h"
 #include "md/engine/Engine.h"
 #include "md/io/InitialState.h"
+#include "md/neighbor/Skin.h"
 #include "meanfield/kinetic/Cooling.h"
 
 using namespace granagg;
@@ -424,4 +425,67 @@ TEST_CASE("a restart keeps the split it was written with, whatever \"auto\" mean
   Engine legacy(automatic, ck);
   CHECK(legacy.coulombSetup()->r_fast == 3.5);
   CHECK(legacy.coulombSetup()->every_max == 4 * legacy.coulombSetup()->every);
+}
+
+TEST_CASE("skins that follow a cold gas are short and change no bit", "[md][coulomb]") {
+  // neighbor.skin and coulomb.skin "auto" (md/neighbor/Skin.h): in a gas at T = 0.0025 the
+  // fastest particle moves about dt 0.2 per step, and the optimum skins are far below the fixed
+  // 0.3 and 0.8 used before. Rows are in id order and entries beyond a pass's cutoff add exactly
+  // zero, so the trajectory must equal the fixed skins' to the bit, while the lists are rebuilt
+  // more often.
+  MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
+  Frame init = randomInitialState(c);
+  for (auto* v : {&init.vx, &init.vy, &init.vz})
+    for (double& x : *v) x *= 0.05;
+  MdConfig fixed = c;
+  fixed.neighbor.skin = 0.3;
+  fixed.coulomb.skin = 0.8;
+  Engine follows(c, init), stays(fixed, init);
+  follows.run(600);
+  stays.run(600);
+  // the optimum for delta = dt max|u| (Skin.h) lies well inside the bounds here
+  INFO("skins " << follows.contactListSkin() << " and " << follows.coulombListSkin() << "; builds "
+                << follows.neighborBuilds() << " against " << stays.neighborBuilds());
+  CHECK(follows.contactListSkin() > NEIGHBOR_SKIN_AUTO_MIN);
+  CHECK(follows.contactListSkin() < 0.2);
+  CHECK(follows.coulombListSkin() > COULOMB_SKIN_AUTO_MIN);
+  CHECK(follows.coulombListSkin() < 0.8);
+  CHECK(stays.contactListSkin() == 0.3);
+  CHECK(stays.coulombListSkin() == 0.8);
+  CHECK(follows.neighborBuilds() > stays.neighborBuilds());
+  const Frame a = follows.frame(), b = stays.frame();
+  CHECK(a.x == b.x);
+  CHECK(a.y == b.y);
+  CHECK(a.z == b.z);
+  CHECK(a.vx == b.vx);
+  CHECK(a.vz == b.vz);
+  CHECK(a.charge == b.charge);
+  CHECK(follows.forces() == stays.forces());
+}
+
+TEST_CASE("the following skin is the minimum of its cost model within its bounds",
+          "[md][coulomb]") {
+  // Skin.h: per use P0 (1 + s/r)^3 (1 + c/s) with c = 2 delta B/P0; its minimum found by a plain
+  // scan of s must equal the closed form (to the scan's resolution, 1e-5).
+  const auto cost = [](double s, double r, double c) {
+    return std::pow(1.0 + s / r, 3) * (1.0 + c / s);
+  };
+  for (const double r : {1.0, 2.0, 4.75})
+    for (const double delta : {1e-4, 6e-4, 1e-2, 0.07}) {
+      const double ratio = 5.0, c = 2.0 * delta * ratio;
+      double best = 0.0, best_cost = HUGE_VAL;
+      for (double s = 1e-5; s < 1.5; s += 1e-5) {
+        const double v = cost(s, r, c);
+        if (v < best_cost) {
+          best_cost = v;
+          best = s;
+        }
+      }
+      INFO("r = " << r << ", delta = " << delta);
+      CHECK(followingSkin(r, delta, ratio, 0.0, 10.0) == Approx(best).margin(1.5e-5));
+    }
+  CHECK(followingSkin(2.0, 1e-9, 4.0, 0.05, 0.3) == 0.05);  // at rest: the floor
+  CHECK(followingSkin(2.0, 1.0, 4.0, 0.05, 0.3) == 0.3);    // hot: the cap
+  CHECK(followingSkin(2.0, 0.0, 4.0, 0.05, 0.3) == 0.3);    // unknown motion: the cap
+  CHECK(followingSkin(2.0, std::nan(""), 4.0, 0.05, 0.3) == 0.3);
 }
