@@ -7,6 +7,7 @@
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
+#include "md/compute/PairChunks.h"
 #include "md/coulomb/RealSpace.h"
 #include "md/engine/Launch.h"
 
@@ -30,6 +31,25 @@ struct RealForceFunctor {
     if (ri.w != 0.0) {  // (an exchanging gas starts neutral)
       const int* row = rows + static_cast<long>(i) * cap;
       const int n = counts[i];
+#if !defined(GRANAGG_CUDA)
+      if (TABLE) {  // CPU: in chunks, the terms in SIMD where possible (md/compute/PairChunks.h)
+        double tx[PAIR_CHUNK], ty[PAIR_CHUNK], tz[PAIR_CHUNK];
+        for (int k0 = 0; k0 < n; k0 += PAIR_CHUNK) {
+          const int m = n - k0 < PAIR_CHUNK ? n - k0 : PAIR_CHUNK;
+          slowRealChunk(PairChunkInput{pos, row + k0, m, ri.x, ri.y, ri.z, box.L}, ri.w, K, table,
+                        rc2, tx, ty, tz);
+          for (int k = 0; k < m; ++k) {  // in row order, as the loop below
+            f0 += tx[k];
+            f1 += ty[k];
+            f2 += tz[k];
+          }
+        }
+        fx[i] = f0;
+        fy[i] = f1;
+        fz[i] = f2;
+        return 0;
+      }
+#endif
       for (int k = 0; k < n; ++k) {
         const Scalar4 rj = pos[row[k]];
         const double rx = box.minimumImageWrapped(ri.x - rj.x),
