@@ -5,7 +5,7 @@
 /// row at a time, in a form the compiler vectorises: each entry's force terms are written to
 /// buffers, and the caller sums them in row order. The sum's order, and every operation of each
 /// term, are the scalar loop's, so results are the same to the bit on every instruction set
-/// (docs/benchmarks-coulomb.md, "The slow real space in SIMD"). The same treatment of the contact
+/// (docs/benchmarks-coulomb.md, "Session 13", "The slow real space in SIMD"). The same treatment of the contact
 /// pass's fast pairs (about 30 entries per particle) was measured and dropped: no faster, since
 /// its ordered sum and its contacts, not the terms, bound that loop.
 ///

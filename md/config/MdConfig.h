@@ -23,6 +23,8 @@
 #include <cstdint>
 #include <string>
 
+#include "md/neighbor/Skin.h"
+
 namespace granagg::md {
 
 struct SystemConfig {
@@ -57,7 +59,7 @@ struct NeighborConfig {
   /// 0.05 and 0.3 (md/neighbor/Skin.h)
   double skin = 0.0;
   /// The skin a list built now uses at most: the number, or 0.3 for "auto".
-  double skinCap() const { return skin > 0.0 ? skin : 0.3; }
+  double skinCap() const { return skin > 0.0 ? skin : NEIGHBOR_SKIN_AUTO_MAX; }
 };
 
 /// Collisional charging (design.md section 2): at the first step of a contact, |dq| =

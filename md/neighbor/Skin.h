@@ -14,7 +14,7 @@
 ///
 /// The skin changes no result: rows are in particle-id order and entries beyond a pass's cutoff
 /// add exactly zero, so forces, and hence trajectories, are the same to the bit for any skin
-/// (tests/md/test_neighbor_list.cpp, "a skin that follows the gas changes no bit").
+/// (tests/md/test_coulomb_md.cpp, "skins that follow a cold gas are short and change no bit").
 #include <cmath>
 
 namespace granagg::md {
