@@ -12,11 +12,15 @@ m tests). With few runs the test only sees large differences: the table also giv
 difference it would detect (80 % power at the 5 % level, about 2.8 standard errors of the
 difference), relative to the reference mean, so a pass says how close, not just "equal".
 
-  usage: /usr/bin/python3 scripts/coulomb_accuracy.py DIR [--docs]
+  usage: /usr/bin/python3 scripts/coulomb_accuracy.py DIR [--docs] [--ref-csv CSV]
     DIR     the study folder (results/coulomb_accuracy)
     --docs  also copy the table and figure to docs/validation/ and docs/img/validation/
+    --ref-csv CSV  take the reference ensemble's means, standard deviations and run count from
+            an earlier comparison.csv (e.g. docs/validation/coulomb_accuracy.csv) instead of
+            DIR/ref: the reference costs 3 h of CPU and Welch's test needs only its statistics
 Writes DIR/comparison.csv, DIR/comparison.md and DIR/comparison.png.
 """
+import csv as _csv
 import os
 import shutil
 import sys
@@ -28,7 +32,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import granagg_tables as gt  # noqa: E402
 
 TIMES = (50.0, 100.0, 150.0)
-SETS = ("ref", "default", "fast", "follow", "fastfollow", "rfast25", "rfast20", "rfast20cap64")
+SETS = ("ref", "default", "fast", "follow", "fastfollow", "rfast25", "rfast20", "rfast20cap32",
+        "rfast20cap64")
 LABELS = {
     "ref": "reference (accuracy 1e-5, every 1)",
     "default": "old default (1e-4, every 4 fixed, r_fast 3.5)",
@@ -37,6 +42,7 @@ LABELS = {
     "fastfollow": "1e-3, r_fast 2.5, interval follows the gas (every_max 16)",
     "rfast25": "interval follows (every_max 16), r_fast 2.5",
     "rfast20": "**default**: interval follows (every_max 16), r_fast 2.0",
+    "rfast20cap32": "interval follows up to 32 steps, r_fast 2.0",
     "rfast20cap64": "interval follows up to 64 steps, r_fast 2.0",
 }
 OBSERVABLES = ("T_g", "mean_abs_q", "S_grid", "S_particle", "clusters_particle", "N_1")
@@ -72,6 +78,39 @@ def per_run_values(folder):
     return out, len(runs)
 
 
+def ensemble_stats(values, n):
+    """{observable: (means, sds, n)} over runs, per time, from per_run_values()."""
+    return {o: (v.mean(0), v.std(0, ddof=1), n) for o, v in values.items()}
+
+
+def stored_reference(csv):
+    """The reference's {observable: (means, sds, n)} from an earlier comparison.csv: its ref_mean
+    and ref_sd columns, and the run count from its '# runs: ref R, ...' line."""
+    n = None
+    with open(csv) as f:
+        for line in f:
+            if line.startswith("# runs:"):
+                for item in line[len("# runs:"):].split(","):
+                    name, count = item.split()
+                    if name == "ref":
+                        n = int(count)
+    if n is None:
+        raise SystemExit(f"coulomb_accuracy.py: {csv} does not give the reference's run count")
+    with open(csv) as f:
+        rows = list(_csv.DictReader(line for line in f if not line.startswith("#")))
+    out = {}
+    for o in OBSERVABLES:
+        m, sd = np.full(len(TIMES), np.nan), np.full(len(TIMES), np.nan)
+        for b, t in enumerate(TIMES):
+            sel = [r for r in rows
+                   if r["observable"] == o and abs(float(r["t"]) - t) < 1e-3 * t]
+            if not sel:
+                raise SystemExit(f"coulomb_accuracy.py: {csv} has no reference {o} at t = {t}")
+            m[b], sd[b] = float(sel[0]["ref_mean"]), float(sel[0]["ref_sd"])
+        out[o] = (m, sd, n)
+    return out
+
+
 def wall_seconds(folder):
     """Wall seconds of each finished run (the `done` files of coulomb_accuracy.sh)."""
     w = []
@@ -88,12 +127,26 @@ def main():
         return 0 if len(sys.argv) >= 2 else 2
     top = sys.argv[1]
     docs = "--docs" in sys.argv[2:]
+    ref_csv = None
+    if "--ref-csv" in sys.argv[2:]:
+        k = sys.argv.index("--ref-csv")
+        if k + 1 >= len(sys.argv):
+            print("coulomb_accuracy.py: --ref-csv needs a file")
+            return 2
+        ref_csv = sys.argv[k + 1]
     data, nruns, wall = {}, {}, {}
+    if ref_csv:
+        data["ref"] = stored_reference(ref_csv)
+        nruns["ref"] = data["ref"]["T_g"][2]
+        wall["ref"] = np.array([])
     for s in SETS:
+        if s == "ref" and ref_csv:
+            continue
         if os.path.isdir(os.path.join(top, s)):
             v, n = per_run_values(os.path.join(top, s))
             if v is not None:
-                data[s], nruns[s], wall[s] = v, n, wall_seconds(os.path.join(top, s))
+                data[s], nruns[s] = ensemble_stats(v, n), n
+                wall[s] = wall_seconds(os.path.join(top, s))
     if "ref" not in data:
         print("coulomb_accuracy.py: no analysed reference ensemble yet in " + top)
         return 1
@@ -107,17 +160,17 @@ def main():
         pmin, nsig = 1.0, 0
         for o in OBSERVABLES:
             for b, t in enumerate(TIMES):
-                x, y = data[s][o][:, b], ref[o][:, b]
-                se = np.sqrt(x.var(ddof=1) / len(x) + y.var(ddof=1) / len(y))
+                xm, xs, xn = data[s][o][0][b], data[s][o][1][b], data[s][o][2]
+                ym, ys, yn = ref[o][0][b], ref[o][1][b], ref[o][2]
+                se = np.sqrt(xs ** 2 / xn + ys ** 2 / yn)
                 if se > 0:
-                    tstat, p = stats.ttest_ind(x, y, equal_var=False)
+                    tstat, p = stats.ttest_ind_from_stats(xm, xs, xn, ym, ys, yn, equal_var=False)
                 else:  # identical constant values
                     tstat, p = 0.0, 1.0
                 pmin = min(pmin, p)
                 nsig += p < 0.05
-                rows.append((s, o, t, x.mean(), y.mean(), x.std(ddof=1), y.std(ddof=1),
-                             (x.mean() - y.mean()) / y.mean() if y.mean() != 0 else np.nan,
-                             DETECTABLE_SE * se / abs(y.mean()) if y.mean() != 0 else np.nan, tstat, p))
+                rows.append((s, o, t, xm, ym, xs, ys, (xm - ym) / ym if ym != 0 else np.nan,
+                             DETECTABLE_SE * se / abs(ym) if ym != 0 else np.nan, tstat, p))
         verdict[s] = (pmin, nsig, m, pmin >= 0.05 / m)
     os.makedirs(top, exist_ok=True)
     csv = os.path.join(top, "comparison.csv")
@@ -170,11 +223,11 @@ def plot(top, data, png):
     others = [s for s in data if s != "ref"]
     width = 0.8 / max(1, len(others))
     for ax, o in zip(axes, shown):
-        r = ref[o]
-        rm, rse2 = r.mean(0), r.var(0, ddof=1) / len(r)
+        rm, rsd, rn = ref[o]
+        rse2 = rsd ** 2 / rn
         for k, s in enumerate(others):
-            v = data[s][o]
-            m, se2 = v.mean(0), v.var(0, ddof=1) / len(v)
+            m, sd, n = data[s][o]
+            se2 = sd ** 2 / n
             rel = 100.0 * (m / rm - 1.0)
             err = 100.0 * np.sqrt(se2 + rse2 * (m / rm) ** 2) / rm
             x = np.arange(len(TIMES)) + (k - (len(others) - 1) / 2) * width

@@ -11,7 +11,8 @@
 #     R     runs per setting, seeds 1..R (default 6)
 #     N     particles (default 2000; phi = 0.076 as in the paper)
 #     J     runs at once, one thread each (default 2)
-#     SET   any of: ref default fast follow fastfollow rfast25 rfast20 rfast20cap64
+#     SET   any of: ref default fast follow fastfollow rfast25 rfast20 rfast20cap32
+#           rfast20cap64
 #           (default: all)
 #       ref      coulomb.accuracy = 1e-5, coulomb.every = 1 (no multiple time stepping)
 #       default  the defaults before issue 15 (accuracy 1e-4, every auto = 4 at the auto dt,
@@ -21,6 +22,7 @@
 #       fastfollow  accuracy 1e-3, r_fast = 2.5, every_max = 16
 #       rfast25  every_max auto (16), r_fast = 2.5
 #       rfast20  every_max auto (16), r_fast = 2.0: the defaults since issue 15
+#       rfast20cap32  r_fast = 2.0 and every_max = 32
 #       rfast20cap64  r_fast = 2.0 and every_max = 64 (the slow interval may grow to 64 steps)
 #
 # Cost on 2 cores (measured 2026-12-02, N = 2000, t = 150, 6 runs each): see the doc.
@@ -44,11 +46,12 @@ while [ $# -gt 0 ]; do
     --n) N=$2; shift 2 ;;
     --jobs) JOBS=$2; shift 2 ;;
     -h|--help) sed -n '2,/^{/p' "$0" | grep '^#' | sed -E 's/^# ?//'; exit 0 ;;
-    ref|default|fast|follow|fastfollow|rfast25|rfast20|rfast20cap64) SETS+=("$1"); shift ;;
+    ref|default|fast|follow|fastfollow|rfast25|rfast20|rfast20cap32|rfast20cap64) SETS+=("$1"); shift ;;
     *) echo "coulomb_accuracy.sh: unknown setting or option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
-[ ${#SETS[@]} -gt 0 ] || SETS=(ref default fast follow fastfollow rfast25 rfast20 rfast20cap64)
+[ ${#SETS[@]} -gt 0 ] \
+  || SETS=(ref default fast follow fastfollow rfast25 rfast20 rfast20cap32 rfast20cap64)
 [ -x "$G" ] \
   || { echo "coulomb_accuracy.sh: no granagg at $G (run bash scripts/setup.sh)" >&2; exit 2; }
 
@@ -62,6 +65,7 @@ settings() {
       echo "--set coulomb.accuracy=1e-3 --set coulomb.r_fast=2.5 --set coulomb.every_max=16" ;;
     rfast25) echo "--set coulomb.r_fast=2.5" ;;
     rfast20) echo "--set coulomb.r_fast=2.0" ;;
+    rfast20cap32) echo "--set coulomb.r_fast=2.0 --set coulomb.every_max=32" ;;
     rfast20cap64) echo "--set coulomb.r_fast=2.0 --set coulomb.every_max=64" ;;
   esac
 }

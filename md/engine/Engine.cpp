@@ -63,10 +63,15 @@ double impactSpeedMax(const MdConfig& c) {
 }
 // coulomb.every = "auto": time between evaluations of the slow Coulomb part (Engine::coulombEvery)
 constexpr double SLOW_INTERVAL = 0.016;
-// coulomb.every_max = "auto": the slow interval grows to at most this many times coulomb.every,
-// the setting the ensemble comparison found indistinguishable from the tight reference
-// (docs/benchmarks-coulomb.md, "Accuracy behind the settings")
-constexpr int SLOW_INTERVAL_GROWTH = 4;
+// coulomb.every_max = "auto": the slow interval grows to at most this many times coulomb.every
+// (64 steps at the paper preset's dt), so that in the cold gas the interval is set by the gas's
+// speeds, not by the cap: ensembles at caps 16, 32 and 64 are indistinguishable from the tight
+// reference, and the cold gas's energy drift is 2-3e-5 of E_kin per 1000 steps at each
+// (docs/benchmarks-coulomb.md, "Session 14"). 4 (16 steps) until issue 15's session 14.
+constexpr int SLOW_INTERVAL_GROWTH = 16;
+// what "auto" meant for checkpoints that do not record their every_max (written in session 9 of
+// issue 15, before the split was recorded)
+constexpr int SLOW_INTERVAL_GROWTH_BEFORE_RECORDED = 4;
 // coulomb.r_fast = "auto" is R_FAST_AUTO (md/coulomb/CoulombDesign.h). What "auto" meant for
 // checkpoints that do not record their split (written before issue 15's change of R_FAST_AUTO; they
 // continue with the split they were written with)
@@ -84,9 +89,14 @@ MdConfig withRecordedSplit(MdConfig c, const Checkpoint& ck) {
     const auto r = reals.find("coulomb_r_fast");
     c.coulomb.r_fast = r != reals.end() ? r->second : R_FAST_AUTO_BEFORE_RECORDED;
   }
-  if (c.coulomb.every_max == 0)
-    if (const auto m = ints.find("coulomb_every_max"); m != ints.end())
-      c.coulomb.every_max = static_cast<int>(m->second);
+  if (c.coulomb.every_max == 0) {
+    const auto m = ints.find("coulomb_every_max");
+    c.coulomb.every_max =
+        m != ints.end()
+            ? static_cast<int>(m->second)
+            : SLOW_INTERVAL_GROWTH_BEFORE_RECORDED *
+                  Engine::coulombEvery(c, Engine::chooseTimeStep(c));
+  }
   return c;
 }
 

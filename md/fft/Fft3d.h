@@ -12,6 +12,9 @@
 ///     implied)
 /// so backward(forward(r)) = nx ny nz r.
 ///
+/// Arrays must be aligned as malloc aligns them (16 bytes; every device_vector is): the FFTW plans
+/// use SIMD codelets, which need it (std::logic_error otherwise).
+///
 /// Plans are made once in the constructor (FFTW's planner is not thread-safe; a global lock
 /// serialises construction). A plan's result does not depend on the caller's thread count at
 /// execution time.

@@ -402,7 +402,8 @@ TEST_CASE(
 TEST_CASE("a restart keeps the split it was written with, whatever \"auto\" means now",
           "[md][coulomb]") {
   // The checkpoint records the resolved r_fast and every_max (Engine::extraState); one without
-  // them was written when "auto" meant r_fast = 3.5 d and continues with that.
+  // them was written when "auto" meant r_fast = 3.5 d and every_max = 4 x every, and continues
+  // with that (since issue 15's session 14 "auto" is 16 x every).
   MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
   c.coulomb.r_fast = 2.5;
   c.coulomb.every_max = 12;
