@@ -178,6 +178,8 @@ def main():
         f.write("# scripts/coulomb_accuracy.py: each setting's ensemble against the reference "
                 "(accuracy 1e-5, every 1); Welch's t test per observable and time\n")
         f.write("# runs: " + ", ".join(f"{s} {nruns[s]}" for s in data) + "\n")
+        if ref_csv:
+            f.write(f"# reference statistics (means, sd, runs) from {ref_csv}\n")
         f.write("setting,observable,t,mean,ref_mean,sd,ref_sd,rel_diff,rel_detectable,t_stat,p\n")
         for r in rows:
             f.write("%s,%s,%g,%.6g,%.6g,%.4g,%.4g,%.4g,%.4g,%.3f,%.4g\n" % r)

@@ -15,6 +15,8 @@
 # charged1   K = 1, as charged5                                                       ~52 min
 # charged025 K = 0.25, as charged5                                                    ~52 min
 # qscan      K = 5 with Q = 0.025 and 0.1, 2 runs each to t = 100 (else as charged5)   ~26 min
+# charged5big  K = 5 at the paper's N = 50016 (L = 70.1), 5 runs to t = 150 (else as
+#            charged5): the size dependence of the onset (issue 15 made it affordable) ~50 min
 # fits       z and beta (fit-beta) over several windows, grid and particle clusters     ~1 min
 # sensitivity  grid spacing 1.5 / 2 / 3 d, threshold 3 / 4 / 5 centres per 2 d cell on the
 #            neutral and K = 5 ensembles (granagg analyze --no-particle), z over the windows  ~5 min
@@ -38,12 +40,13 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --out) OUT=$2; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | grep '^#' | sed -E 's/^# ?//'; exit 0 ;;
-    neutral|charged5|box|charged1|charged025|qscan|fits|sensitivity|report) PARTS+=("$1"); shift ;;
+    neutral|charged5|box|charged1|charged025|qscan|charged5big|fits|sensitivity|report)
+      PARTS+=("$1"); shift ;;
     *) echo "validate.sh: unknown part or option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 [ ${#PARTS[@]} -gt 0 ] \
-  || PARTS=(neutral charged5 box charged1 qscan charged025 fits sensitivity report)
+  || PARTS=(neutral charged5 box charged1 qscan charged025 charged5big fits sensitivity report)
 [ -x "$G" ] || bash scripts/setup.sh
 mkdir -p "$OUT"
 LOG="$OUT/validate.log"
@@ -97,6 +100,18 @@ q_config() {
   grep -q "^Q = $q\$" "$f" && grep -q "^runs = 2" "$f" && grep -q "run.t_end=100" "$f" \
     && grep -q '"50", "100"' "$f" && grep -q "^window = \[50.0, 100.0\]" "$f" \
     || { echo "validate.sh: could not set Q, runs or t_end in $f" >&2; exit 1; }
+  echo "$f"
+}
+
+# The K = 5 study at the paper's N: validate-charged.toml with N = 50016 (same seeds, Q, t_end).
+big_config() {
+  local f="$OUT/config/validate-charged-N50016.toml"
+  mkdir -p "$OUT/config"
+  sed -e "s/system.N=10000/system.N=50016/" \
+      -e "s/^name = \"validate-charged\"/name = \"validate-charged-N50016\"/" \
+      data/pair/validate-charged.toml > "$f"
+  grep -q "system.N=50016" "$f" && grep -q '^name = "validate-charged-N50016"' "$f" \
+    || { echo "validate.sh: could not set N in $f" >&2; exit 1; }
   echo "$f"
 }
 
@@ -158,9 +173,10 @@ for part in "${PARTS[@]}"; do
     charged025) pair charged-K0.25 --preset validate-charged --K 0.25 ;;
     qscan)      pair charged-K5-Q0.025 --config "$(q_config 0.025)" --K 5
                 pair charged-K5-Q0.1 --config "$(q_config 0.1)" --K 5 ;;
+    charged5big) pair charged-K5-N50016 --config "$(big_config)" --K 5 ;;
     fits)       fits neutral S_grid_mean "100 1000" "300 1000" "631 1000"
                 fits box S_grid_mean "100 1000" "631 1000"
-                for c in charged-K5 charged-K1 charged-K0.25; do
+                for c in charged-K5 charged-K1 charged-K0.25 charged-K5-N50016; do
                   fits "$c" S_grid_mean "10 150" "50 150" "80 150"
                   fits "$c" S_particle_mean "10 150" "50 150" "80 150"
                 done
