@@ -66,7 +66,7 @@ constexpr double SLOW_INTERVAL = 0.016;
 // coulomb.every_max = "auto": the slow interval grows to at most this many times coulomb.every
 // (64 steps at the paper preset's dt), so that in the cold gas the interval is set by the gas's
 // speeds, not by the cap: ensembles at caps 16, 32 and 64 are indistinguishable from the tight
-// reference, and the cold gas's energy drift is 2-3e-5 of E_kin per 1000 steps at each
+// reference, and the cold gas's energy drift is at most 3e-5 of E_kin per 1000 steps at each
 // (docs/benchmarks-coulomb.md, "Session 14"). 4 (16 steps) until issue 15's session 14.
 constexpr int SLOW_INTERVAL_GROWTH = 16;
 // what "auto" meant for checkpoints that do not record their every_max (written in session 9 of
