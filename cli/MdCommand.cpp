@@ -89,6 +89,17 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                   overrides);
     sim.emplace(md::Simulation::start(cfg, a.out.empty() ? "md-out" : a.out, options));
   }
+  if (sim->finished()) {  // --restart of a run at its run.t_end: say so, write nothing
+    std::fprintf(stderr,
+                 "md: the run in %s is complete at run.t_end = %s (step %lld): nothing to do; "
+                 "to run it further: granagg md --restart %s --set run.t_end=T (T > %s)\n",
+                 sim->folder().c_str(), common::formatReal(sim->config().run.t_end).c_str(),
+                 static_cast<long long>(sim->engine().step()), sim->folder().c_str(),
+                 common::formatReal(sim->config().run.t_end).c_str());
+    return;
+  }
+  if (!sim->clearedStaleLock().empty() && !a.quiet)
+    std::fprintf(stderr, "md: cleared the stale lock of %s\n", sim->clearedStaleLock().c_str());
   if (!a.quiet) {
     log(md::runStartLines(*sim));
     sim->addReporter(std::make_shared<md::ProgressReporter>(*sim));
@@ -130,7 +141,9 @@ void registerMdCommand(CLI::App& app, const CliContext& ctx) {
   md->add_option("--seed", a->seed, "Random seed, an integer in [0, 2^64) (overrides system.seed)");
   md->add_option("--threads", a->threads, "OpenMP threads (default: all cores; OMP_NUM_THREADS)")
       ->check(CLI::Range(1, 4096));
-  md->add_flag("--force", a->force, "Overwrite an existing output folder");
+  md->add_flag("--force", a->force,
+               "Overwrite an existing output folder; clear a stale lock (of a run that was "
+               "killed) with --out or --restart. A folder in use is never taken");
   md->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
   md->add_flag(
       "--profile", a->profile,

@@ -18,6 +18,7 @@
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/FolderLock.h"
 #include "common/Interrupted.h"
 #include "common/Version.h"
 #include "study/Process.h"
@@ -71,13 +72,31 @@ void PairStudy::prepareFolder() {
   const bool exists = fs::exists(m_out);
   if (exists && !fs::is_directory(m_out))
     throw std::invalid_argument("--out '" + m_out.string() + "' exists and is not a folder");
+  // The study folder is locked by the command that runs the whole study; the array tasks of a
+  // batch job (run_index) run side by side, each md run locking its own run folder. A stale lock
+  // that a killed study left on this host is cleared: resuming is what pair does, and every run
+  // is checked against its records. Another host's stale lock needs --force.
+  const bool whole = m_a.run_index < 0;
+  const std::optional<common::LockHolder> stale =
+      whole ? common::FolderLock::staleHolder(m_out) : std::nullopt;
+  const bool clear_stale = m_a.force || (stale && stale->deadHere());
+  const std::string hint = "If that study has ended, delete " +
+                           (m_out / common::FOLDER_LOCK_FILE).string() +
+                           " (--force would start the study over)";
+  if (whole) common::FolderLock::checkAvailable(m_out, clear_stale, "--out", hint);
   const bool is_pair = fs::exists(m_out / "config" / "pair.toml");
   if (exists && !fs::is_empty(m_out) && !is_pair && !m_a.force)
     throw std::invalid_argument(
         "output folder '" + m_out.string() +
         "' exists, is not empty and holds no pair study; choose another --out or pass --force");
-  if (is_pair && m_a.force && m_a.run_index < 0) {
-    // --force: start over (keep nothing this command made before).
+  if (whole) {
+    m_lock = common::FolderLock::acquire(m_out, m_s.command_line, clear_stale, "--out", hint);
+    if (!m_lock->clearedStale().empty())
+      say("cleared the stale lock of " + m_lock->clearedStale());
+  }
+  if (is_pair && m_a.force && whole) {
+    // --force: start over (keep nothing this command made before), unless a run is being written
+    common::FolderLock::checkTreeAvailable(m_out);
     for (const char* sub : {"runs", "analysis", "meanfield", "fit", "figures", "logs", "config"})
       fs::remove_all(m_out / sub);
     for (const char* f : {"summary.json", "report.html", "commands.txt", "batch.slurm", "pair.log"})
@@ -185,6 +204,9 @@ void PairStudy::runMd(std::vector<RunJob> all) {
                                     "' holds a run made with another configuration; choose another "
                                     "--out or pass --force to redo it");
     }
+    if (const auto holder = common::FolderLock::liveHolder(j.dir))
+      throw std::invalid_argument("run folder '" + j.dir.string() + "' is in use by " +
+                                  holder->describe() + ": wait for it to finish or stop it");
     j.restart = fs::exists(j.dir / "checkpoint.h5") && fs::exists(j.dir / "traj.h5") &&
                 recordOf(j.dir / "run.json", j);
     todo.push_back(j);
@@ -228,7 +250,8 @@ void PairStudy::runMd(std::vector<RunJob> all) {
     fs::create_directories(j.dir);
     std::vector<std::string> argv{m_s.exe, "md"};
     if (j.restart) {
-      argv.insert(argv.end(), {"--restart", j.dir.string()});
+      // --force clears the stale lock of a run killed with the study (a live one is never taken)
+      argv.insert(argv.end(), {"--restart", j.dir.string(), "--force"});
     } else {
       // A fresh start: clear what an interrupted attempt left behind.
       for (const char* f : {"traj.h5", "traj.xdmf", "checkpoint.h5", "done.json"})

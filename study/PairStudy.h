@@ -14,10 +14,12 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "common/FolderLock.h"
 #include "common/PaperValues.h"
 #include "study/PairConfig.h"
 
@@ -121,6 +123,7 @@ class PairStudy {
   StudyRequest m_a;
   StudyServices m_s;
   std::filesystem::path m_out;
+  std::optional<common::FolderLock> m_lock;  ///< the study folder's, while run() writes it
   int m_cores;
   clock::time_point m_start;
   std::map<std::string, MdPlan> m_md;            ///< per K name

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "analysis/io/AnalysisFile.h"
+#include "common/FolderLock.h"
 #include "common/Strings.h"
 
 namespace granagg::analysis {
@@ -22,6 +23,11 @@ void checkAnalysisFolderRequest(const AnalysisFolderRequest& request) {
   for (const auto& r : request.runs) {
     if (!fs::exists(r))
       throw std::invalid_argument("no such trajectory or run folder: '" + r + "'");
+    // a run still being written is read only when it has finished (its file is incomplete)
+    const fs::path folder = fs::is_directory(r) ? fs::path(r) : fs::path(r).parent_path();
+    if (const auto holder = common::FolderLock::liveHolder(folder.empty() ? "." : folder))
+      throw std::invalid_argument("run '" + r + "' is being written by " + holder->describe() +
+                                  ": analyse it when that command has finished");
     // the ensemble statistics treat runs as independent samples: one run twice is not two
     fs::path canonical = fs::weakly_canonical(r);
     if (canonical.filename().empty()) canonical = canonical.parent_path();  // "dir/" = "dir"
@@ -33,6 +39,7 @@ void checkAnalysisFolderRequest(const AnalysisFolderRequest& request) {
   if (fs::exists(out) && !fs::is_directory(out))
     throw std::invalid_argument("--out '" + out.string() +
                                 "' is a file, not a folder; analyze writes a folder");
+  common::FolderLock::checkAvailable(out, request.force);
   if (fs::exists(out) && !fs::is_empty(out) && !request.force)
     throw std::invalid_argument(
         "output folder '" + out.string() +
@@ -44,7 +51,7 @@ AnalysisFolder analyseIntoFolder(
     const std::function<void(std::size_t, std::size_t, std::size_t)>& progress) {
   checkAnalysisFolderRequest(request);
   const fs::path out(request.out);
-  const bool created = !fs::exists(out);
+  common::FolderLock lock = common::FolderLock::acquire(out, request.command_line, request.force);
   fs::create_directories(out / "per_run");
 
   // analysis.h5 is opened first so that --write-grid streams one frame at a time into it; a
@@ -70,10 +77,12 @@ AnalysisFolder analyseIntoFolder(
     std::error_code ec;
     fs::remove(h5path, ec);
     // nothing left that would block the rerun: a folder made here goes, an empty per_run too
-    if (created)
+    if (lock.createdFolder()) {
+      lock.release();
       fs::remove_all(out, ec);
-    else
+    } else {
       fs::remove(out / "per_run", ec);
+    }
     throw;
   }
   const std::vector<Table> ensemble = analyzeEnsemble(results, o);

@@ -72,9 +72,10 @@ std::vector<std::string> runSummaryLines(const Simulation& sim, const RunSummary
       static_cast<long long>(s.neighbor_builds),
       s.neighbor_builds > 0 ? static_cast<double>(s.steps) / s.neighbor_builds : 0.0));
   out.push_back(printfString(
-      "md: done at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max overlap "
+      "md: %s at t = %g: T_g = %.6g, %lld collisions, %.3g contacts per particle, max overlap "
       "%.3g",
-      o.time, o.temperature, static_cast<long long>(o.collisions), o.contacts_per_particle,
+      s.stopped ? "stopped" : "done", o.time, o.temperature,
+      static_cast<long long>(o.collisions), o.contacts_per_particle,
       o.max_overlap));
   if (const CoulombSetup* cs = e.coulombSetup(); cs && cs->r_fast > 0.0)
     out.push_back(printfString(

@@ -1,14 +1,19 @@
 #include "md/run/Simulation.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/FolderLock.h"
+#include "common/H5mdReader.h"
 #include "common/Version.h"
 #include "md/config/ConfigParser.h"
 #include "md/io/Checkpoint.h"
@@ -201,8 +206,59 @@ struct Simulation::Impl {
   std::int64_t last_checkpoint_step = -1;  // -1: none written by this process or found
   Observables observables;                 // at the end of the last chunk
 
+  std::size_t frames_at_resume = 0;        // resume(): the frames the checkpoint counts
+  std::optional<common::FolderLock> lock;  // held from the first write to the end of the run
+  struct stat traj_stat {};                // the trajectory as this run last left it
+
   fs::path trajectory() const { return out / "traj.h5"; }
   fs::path checkpointFile() const { return out / "checkpoint.h5"; }
+
+  /// The trajectory changed behind the run's back (removed, replaced, truncated by another
+  /// program; other granagg commands are kept out by the folder lock): the run stops, and never
+  /// reports success for a file it cannot vouch for.
+  [[noreturn]] void trajectoryDamaged(const std::string& what) const {
+    throw std::runtime_error(
+        trajectory().string() + " was damaged while this run wrote it (" + what +
+        "); its frames cannot be trusted. Start the run again into a new folder" +
+        (last_checkpoint_step >= 0 ? " (checkpoint.h5 holds step " +
+                                         std::to_string(last_checkpoint_step) +
+                                         ", but the trajectory up to it is lost)"
+                                   : ""));
+  }
+
+  void watchTrajectory() {
+    if (::stat(trajectory().c_str(), &traj_stat) != 0) trajectoryDamaged("it is gone");
+  }
+
+  /// Called between chunks: the file must be the one this run opened, and no shorter. (The HDF5
+  /// library only ever extends a file it writes.)
+  void checkTrajectory() {
+    struct stat now {};
+    if (::stat(trajectory().c_str(), &now) != 0) trajectoryDamaged("it was removed");
+    if (now.st_ino != traj_stat.st_ino || now.st_dev != traj_stat.st_dev)
+      trajectoryDamaged("another file took its name");
+    if (now.st_size < traj_stat.st_size)
+      trajectoryDamaged("its size fell from " + std::to_string(traj_stat.st_size) + " to " +
+                        std::to_string(now.st_size) + " bytes");
+    traj_stat = now;
+  }
+
+  /// After the writer closed the file: it reads back whole, with every frame written.
+  void verifyTrajectory(std::size_t frames_written) const {
+    try {
+      const common::H5mdReader reader(trajectory().string());
+      if (reader.frames() != frames_written)
+        trajectoryDamaged("it reads back with " + std::to_string(reader.frames()) +
+                          " frames of the " + std::to_string(frames_written) + " written");
+      if (frames_written > 0) {
+        reader.readFrame(0);
+        reader.readFrame(frames_written - 1);
+      }
+    } catch (const std::runtime_error& e) {
+      if (std::string(e.what()).find("was damaged while") != std::string::npos) throw;
+      trajectoryDamaged(std::string("it cannot be read back: ") + e.what());
+    }
+  }
 
   /// engine, dt, last step and frame schedule (both start() and resume())
   void setUp(std::unique_ptr<Engine> e) {
@@ -243,23 +299,36 @@ Simulation Simulation::start(const MdConfig& config, const fs::path& out,
   if (fs::exists(out) && !fs::is_directory(out))  // (--force would not help: say what it is)
     throw std::invalid_argument("--out '" + out.string() +
                                 "' is a file, not a folder; a run writes a folder");
+  // a folder in use by another command is refused before anything else, even with --force
+  common::FolderLock::checkAvailable(out, options.overwrite);
   if (fs::exists(out) && !fs::is_empty(out) && !options.overwrite)
     throw std::invalid_argument("output folder '" + out.string() +
                                 "' exists and is not empty; choose another --out or pass --force "
                                 "to overwrite it");
   // everything that can fail on the input fails before the folder is touched
   d->setUp(std::make_unique<Engine>(d->cfg, initialState(d->cfg)));
-  fs::create_directories(out);
-  // an overwritten run's checkpoint and profile are not this run's
-  fs::remove(d->checkpointFile());
-  fs::remove(out / "profile.csv");
-  const Engine& e = *d->engine;
-  d->writer = std::make_unique<H5mdWriter>(
-      d->trajectory().string(), e.size(), parameters(d->cfg, e, options.command_line, d->dt_reason),
-      toToml(d->cfg), options.overwrite, d->cfg.output.write_velocities,
-      d->cfg.output.write_forces);
-  d->writer->writeObservables(0, 0.0, observableRow(e.observables()));
-  d->writer->writeFrame(outputFrame(e, d->cfg));
+  d->lock = common::FolderLock::acquire(out, options.command_line, options.overwrite);
+  try {
+    // an overwritten run's checkpoint and profile are not this run's
+    fs::remove(d->checkpointFile());
+    fs::remove(out / "profile.csv");
+    const Engine& e = *d->engine;
+    d->writer = std::make_unique<H5mdWriter>(
+        d->trajectory().string(), e.size(),
+        parameters(d->cfg, e, options.command_line, d->dt_reason), toToml(d->cfg),
+        options.overwrite, d->cfg.output.write_velocities, d->cfg.output.write_forces);
+    d->writer->writeObservables(0, 0.0, observableRow(e.observables()));
+    d->writer->writeFrame(outputFrame(e, d->cfg));
+  } catch (...) {
+    d->writer.reset();
+    if (d->lock->createdFolder()) {  // nothing half-written: a folder made here goes again
+      d->lock.reset();
+      std::error_code ec;
+      fs::remove_all(out, ec);
+    }
+    throw;
+  }
+  d->watchTrajectory();
   d->next_frame = 1;  // frames[0] = 0: written
   return Simulation(std::move(d));
 }
@@ -277,6 +346,7 @@ Simulation Simulation::resume(const fs::path& out, const std::vector<std::string
   const fs::path cpath = d->checkpointFile();
   if (!fs::exists(cpath))
     throw std::invalid_argument("--restart: no checkpoint at " + cpath.string());
+  common::FolderLock::checkAvailable(out, options.overwrite, "--restart");
   const Checkpoint ck = readCheckpoint(cpath.string());
   d->cfg = parseConfigString(ck.extra.config_toml, cpath.string() + ":/config_toml", overrides);
   validateConfig(d->cfg);
@@ -289,12 +359,16 @@ Simulation Simulation::resume(const fs::path& out, const std::vector<std::string
         out.string() + " (t = " + common::formatReal(e.time()) + ", step " +
         std::to_string(e.step()) + "): give a later --set run.t_end=... to run further");
   d->last_checkpoint_step = e.step();
+  d->frames_at_resume = ck.extra.frames_written;
+  if (d->last == e.step()) return Simulation(std::move(d));  // finished: nothing to open
+  d->lock = common::FolderLock::acquire(out, options.command_line, options.overwrite, "--restart");
   d->writer = std::make_unique<H5mdWriter>(
       H5mdWriter::reopen(d->trajectory().string(), e.size(), e.step(),
                          d->cfg.output.write_velocities, d->cfg.output.write_forces));
-  if (d->last > e.step())  // the run's history: who continued it from where, to where
-    d->writer->recordRestart(e.step(), e.time(), d->cfg.run.t_end, options.command_line,
-                             common::versionString());
+  // the run's history: who continued it from where, to where
+  d->writer->recordRestart(e.step(), e.time(), d->cfg.run.t_end, options.command_line,
+                           common::versionString());
+  d->watchTrajectory();
   return Simulation(std::move(d));
 }
 
@@ -304,6 +378,7 @@ void Simulation::addReporter(std::shared_ptr<Reporter> reporter) {
 
 RunSummary Simulation::run() {
   Impl& d = *m_impl;
+  if (finished()) return {};  // resumed at run.t_end: no file is opened, nothing to do
   Engine& engine = *d.engine;
   const MdConfig& cfg = d.cfg;
   const std::int64_t obs_every = cfg.output.observable_interval;
@@ -328,6 +403,7 @@ RunSummary Simulation::run() {
         if (const std::int64_t s = r->nextStep(*this); s > engine.step())
           target = std::min(target, s);
       engine.run(target - engine.step());
+      d.checkTrajectory();
       d.observables = engine.observables();
       const Observables& o = d.observables;
       if (engine.step() % obs_every == 0 || engine.step() == d.last)
@@ -363,15 +439,27 @@ RunSummary Simulation::run() {
   s.neighbor_builds = engine.neighborBuilds() - first_builds;
   s.slow_evaluations = engine.slowEvaluations() - first_slow;
   s.stopped = engine.step() < d.last;
+  d.checkTrajectory();
   d.checkpoint();
   d.writer->close();
+  d.verifyTrajectory(d.writer->frames());
+  d.lock.reset();
   if (d.options.profile)
     writeProfile(engine, d.out / "profile.csv", d.options.command_line, s.steps, s.loop_seconds,
                  s.neighbor_builds, s.slow_evaluations);
   return s;
 }
 
-void Simulation::writeCheckpoint() { m_impl->checkpoint(); }
+void Simulation::writeCheckpoint() {
+  if (!finished()) m_impl->checkpoint();
+}
+
+const std::string& Simulation::clearedStaleLock() const {
+  static const std::string none;
+  return m_impl->lock ? m_impl->lock->clearedStale() : none;
+}
+
+bool Simulation::finished() const { return m_impl->resumed && !m_impl->writer; }
 
 const Engine& Simulation::engine() const { return *m_impl->engine; }
 const MdConfig& Simulation::config() const { return m_impl->cfg; }
@@ -381,7 +469,9 @@ fs::path Simulation::checkpointPath() const { return m_impl->checkpointFile(); }
 const std::string& Simulation::dtReason() const { return m_impl->dt_reason; }
 std::int64_t Simulation::lastStep() const { return m_impl->last; }
 bool Simulation::resumed() const { return m_impl->resumed; }
-std::size_t Simulation::framesWritten() const { return m_impl->writer->frames(); }
+std::size_t Simulation::framesWritten() const {
+  return m_impl->writer ? m_impl->writer->frames() : m_impl->frames_at_resume;
+}
 const Observables& Simulation::lastObservables() const { return m_impl->observables; }
 
 std::vector<std::int64_t> Simulation::frameSteps(const MdConfig& c, double dt, std::int64_t last) {

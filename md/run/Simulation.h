@@ -12,6 +12,8 @@
 ///                    output.checkpoint_interval steps and/or output.checkpoint_wall_seconds, and
 ///                    at the end of run()
 ///     profile.csv    with RunOptions::profile: wall seconds per phase of the loop
+///     .granagg.lock  while start() or resume() writes the folder (common/FolderLock.h): a second
+///                    command into the same folder is refused, naming this one
 ///
 /// Determinism: a run resumed from any of its checkpoints writes the same frames, observables and
 /// final state, to the bit, as the uninterrupted run (same build; any thread count).
@@ -51,7 +53,9 @@ class Reporter {
 /// How a run is started or resumed.
 struct RunOptions {
   std::string command_line;  ///< provenance: stored in /parameters of a new trajectory
-  bool overwrite = false;    ///< start(): replace the files of a non-empty output folder
+  /// start(): replace the files of a non-empty output folder; start() and resume(): clear a
+  /// stale folder lock (a run that was killed). A folder held by a live process is never taken.
+  bool overwrite = false;
   bool profile = false;      ///< time the loop by phase and write profile.csv (no result changes)
   /// When it points at a nonzero value (a signal handler sets it), run() stops after the chunk of
   /// steps in progress, writes a checkpoint and returns with RunSummary::stopped.
@@ -71,9 +75,10 @@ class Simulation {
  public:
   /// A new run of `config` (validated here) into the folder `out`, from its initial state
   /// (system.initial: random, or a CSV / H5MD file, with charges from charging.initial). Creates
-  /// `out`; throws std::invalid_argument, before writing anything, for a bad configuration or
-  /// initial state and for a non-empty `out` without RunOptions::overwrite. Writes the trajectory's
-  /// header and the frame and observables at t = 0.
+  /// and locks `out`; throws std::invalid_argument, before writing anything, for a bad
+  /// configuration or initial state, for a non-empty `out` without RunOptions::overwrite and for
+  /// an `out` that another process holds. Writes the trajectory's header and the frame and
+  /// observables at t = 0; a failure there removes a folder it created.
   static Simulation start(const MdConfig& config, const std::filesystem::path& out,
                           const RunOptions& options);
   /// Continues the run in `out` from its checkpoint.h5, with the configuration stored there.
@@ -81,7 +86,8 @@ class Simulation {
   /// then records the continuation (/granagg/restarts, H5mdWriter::recordRestart). Throws
   /// std::invalid_argument, before writing anything, for another key, a bad value, a run.t_end
   /// before the checkpoint or a missing checkpoint, and std::runtime_error for an unreadable one.
-  /// A run already at its run.t_end resumes with nothing to do.
+  /// A run already at its run.t_end resumes with nothing to do (finished()) and touches nothing;
+  /// any other locks the folder as start() does.
   static Simulation resume(const std::filesystem::path& out,
                            const std::vector<std::string>& overrides, const RunOptions& options);
 
@@ -96,7 +102,9 @@ class Simulation {
   /// checkpoints on their schedule and a final checkpoint, and closes the trajectory. With
   /// RunOptions::stop set it ends early the same way, at the end of a chunk. Throws
   /// RunAborted when the engine stops (NaN, deep overlap); the message then says where the
-  /// trajectory ends and which checkpoint is the last good state.
+  /// trajectory ends and which checkpoint is the last good state. Throws std::runtime_error when
+  /// the trajectory was changed behind the run's back (removed, replaced or truncated between
+  /// chunks, or unreadable after closing): such a run never ends as a success.
   RunSummary run();
 
   /// Writes checkpoint.h5 now (atomically; the trajectory is flushed first).
@@ -113,6 +121,10 @@ class Simulation {
   std::int64_t lastStep() const;
   /// True if this Simulation continues a checkpoint.
   bool resumed() const;
+  /// The stale folder lock that RunOptions::overwrite cleared ("" if none), for the log.
+  const std::string& clearedStaleLock() const;
+  /// True if it was resumed at its run.t_end: run() has nothing to do and opens no file.
+  bool finished() const;
   /// Frames in the trajectory so far.
   std::size_t framesWritten() const;
   /// The observables at the end of the last chunk of run() (what reporters should read: the

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/FolderLock.h"
 #include "common/Strings.h"
 #include "common/Version.h"
 
@@ -129,6 +130,7 @@ FitBetaFiles fitBetaFiles(const std::string& folder) {
 
 void checkFitBetaOutputs(const std::string& folder, bool curve_fit, bool force) {
   const FitBetaFiles f = fitBetaFiles(folder);
+  common::FolderLock::checkAvailable(folder, force);  // another command writing there: refused
   common::refuseToOverwrite(f.csv, force);
   common::refuseToOverwrite(f.json, force);
   if (curve_fit) common::refuseToOverwrite(f.curve, force);
@@ -138,7 +140,7 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
                   const std::string& command_line, const common::PaperValues& paper, bool force) {
   const FitBetaFiles f = fitBetaFiles(folder);
   const double nan = NaN;
-  fs::create_directories(folder);
+  const common::FolderLock lock = common::FolderLock::acquire(folder, command_line, force);
   if (!r.request.curve_fit && force) fs::remove(f.curve);  // a stale curve would mislead
   common::Provenance prov(command_line);
   prov.add("input", r.input.source);
