@@ -11,11 +11,15 @@ PAIR_DIR/figures/ (figN_<name>.png and .pdf):
   fig2_snapshots     projected slab (|z - L/2| < 2 d) of run 0 at three times, neutral and charged
   fig3_nstick        N_stick of the tracked particles (contacts within 1 + tolerance)
   fig4_charge        mean |q|(t), its rate against the t^(-a(1/2+kappa)) law, N_s(s) at three times
-  fig5_growth        S(t) with power-law fits (and the fitted mean field), local slope below
-  fig6_meanfield     MD against mean-field S(t) (fit-beta's fitted curve), MSD beside
+  fig5_growth        S(t) with the power-law fit where the summary reports a z (and the fitted
+                     mean field where beta is determined), local slope below
+  fig6_meanfield     MD against mean-field S(t) (fit-beta's fitted curve where beta is
+                     determined), MSD beside
   fig7_speed         f(v~) against the Maxwellian at the first and last frames
   fig8_charge_speed  (q~, v~) scatter of the last analysed frame, charged ensembles
 
+No curve of an undetermined quantity is drawn: no power law where S(t) is none (summary.json
+"z_reported"), no fitted mean field where beta lies at a bound of its search range.
 A missing input (no charged ensemble, no fit-beta output...) leaves a note in that panel; the
 script does not fail for it. Exit status 1 only when a figure failed for another reason (the
 figure then holds the error). Debian's python3-matplotlib, python3-numpy and python3-h5py only.
@@ -93,14 +97,29 @@ def readable_log(ax, axis="y"):
     a.set_minor_formatter(NullFormatter())
 
 
-def beta_label(e):
-    """The fitted-beta part of a legend entry: the value, or why there is none."""
+def beta_determined(e):
+    """Whether the summary holds a full-curve beta that is a result. A beta at a bound of fit-beta's
+    search range is not one: summary.json then says beta_fit_determined = false (older folders
+    still carry the bound as the value), and its curve is not drawn."""
     b = (e.get("beta_fit") or {}).get("value")
-    if b is None:
-        return "mean field (no fitted beta)"
-    if not e.get("beta_fit_determined", True):
-        return f"mean field at beta = {b:.3g}: the search bound, beta not determined"
-    return f"mean field, fitted beta = {b:.3g}"
+    return b is not None and bool(e.get("beta_fit_determined", False))
+
+
+def beta_label(e):
+    """The legend entry of a fitted mean-field curve (drawn only where beta_determined(e))."""
+    return f"mean field, fitted beta = {e['beta_fit']['value']:.3g}"
+
+
+def reported_z(e):
+    """The growth exponent the summary reports (summary.json "z_reported"): a dict with status
+    "power law", value, low, high and window, or another status and the text that says why there is
+    no z. Folders written before z_reported existed: analyze's z, only in a scaling regime."""
+    if "z_reported" in e:
+        return e["z_reported"]
+    zi = e.get("z_analyze") or {}
+    if e.get("regime") == "scaling" and zi.get("value") is not None:
+        return dict(status="power law", window=e.get("z_analyze_window"), **zi)
+    return {"status": e.get("regime", "unknown"), "text": f"regime: {e.get('regime', 'unknown')}, no z"}
 
 
 def colors(i):
@@ -297,19 +316,23 @@ def fig5(st, fig):
             continue
         m = (S["t"] > 0) & np.isfinite(S["S_grid_mean"])
         t, s = S["t"][m], S["S_grid_mean"][m]
-        ax.errorbar(t, s, yerr=S["S_grid_se"][m], fmt="o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
         e = ens.get(k[0], {})
-        win = e.get("z_analyze_window") or [t[-1] / 10, t[-1]]
-        if win[0] is not None:
+        zr = reported_z(e) if e else {"status": "unknown"}
+        # A power-law line only where the summary reports a z (a flat local slope, an interval
+        # above 0); otherwise the legend says why there is none.
+        why = "" if zr.get("status") == "power law" or not zr.get("text") else f"; z: {zr['text']}"
+        ax.errorbar(t, s, yerr=S["S_grid_se"][m], fmt="o", ms=3, color=colors(i), label=f"MD, {st.label(k)}{why}")
+        win = zr.get("window") or [None, None]
+        if zr.get("status") == "power law" and None not in win:
             f = powerfit(t, s, win[0], win[1])
             if f:
-                z, c, tw = f
-                zi = e.get("z_analyze", {})
-                lab = f"power law over t = {win[0]:.3g}..{win[1]:.3g}: z = {z:.3g}" + (
-                    f" [{zi['low']:.3g}, {zi['high']:.3g}]" if zi.get("low") is not None else "")
+                _, c, tw = f
+                z = zr["value"]
+                c = np.mean(np.log(s[(t >= tw[0]) & (t <= tw[-1])]) - z * np.log(tw))  # the reported z
+                lab = f"power law over t = {win[0]:.3g}..{win[1]:.3g}: z = {z:.3g} [{zr['low']:.3g}, {zr['high']:.3g}]"
                 ax.plot(tw, np.exp(c) * tw**z, "-", color=colors(i), lw=2, label=lab)
         fc = read(f"{st.d}/fit/{k[0]}/fit_curve.csv")
-        if fc is not None and col(fc, "S_mf_fitted") is not None:
+        if beta_determined(e) and fc is not None and col(fc, "S_mf_fitted") is not None:
             ax.plot(fc["t"], fc["S_mf_fitted"], "--", color=colors(i), label=beta_label(e))
         zl = col(S, "z_local_grid_of_mean")
         if zl is not None:
@@ -333,17 +356,22 @@ def fig6(st, fig):
     ax, ins = fig.subplots(1, 2, gridspec_kw={"width_ratios": [2, 1], "wspace": 0.3})
     ens = {e["name"]: e for e in st.summary.get("ensembles", [])}
     drawn = False
+    undetermined = []
     for i, k in enumerate(st.ks):
         fc = read(f"{st.d}/fit/{k[0]}/fit_curve.csv")
         S = st.table("S_t", k[0])
-        if fc is not None and col(fc, "S_md") is not None:
+        e = ens.get(k[0], {})
+        if fc is not None and col(fc, "S_md") is not None and beta_determined(e):
             ax.plot(fc["t"], fc["S_md"], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
-            ax.plot(fc["t"], fc["S_mf_fitted"], "-", color=colors(i),
-                    label=beta_label(ens.get(k[0], {})) + " (S_c, tau_c fitted)")
+            ax.plot(fc["t"], fc["S_mf_fitted"], "-", color=colors(i), label=beta_label(e) + " (S_c, tau_c fitted)")
             drawn = True
         elif S is not None:
+            # no fitted beta (fit-beta not run, or beta at a bound of its range): the MD data alone
+            why = "no fit-beta output" if fc is None else "beta not determined, no fitted curve"
+            if fc is not None:
+                undetermined.append(f"K = {k[1]:g}")
             m = S["t"] > 0
-            ax.plot(S["t"][m], S["S_grid_mean"][m], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)} (no fit-beta output)")
+            ax.plot(S["t"][m], S["S_grid_mean"][m], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)} ({why})")
         msd = st.table("msd", k[0])
         if msd is not None:
             m = msd["t"] > 0
@@ -357,7 +385,9 @@ def fig6(st, fig):
             ax2.loglog(mf["t"][m], mf["S"][m], "k" + ls, label=f"mean field beta = {b} (top axis: t in 1/(K0 n1(0)))")
             ax2.legend(fontsize=7, loc="lower right")
     if not drawn:
-        note(ax, "fit/K*/fit_curve.csv missing (granagg fit-beta not run):\nMD and mean field shown on their own time axes")
+        note(ax, (f"beta not determined ({', '.join(undetermined)}): no fitted mean-field curve"
+                  if undetermined else "fit/K*/fit_curve.csv missing (granagg fit-beta not run)")
+             + ":\nMD and mean field shown on their own time axes")
     ins.set(xlabel="t", ylabel=r"MSD / $d^2$", title="mean squared displacement")
     if ins.lines:
         ins.legend(fontsize=7)
