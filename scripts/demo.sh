@@ -2,10 +2,13 @@
 # The main job (README): installs what is missing, builds, and runs the quick paired MD /
 # mean-field study (issue 6, docs/pair.md): neutral (K = 0) and charged (K = 5) granular gases,
 # 3 MD runs each, their analysis, the Smoluchowski mean field (S(t) for beta = 2 and 3, z(beta)),
-# the beta fit, the paper's eight figures, summary.json and a self-contained report.html.
+# the beta fit, the paper's eight figures, summary.txt, summary.json and a self-contained
+# report.html.
 # Under 10 minutes on 2 cores after the build (data/pair/quick.toml states the sizes; the measured
-# time is in docs/validation.md, "The demo"). Both ensembles aggregate; the summary says in which
-# regime (none / onset / scaling) and prints the validation study's numbers beside the demo's.
+# time is in docs/validation.md, "The demo"). Both ensembles aggregate; the summary leads with the
+# verdict (what the demo showed, what the validation study concluded), then per ensemble the
+# growth, onset and regime, the local slope, and one z or why there is none. It ends with the
+# size of the results (about 0.6 GB, nearly all trajectories) and the command that deletes them.
 #   usage: bash scripts/demo.sh [OUTDIR]     (default: results/demo-<date>-<time>; never reused)
 #   GRANAGG_BUILD_DIR   build folder (default: build)
 set -euo pipefail
@@ -24,4 +27,7 @@ START=$(date +%s)
 # Interrupted? Run `$G pair --preset quick --out $OUT` again: finished runs are not redone.
 "$G" pair --preset quick --out "$OUT"
 
-echo "== done in $(( $(date +%s) - START )) s: open $OUT/report.html (figures in $OUT/figures/, numbers in $OUT/summary.json)"
+echo "== done in $(( $(date +%s) - START )) s. The verdict: $OUT/summary.txt (printed above)"
+echo "   and $OUT/report.html (figures in $OUT/figures/, every number in $OUT/summary.json)."
+echo "== The results take $(du -sh "$OUT" | cut -f1) on disk (nearly all trajectories, $OUT/runs/)."
+echo "   Delete them with: rm -r $(printf '%q' "$OUT")"

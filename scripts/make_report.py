@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""A self-contained report.html for a `granagg pair` results folder: the numbers (z per K with its
+"""A self-contained report.html for a `granagg pair` results folder. It leads with the verdict (what
+the study showed and what the validation study concluded, summary.json "verdict") and a few plain
+lines per ensemble (the same as summary.txt); then the details (every fitted z with its window and
 interval, fitted beta, the mean-field exponents, the paper's values beside them), the figures
 (embedded as base64 PNG: the file can be mailed or archived alone), the steps' status and timings,
 and every command that made the results.
@@ -12,6 +14,7 @@ import html
 import json
 import math
 import os
+import shlex
 import sys
 
 CAPTIONS = {
@@ -76,7 +79,38 @@ def main():
       f"written {esc(s.get('written', ''))}; folder <code>{esc(s.get('out', ''))}</code>.<br>"
       f"Physics: {esc(paper.get('reference', 'Singh & Mazza, Phys. Rev. E (2018)'))}. Reduced units: d = m = T0 = 1.</p>")
 
-    w("<h2>Growth exponent z and kernel exponent beta</h2>")
+    verdict = s.get("verdict") or []
+    if verdict:
+        w("<h2>Verdict</h2><p class='small'>What this study showed, and what the validation study "
+          "(docs/validation.md: larger and longer ensembles) concluded. A growth exponent z is given only "
+          "where S(t) is a power law (a flat local slope) and its interval excludes 0.</p><ul>")
+        for line in verdict:
+            w(f"<li>{esc(line)}</li>")
+        w("</ul>")
+    if any(e.get("summary") for e in s.get("ensembles", [])):
+        w("<h2>Per ensemble</h2>")
+        for e in s.get("ensembles", []):
+            lines = e.get("summary") or []
+            if not lines:
+                continue
+            w(f"<h3>{esc(lines[0])}</h3><ul>")
+            for line in lines[1:]:
+                w(f"<li>{esc(line.strip())}</li>")
+            w("</ul>")
+        folder = s.get("out", d)
+        size = s.get("results_bytes")
+        if size:
+            w(f"<p class='small'>The results folder takes {size / 2**20:.0f} MiB (mostly runs/: the "
+              f"trajectories); delete it with <code>rm -r {esc(shlex.quote(folder))}</code>. "
+              "The same summary as text: summary.txt.</p>")
+
+    w("<h2>Details: every fitted number</h2>")
+    w("<p class='small'>For reference, not results: two least-squares fits of ln S on ln t over different "
+      "windows. analyze's window is the last decade of the runs; fit-beta's is the longest stretch at the "
+      "end over which the local slope is flat. Where S(t) is not a power law (regime onset or none, below) "
+      "each fit's value is set by its window, and an interval over few runs may reach below 0: the verdict "
+      "above then reports no z. beta from the full-curve fit is \"not determined\" where it ends at a "
+      "bound of its search range.</p>")
     w("<table><tr><th>K</th><th>runs</th><th>N</th><th>t_end</th><th>z (analyze, grid clusters, 95% interval)</th>"
       "<th>fit window</th><th>z (fit-beta)</th><th>beta from z</th><th>beta, full-curve fit</th><th>paper z</th></tr>")
     for e in s.get("ensembles", []):
@@ -90,11 +124,11 @@ def main():
         w(f"<tr><td>{esc(e['K'])}</td><td>{esc(e.get('runs'))}</td><td>{esc(e.get('N'))}</td><td>{esc(e.get('t_end'))}</td>"
           f"<td>{interval(e.get('z_analyze'))}</td><td>[{num(win[0], 3)}, {num(win[1], 3)}]</td>"
           f"<td>{interval(e.get('z'))}{fit_note}</td><td>{interval(e.get('beta_from_z'), 2)}</td>"
-          f"<td>{interval(e.get('beta_fit'), 2) if e.get('beta_fit_determined', True) else 'not determined (at a bound of the search range)'}{beta_note}</td><td>{esc(e.get('paper_z'))} &plusmn; {esc(e.get('paper_z_pm'))}</td></tr>")
+          f"<td>{interval(e.get('beta_fit'), 2) if e.get('beta_fit_determined', True) or e.get('fit_beta') != 'done' else 'not determined (at a bound of the search range)'}{beta_note}</td><td>{esc(e.get('paper_z'))} &plusmn; {esc(e.get('paper_z_pm'))}</td></tr>")
     w("</table>")
     w("<h2>Which regime are these numbers in?</h2>")
     w("<p class='small'>A growth exponent is a result only where S(t) has left its onset and its local slope is "
-      "flat (design.md section 3). Regime of the ensemble-mean S_grid at the end of the runs: <b>none</b> (S has not "
+      "flat (docs/model.md section 11). Regime of the ensemble-mean S_grid at the end of the runs: <b>none</b> (S has not "
       "doubled), <b>onset</b> (S grows but the local slope over the last half decade still changes by more than 25 %), "
       "<b>scaling</b> (flat within 25 %). Beside it, the validation study's number for the same K "
       "(docs/validation.md, data/validation/verdict.csv), so that a demo is not read as a result.</p>")
@@ -116,7 +150,7 @@ def main():
     pz = s.get("paper", {})
     w(f"</table><p class='small'>The paper's {esc(pz.get('z_meanfield_beta2'))} (beta = 2) and "
       f"{esc(pz.get('z_meanfield_beta3'))} (beta = 3) are local slopes near S ~ 250 and S ~ 1650; "
-      "the full equation converges to 3 beta/(beta+3) (design.md section 4).</p>")
+      "the full equation converges to 3 beta/(beta+3) (docs/model.md section 12).</p>")
 
     w("<h2>Figures</h2>")
     figs = os.path.join(d, "figures")
