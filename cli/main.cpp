@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
       "granagg: aggregation in charged granular gases -- MD engine, trajectory analysis and "
       "mean-field\n"
       "(Smoluchowski, kinetic theory) solver. Reduced units: particle diameter d = 1, mass m = 1,\n"
-      "initial granular temperature T0 = 1 (design.md section 2).",
+      "initial granular temperature T0 = 1 (docs/model.md section 2).",
       "granagg"};
   app.set_version_flag("--version", common::versionString());
   app.require_subcommand(1);

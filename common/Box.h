@@ -1,6 +1,6 @@
 #pragma once
 /// \file Box.h
-/// Cubic periodic box [0, L)^3 and the minimum-image convention (design.md section 2).
+/// Cubic periodic box [0, L)^3 and the minimum-image convention (docs/model.md section 5).
 #include <cmath>
 #include <cstdint>
 #include <limits>

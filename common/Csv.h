@@ -1,6 +1,6 @@
 #pragma once
 /// \file Csv.h
-/// CSV tables with a provenance header (design.md section 6):
+/// CSV tables with a provenance header (docs/ARCHITECTURE.md, "Files and formats"):
 ///
 ///     # granagg 0.1.0 (abc123)
 ///     # command = granagg smol --beta 3

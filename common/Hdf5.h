@@ -3,7 +3,7 @@
 /// The one layer of helpers over the HDF5 C API, for every module that reads or writes HDF5 (md's
 /// H5MD writer, reader and checkpoint; analysis's trajectory reader and analysis.h5; fit-beta; the
 /// tests): an RAII handle, attribute and dataset helpers, and the text of the last HDF5 error.
-/// Debian ships no HDF5 C++ wrapper (design.md section 6), hence this file. Included by .cpp files
+/// Debian ships no HDF5 C++ wrapper (docs/ARCHITECTURE.md), hence this file. Included by .cpp files
 /// only: the modules' public headers do not include it, so their users need no HDF5 include path.
 ///
 /// Every helper that can fail throws std::runtime_error whose message starts with the context

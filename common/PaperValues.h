@@ -1,6 +1,6 @@
 #pragma once
 /// \file PaperValues.h
-/// The published values of the paper granagg reproduces (R. C. Singh and M. G. Mazza, Phys.
+/// The published values of the paper granagg reproduces (C. Singh and M. G. Mazza, Phys.
 /// Rev. E 97, 022904 (2018)), read from data/reference/paper.json: the one place they are typed.
 /// The C++ code reads them here; the Python scripts read the same file with json.load.
 #include <string>

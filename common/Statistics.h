@@ -41,10 +41,10 @@ struct Interval {
 Interval bootstrapInterval(const std::vector<double>& replicates, double estimate, std::size_t runs,
                            double confidence);
 
-/// Local slope z(t_k) = ln[y(t_k) / y(t_k / p)] / ln p of a growing quantity (design.md section
-/// 3), y(t_k / p) interpolated linearly in (ln t, ln y) between the bracketing samples (exact for a
-/// power law). NaN where t_k / p lies before the first sample or a t or y involved is not
-/// positive. t must increase; p > 1 (std::invalid_argument otherwise).
+/// Local slope z(t_k) = ln[y(t_k) / y(t_k / p)] / ln p of a growing quantity (docs/model.md
+/// section 11), y(t_k / p) interpolated linearly in (ln t, ln y) between the bracketing samples
+/// (exact for a power law). NaN where t_k / p lies before the first sample or a t or y involved is
+/// not positive. t must increase; p > 1 (std::invalid_argument otherwise).
 std::vector<double> localSlope(const std::vector<double>& t, const std::vector<double>& y,
                                double p);
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# MD throughput of granagg against LAMMPS (issue 3; design.md section 7): the same neutral
+# MD throughput of granagg against LAMMPS (issue 3; docs/benchmarks.md): the same neutral
 # viscoelastic-Hertz gas (phi = 0.076, E = 278.6, D = 27.7, clamped, d = m = 1, T = 1), the same
 # initial state, the same fixed time step and the same Verlet skin, run in one go on this machine.
 # Prints Markdown tables for docs/benchmarks.md: the two-body mapping check, then N, code, cores

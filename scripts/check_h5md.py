@@ -3,7 +3,7 @@
 
 Usage:  /usr/bin/python3 scripts/check_h5md.py traj.h5 [--group all] [--quiet]
 
-Checks the H5MD 1.1 structure (design.md section 6): /h5md version, author and creator; the
+Checks the H5MD 1.1 structure (docs/ARCHITECTURE.md): /h5md version, author and creator; the
 particle group (by default the first under /particles, as MDAnalysis picks it) with position,
 box (dimension 3, periodic boundary, edges per frame), and the optional velocity, charge and image
 time series, all with consistent shapes [frames, N, ...]; positions finite and wrapped into

@@ -1,6 +1,6 @@
 #pragma once
 // Helpers shared by every test suite: scratch files and folders, whole-file reads, and the
-// bit-for-bit comparisons behind the determinism claims (README, design.md section 6).
+// bit-for-bit comparisons behind the determinism claims (README, docs/ARCHITECTURE.md).
 // Include as "TestUtil.h" (tests/ is on each suite's include path).
 #include <unistd.h>
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file ClusterSizes.h
 /// Cluster-size distribution N_s(s) and the mean cluster size
-/// S = sum_s s^2 N_s / sum_s s N_s (design.md section 3; the paper's S(t)).
+/// S = sum_s s^2 N_s / sum_s s N_s (docs/model.md section 10; the paper's S(t)).
 #include <cstdint>
 #include <map>
 #include <vector>

@@ -5,12 +5,12 @@
 /// `min_fill` are occupied, and occupied cells sharing a face (6-connectivity) form a cluster,
 /// with periodic boundaries (union-find). The size s of a cluster is its number of sites.
 ///
-/// Defaults (design.md section 3, calibrated on hard-sphere gases at phi = 0.076): cells per side
-/// n = floor(L / 2) (spacing h = L/n, just above 2 d) and min_fill = 0.25, i.e. a cell is occupied
-/// when it holds at least ceil(0.25 h^3 / (pi/6)) centres (4 for h = 2). The homogeneous gas then
-/// has about 1-2 % occupied sites and S near 1, far below site percolation (0.3116 in 3-D), while
-/// compact clusters give site counts proportional to their mass. A spacing of 1 d would make a
-/// single particle an occupied site and the homogeneous gas percolates.
+/// Defaults (docs/model.md section 10, calibrated on hard-sphere gases at phi = 0.076): cells per
+/// side n = floor(L / 2) (spacing h = L/n, just above 2 d) and min_fill = 0.25, i.e. a cell is
+/// occupied when it holds at least ceil(0.25 h^3 / (pi/6)) centres (4 for h = 2). The homogeneous
+/// gas then has about 1-2 % occupied sites and S near 1, far below site percolation (0.3116 in
+/// 3-D), while compact clusters give site counts proportional to their mass. A spacing of 1 d would
+/// make a single particle an occupied site and the homogeneous gas percolates.
 #include <cstdint>
 #include <vector>
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file ParticleClusters.h
-/// Particle-contact clusters (design.md section 3, second definition): i and j are bonded when
+/// Particle-contact clusters (docs/model.md section 10, second definition): i and j are bonded when
 /// their minimum-image distance |r_ij| <= 1 + tolerance (diameter d = 1); clusters are the
 /// connected components, found with a periodic cell list and union-find. The size s of a
 /// cluster is its number of particles (monomers count as clusters of size 1).

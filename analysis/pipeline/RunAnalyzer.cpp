@@ -19,7 +19,7 @@ namespace granagg::analysis {
 
 namespace {
 
-constexpr double DEFAULT_KAPPA = 0.83;  // Poppe et al. 2000, silica (design.md section 2)
+constexpr double DEFAULT_KAPPA = 0.83;  // Poppe et al. 2000, silica (docs/model.md section 7)
 const double NaN = std::numeric_limits<double>::quiet_NaN();
 
 void require(bool ok, const std::string& what) {

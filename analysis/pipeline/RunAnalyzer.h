@@ -1,6 +1,6 @@
 #pragma once
 /// \file RunAnalyzer.h
-/// One trajectory -> all observables of design.md section 3 as tables, streaming the frames
+/// One trajectory -> all observables of docs/model.md section 10 as tables, streaming the frames
 /// (memory: one frame, the MSD reference positions, and the all-origins MSD buffer within its
 /// budget); then the ensemble over runs. `granagg analyze` is a thin wrapper over these.
 #include <cstdint>

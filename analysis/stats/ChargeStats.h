@@ -1,6 +1,6 @@
 #pragma once
 /// \file ChargeStats.h
-/// Charge observables (design.md sections 2-3): mean |q|(t), the charging rate d<|q|>/dt
+/// Charge observables (docs/model.md sections 8 and 10): mean |q|(t), the charging rate d<|q|>/dt
 /// against the kinetic-theory law t^{-5/6 - 5 kappa/3}, and the charge-speed scatter (q~, v~).
 #include <utility>
 #include <vector>
@@ -29,7 +29,7 @@ std::pair<std::vector<double>, std::vector<double>> chargingRate(
     const std::vector<double>& t, const std::vector<double>& mean_abs_q);
 
 /// Exponent of d<|q|>/dt ~ t^x expected from T_g ~ t^{-5/3} and |dq| ~ v^{2 kappa}:
-/// x = -5/6 - 5 kappa / 3 (design.md section 2, the paper's corrected law; -13/6 at kappa = 0.8).
+/// x = -5/6 - 5 kappa / 3 (docs/model.md section 8, the corrected law; -13/6 at kappa = 0.8).
 inline double expectedChargingRateExponent(double kappa) { return -5.0 / 6.0 - 5.0 * kappa / 3.0; }
 
 }  // namespace granagg::analysis

@@ -1,11 +1,11 @@
 #pragma once
 /// \file Msd.h
-/// Mean-squared displacement from unwrapped positions (position + image * L; design.md
-/// section 6: image counts are required, unwrapping from jumps fails whenever a particle moves
-/// more than L/2 between frames).
+/// Mean-squared displacement from unwrapped positions (position + image * L; docs/ARCHITECTURE.md,
+/// "Files and formats": image counts are required, unwrapping from jumps fails whenever a particle
+/// moves more than L/2 between frames).
 ///
 /// MsdFromOrigin: <|r(t) - r(t0)|^2> with t0 the first frame. The freely cooling gas ages, so time
-/// origins are not equivalent and this is the primary MSD (design.md section 3).
+/// origins are not equivalent and this is the primary MSD (docs/model.md section 10).
 /// MsdAllOrigins: average over all time origins for evenly spaced frames, by the FFT method
 /// (Kneller, Keiner, Kneller & Schiller, Comput. Phys. Commun. 91, 191 (1995); Calandrini et al.,
 /// Collection SFN 12, 201 (2011)): MSD(m) = S1(m) - 2 S2(m) with S2 the position autocorrelation

@@ -2,7 +2,7 @@
 /// \file PowerLawFit.h
 /// Growth exponents: y = A t^z fitted by least squares of ln y on ln t over a window, with a
 /// Student-t confidence interval (one run) or a bootstrap over independent runs (ensembles), and
-/// the local slope z(t) = ln[S(t) / S(t/p)] / ln p (design.md section 3).
+/// the local slope z(t) = ln[S(t) / S(t/p)] / ln p (docs/model.md section 11).
 #include <cstdint>
 #include <vector>
 

@@ -3,7 +3,7 @@
 /// Maximum-likelihood fit of a discrete power law p(x) = x^-tau / zeta(tau, xmin), x >= xmin,
 /// with xmin chosen by the Kolmogorov-Smirnov distance (Clauset, Shalizi & Newman, SIAM Rev. 51,
 /// 661 (2009), sections 3.1 and 3.3). Used for the Fisher exponent of N_s(s) ~ s^-tau; the
-/// paper's "Fisher exponents" (slopes of log N_s vs log s) are -tau (design.md section 3).
+/// paper's "Fisher exponents" (slopes of log N_s vs log s) are -tau (docs/model.md section 11).
 /// zeta(tau, xmin) is the Hurwitz zeta function (GSL gsl_sf_hzeta); the likelihood is maximised
 /// with GSL's Brent minimiser.
 #include <cstddef>

@@ -1,7 +1,7 @@
 #pragma once
 /// \file VelocityStats.h
 /// Granular temperature, Sonine coefficient a2 and the speed distribution f(v~) beside the
-/// Maxwellian (design.md section 3). All from peculiar velocities c = v - <v> (mass m = 1).
+/// Maxwellian (docs/model.md section 10). All from peculiar velocities c = v - <v> (mass m = 1).
 #include <cstddef>
 #include <vector>
 

@@ -3,7 +3,7 @@
 /// The resolved configuration of an MD run: what `granagg md --config run.toml` reads
 /// (md/config/ConfigParser.h), what the engine is built from, and what is stored in every output
 /// (/parameters of the H5MD file, provenance of tables). Defaults are the paper's values
-/// (Singh & Mazza 2018; design.md section 2). Reduced units: d = m = T0 = 1.
+/// (Singh & Mazza 2018; docs/model.md sections 2-7). Reduced units: d = m = T0 = 1.
 ///
 /// TOML layout (every key optional except where noted; unknown keys are errors):
 ///
@@ -62,7 +62,7 @@ struct NeighborConfig {
   double skinCap() const { return skin > 0.0 ? skin : NEIGHBOR_SKIN_AUTO_MAX; }
 };
 
-/// Collisional charging (design.md section 2): at the first step of a contact, |dq| =
+/// Collisional charging (docs/model.md section 7): at the first step of a contact, |dq| =
 /// Q [Psi1 m_eff xi'^2]^(kappa + Psi2) moves from one partner to the other (sign + or - with
 /// probability 1/2), Psi1 ~ U[psi1_min, psi1_max], Psi2 ~ U[-psi2_fraction kappa, +psi2_fraction
 /// kappa].
@@ -78,7 +78,7 @@ struct ChargingConfig {
   double psi1_min = 0.1;  ///< Psi1 range: U[0.1, 3.1623], mean 1.63
   double psi1_max = 3.1623;
   double psi2_fraction =
-      0.05;  ///< Psi2 ~ U[-0.05 kappa, +0.05 kappa] (mean 0; the paper's typo, design.md)
+      0.05;  ///< Psi2 ~ U[-0.05 kappa, +0.05 kappa] (mean 0; docs/model.md section 9)
 };
 
 /// Coulomb interaction K q_i q_k / r^2 with all periodic images (Ewald, tinfoil boundary).

@@ -1,8 +1,8 @@
 #pragma once
 /// \file EwaldParams.h
 /// Parameter choice for the long-range Coulomb solvers (plain Ewald reference and PPPM) from
-/// published RMS force error estimates, for a requested relative accuracy (design.md section 2,
-/// docs/coulomb.md).
+/// published RMS force error estimates, for a requested relative accuracy (docs/model.md
+/// section 4, docs/coulomb.md).
 ///
 /// Accuracy convention (as LAMMPS' kspace_style accuracy_relative): an accuracy `a` asks for an RMS
 /// force error (RMS over particles of |F_computed - F_exact|) of at most a * K, where K q^2 / 1^2 =

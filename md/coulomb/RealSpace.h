@@ -1,7 +1,7 @@
 #pragma once
 /// \file RealSpace.h
-/// Real-space (short-range) part of the Ewald splitting of the Coulomb interaction (design.md
-/// section 2; Ewald 1921; Frenkel & Smit, Understanding Molecular Simulation, sec. 12.1).
+/// Real-space (short-range) part of the Ewald splitting of the Coulomb interaction (docs/model.md
+/// section 4; Ewald 1921; Frenkel & Smit, Understanding Molecular Simulation, sec. 12.1).
 ///
 /// The Coulomb pair energy K q_i q_j / r is split with the splitting parameter alpha (units 1/d)
 /// into a short-range part K q_i q_j erfc(alpha r) / r, summed in real space up to a cutoff, and a

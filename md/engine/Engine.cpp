@@ -716,7 +716,7 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
     d.setupCoulomb(std::max(sum_q2, static_cast<double>(N)));
   }
 
-  // overlapping initial states are refused (design.md section 2 / ground rules: bad input)
+  // overlapping initial states are refused (docs/model.md section 5; bad input)
   d.rebuildList(false);
   if (allow_contacts) {
     d.computeInitialForces();

@@ -1,7 +1,7 @@
 #pragma once
 /// \file Engine.h
 /// The MD engine: N spheres of diameter 1 and mass 1 in a periodic cube, normal contact forces
-/// (Hertz viscoelastic or spring-dashpot), velocity Verlet (design.md section 2).
+/// (Hertz viscoelastic or spring-dashpot), velocity Verlet (docs/model.md sections 3-6).
 ///
 /// One source for both backends: Engine.cpp holds the state in Thrust device vectors (structure of
 /// arrays) and loops through Thrust algorithms whose functors call the HD physics of
@@ -52,7 +52,7 @@
 
 namespace granagg::md {
 
-/// Observables at one step (design.md section 3, "Per frame"). Energies are totals (not per
+/// Observables at one step (docs/model.md section 10, "Per frame"). Energies are totals (not per
 /// particle).
 struct Observables {
   std::int64_t step = 0;

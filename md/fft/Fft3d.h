@@ -1,6 +1,6 @@
 #pragma once
 /// \file Fft3d.h
-/// Real-to-complex 3-D FFT on device memory behind one small interface (design.md section 5):
+/// Real-to-complex 3-D FFT on device memory behind one small interface (docs/ARCHITECTURE.md):
 /// FFTW3 with its OpenMP threads in the CPU build (Fft3dFftw.cpp), cuFFT in the CUDA build
 /// (Fft3dCufft.cu). No Thrust or CUDA types here, so any translation unit may include it.
 ///

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Checkpoint.h
-/// Restart files (design.md section 6): everything a run needs to continue bit for bit as the
+/// Restart files (docs/ARCHITECTURE.md): everything a run needs to continue bit for bit as the
 /// uninterrupted run would (same backend and thread count), stored in HDF5 at full precision.
 ///
 /// Layout (HDF5; readable with h5py for inspection):

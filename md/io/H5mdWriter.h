@@ -1,6 +1,6 @@
 #pragma once
 /// \file H5mdWriter.h
-/// Writes MD trajectories as H5MD 1.1 files (design.md section 6), readable by h5py, by
+/// Writes MD trajectories as H5MD 1.1 files (docs/ARCHITECTURE.md), readable by h5py, by
 /// analysis/ and by MDAnalysis 2.x's H5MD reader. Reduced units throughout (d = m = T0 = 1;
 /// lengths in particle diameters, time in sqrt(m d^2 / T0)); no `unit` attributes are written,
 /// so MDAnalysis must be told `convert_units=False`:

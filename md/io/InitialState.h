@@ -71,9 +71,9 @@ Frame readInitialStateH5md(const std::string& path, long frame = -1,
 
 /// Random non-overlapping positions at the configured phi (random sequential insertion),
 /// Maxwell velocities rescaled to T_g = temperature exactly with zero total momentum, and the
-/// charges of config.charging.initial (design.md section 2). Deterministic in config.system.seed
-/// (Philox streams RNG_INIT_*, md/rng/RngStreams.h). Throws std::invalid_argument when phi is too
-/// dense for insertion.
+/// charges of config.charging.initial (docs/model.md section 5). Deterministic in
+/// config.system.seed (Philox streams RNG_INIT_*, md/rng/RngStreams.h). Throws
+/// std::invalid_argument when phi is too dense for insertion.
 Frame randomInitialState(const MdConfig& config);
 
 /// Sets the charges of an initial state from config.charging.initial: "neutral" (0), "monopolar"

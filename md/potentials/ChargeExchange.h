@@ -1,6 +1,6 @@
 #pragma once
 /// \file ChargeExchange.h
-/// Collisional charging (design.md section 2, "Collisional charging"): at the first step of a
+/// Collisional charging (docs/model.md section 7): at the first step of a
 /// contact between particles a and b, a charge
 ///
 ///     |dq| = Q [Psi1 m_eff xi'^2]^(kappa + Psi2),   m_eff = 1/2,

@@ -1,8 +1,8 @@
 #pragma once
 /// \file HertzViscoelastic.h
 /// Viscoelastic Hertz contact (Singh & Mazza 2018, eq. of motion; Brilliantov et al. 1996;
-/// design.md section 2). For two spheres of diameter 1 with overlap xi = 1 - |r_ij| > 0 approaching
-/// at rate xi' (> 0 while approaching), each partner feels the normal force
+/// docs/model.md section 3). For two spheres of diameter 1 with overlap xi = 1 - |r_ij| > 0
+/// approaching at rate xi' (> 0 while approaching), each partner feels the normal force
 ///
 ///     F = E xi^{3/2} + D xi^{1/2} xi'        (reduced units: force in T0/d)
 ///
@@ -40,7 +40,7 @@ struct HertzViscoelastic {
   }
   /// Duration of an elastic (D = 0) Hertz contact at impact speed v for reduced mass m_eff:
   /// t_c = 3.218065 (m_eff^2 / (E^2 v))^{1/5} (Landau & Lifshitz, Theory of Elasticity, sec. 9;
-  /// design.md section 2). Longer for slower impacts and with damping.
+  /// docs/model.md section 6). Longer for slower impacts and with damping.
   static double contactTime(double v, const Params& p, double m_eff = 0.5) {
     return 3.218065 * std::pow(m_eff * m_eff / (p.E * p.E * v), 0.2);
   }

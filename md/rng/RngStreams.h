@@ -2,7 +2,7 @@
 /// \file RngStreams.h
 /// Counter-based random numbers (Random123 Philox4x32-10; Salmon et al., SC'11): no stored state,
 /// key = (seed low, seed high), counter = (stream id, a, b, c). Results do not depend on thread
-/// order or backend, so CPU and GPU builds draw the same numbers (design.md section 2). Every
+/// order or backend, so CPU and GPU builds draw the same numbers (docs/model.md section 7). Every
 /// stream id is listed here, like HOOMD's RNGIdentifiers.h.
 #include <cstdint>
 

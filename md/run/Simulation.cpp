@@ -40,7 +40,7 @@ Frame outputFrame(const Engine& engine, const MdConfig& cfg) {
   return f;
 }
 
-/// The observables as /granagg/observables stores them (design.md section 3).
+/// The observables as /granagg/observables stores them (docs/model.md section 10).
 std::vector<std::pair<std::string, double>> observableRow(const Observables& o) {
   return {{"temperature", o.temperature},
           {"kinetic_energy", o.kinetic_energy},

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Simulation.h
-/// A restartable MD run: an Engine plus its output folder (design.md section 6), the frame and
+/// A restartable MD run: an Engine plus its output folder (docs/ARCHITECTURE.md), the frame and
 /// observable schedule and the checkpoints. `granagg md` is option wiring around this class; so is
 /// any other driver (a test, a study). Modelled on OpenMM's Simulation: the run owns the engine and
 /// its outputs, and reporters look at it between chunks of steps.

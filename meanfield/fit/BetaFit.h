@@ -1,7 +1,7 @@
 #pragma once
 /// \file BetaFit.h
 /// Fitting the kernel exponent beta of the Smoluchowski equation to a measured mean size S(t)
-/// (design.md sections 1, 3 and 4; Singh & Mazza 2018, Figs. 5 and 6):
+/// (docs/model.md sections 1, 11 and 12; Singh & Mazza 2018, Figs. 5 and 6):
 ///
 /// 1. the growth exponent z of S ~ t^z over a window, chosen by the user or automatically where the
 ///    local slope of S(t) is flat within its noise at late times, with a 95 % interval (Student t
@@ -10,7 +10,8 @@
 ///    K = (i^{1/3} + j^{1/3})^2 (1/i + 1/j)^{1/beta}) grows with the same exponent over the same
 ///    range of S as the data window. Not 3 beta/(beta + 3): that is only the S -> infinity limit,
 ///    and the local slope of the mean field approaches it slowly (1.19 at S ~ 250 for beta = 2,
-///    design.md section 4), so the comparison is made at equal S (cli/ repeats it at S / S_c, with
+///    docs/model.md section 12), so the comparison is made at equal S (cli/ repeats it at S / S_c,
+/// with
 ///    S_c from the curve fit, for data whose S unit differs from the mean field's monomer count);
 /// 3. a full-curve fit of log S(t_i) against log[S_c S_MF(t_i / tau_c; beta)] (GSL nonlinear least
 ///    squares, trust region / Levenberg-Marquardt), parameters (beta, ln S_c, ln tau_c), with 95 %
@@ -131,7 +132,7 @@ struct MeanFieldCurveOptions {
 /// node, Catmull-Rom (C1 cubic) in beta between nodes. Below the first output time (1e-6)
 /// S = 1 + (S(t_1) - 1) t / t_1 (the exact early linear growth); above s_cap, ln S continues
 /// linearly in ln t with the local slope at the end of the solve (the slope has then converged to
-/// 3 beta / (beta + 3) within 1e-4, design.md section 4).
+/// 3 beta / (beta + 3) within 1e-4, docs/model.md section 12).
 class MeanFieldCurves {
  public:
   explicit MeanFieldCurves(const MeanFieldCurveOptions& options = {});
@@ -175,7 +176,7 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
 
 /// beta from z through the asymptotic law z = 3 beta / (beta + 3), i.e. beta = 3 z / (3 - z): the
 /// growth exponent the full Smoluchowski equation with the beta kernel converges to at large S
-/// (homogeneity lambda = 2/3 - 1/beta, z = 1/(1 - lambda); design.md sections 2 and 4; the
+/// (homogeneity lambda = 2/3 - 1/beta, z = 1/(1 - lambda); docs/model.md sections 9 and 12; the
 /// sectional solver reaches it within 1e-4 by S ~ 1e6). It needs no S scale, so it applies to data
 /// whose S unit (grid sites) differs from the mean field's (monomers), provided z was measured in
 /// the scaling regime (a flat local slope). Every z in (0, 3) maps to one beta in (0, inf), and

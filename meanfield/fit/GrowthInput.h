@@ -4,7 +4,7 @@
 /// analyze output folder (S_t.csv and per_run/S_t.csv), its analysis.h5 (/ensemble/S_t and
 /// /runs/<k>/S_t), or any CSV with a t column and S column(s): one series, run columns sharing a
 /// prefix, or a long table with a leading `run` column. Files are the contract with analysis/
-/// (design.md section 5): nothing of analysis/ is included.
+/// (docs/ARCHITECTURE.md): nothing of analysis/ is included.
 #include <string>
 #include <vector>
 

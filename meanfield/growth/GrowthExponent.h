@@ -1,6 +1,6 @@
 #pragma once
 /// \file GrowthExponent.h
-/// Growth exponent z of a mean size S(t) ~ t^z (design.md sections 3 and 4):
+/// Growth exponent z of a mean size S(t) ~ t^z (docs/model.md sections 11 and 12):
 /// - the local slope z(t) = log[S(t)/S(t/p)] / log p,
 /// - a power-law fit log S = log A + z log t over a window, with a confidence interval,
 /// - an asymptotic estimate from the local slope with a stated convergence criterion.
@@ -36,8 +36,8 @@ PowerLawFit fitPowerLaw(const std::vector<double>& t, const std::vector<double>&
                         double t_max, double confidence = 0.95);
 
 /// Asymptotic growth exponent. The local slope of Smoluchowski solutions approaches its limit as
-/// z(t) ~ z_inf t / (t + t0) ~ z_inf (1 - t0/t) (design.md section 4), so z_inf is estimated by a
-/// straight-line fit of z(t) against 1/t over the last decade of times. Convergence criterion:
+/// z(t) ~ z_inf t / (t + t0) ~ z_inf (1 - t0/t) (docs/model.md section 12), so z_inf is estimated
+/// by a straight-line fit of z(t) against 1/t over the last decade of times. Convergence criterion:
 /// the extrapolation |z_inf - z(t_last)| and the change of z(t) over that last decade are both
 /// below `tolerance`.
 struct AsymptoticExponent {

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Kernel.h
-/// Aggregation kernels K(i,j) for the Smoluchowski equation (design.md section 4).
+/// Aggregation kernels K(i,j) for the Smoluchowski equation (docs/model.md section 12).
 ///
 /// Sizes i, j are in units of the monomer (particle) mass; K0 sets the time unit of the mean-field
 /// solution (t is measured in 1 / (K0 n_1(0)) for a monodisperse start with n_1(0) = 1).
@@ -9,8 +9,8 @@
 ///
 ///     K(i,j) = K0 * (i+j)^e * sum_t w_t * i^{p_t} * j^{q_t}
 ///
-/// - beta kernel (Singh & Mazza 2018, eq. kernel_beta with its typo corrected, design.md section
-/// 2):
+/// - beta kernel (Singh & Mazza 2018, eq. kernel_beta with its typo corrected, docs/model.md
+/// section 9):
 ///     K = K0 (i^{1/3} + j^{1/3})^2 (1/i + 1/j)^{1/beta}
 ///       = K0 (i+j)^{1/beta} [ i^{2/3} + 2 i^{1/3} j^{1/3} + j^{2/3} ] (ij)^{-1/beta}
 ///   homogeneity lambda = 2/3 - 1/beta;
@@ -46,7 +46,7 @@ class Kernel {
   /// Homogeneity lambda: K(a i, a j) = a^lambda K(i, j).
   double homogeneity() const;
   /// Growth exponent of the mean size predicted by scaling, z = 1 / (1 - lambda), for lambda < 1.
-  /// For the beta kernel z = 3 beta / (beta + 3) (design.md section 2).
+  /// For the beta kernel z = 3 beta / (beta + 3) (docs/model.md section 12).
   double scalingExponent() const;
   /// True for kernels with lambda > 1, whose solutions gel in finite time.
   bool gels() const { return homogeneity() > 1.0; }

@@ -1,12 +1,12 @@
 #pragma once
 /// \file Charging.h
-/// Time exponent of the collisional charging rate (design.md section 2, "Typos in the paper").
+/// Time exponent of the collisional charging rate (docs/model.md sections 8 and 9).
 namespace granagg::meanfield {
 
 /// Exponent of the mean-charge growth rate d<|q|>/dt ~ t^{x} in a cooling gas.
 ///
-/// The charge moved per collision scales as |dq| ~ (m_eff g^2)^{kappa} ~ T^{kappa} (design.md
-/// section 2, with <Psi2> = 0), and the collision frequency as omega ~ T^{1/2} (Enskog), so
+/// The charge moved per collision scales as |dq| ~ (m_eff g^2)^{kappa} ~ T^{kappa} (docs/model.md
+/// section 7, with <Psi2> = 0), and the collision frequency as omega ~ T^{1/2} (Enskog), so
 /// d<|q|>/dt ~ T^{1/2} T^{kappa}. With T ~ t^{-a}:
 ///
 ///     x = -a (1/2 + kappa);   a = 5/3 (viscoelastic cooling): x = -5/6 - 5 kappa / 3,

@@ -80,8 +80,8 @@ double enskogCollisionFrequency(double phi, double T) {
          std::sqrt(T);  // m = d = 1
 }
 
-// Haff's law (Haff 1983; design.md section 2). With a constant restitution L = 1 - eps^2, so the
-// cooling equation below reads dT/dt = -(1 - eps^2) omega0 sqrt(T/T0) T / 3. Substituting
+// Haff's law (Haff 1983; docs/model.md section 8). With a constant restitution L = 1 - eps^2, so
+// the cooling equation below reads dT/dt = -(1 - eps^2) omega0 sqrt(T/T0) T / 3. Substituting
 // T = T0 u^{-2}: -2 T0 u^{-3} u' = -(1 - eps^2) omega0 T0 u^{-3} / 3, i.e. u' = (1 - eps^2) omega0
 // / 6 = 1/tau0 and T = T0 / (1 + t/tau0)^2.
 double haffInverseTau0(double eps, double phi, double T0) {

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Cooling.h
-/// Homogeneous cooling of a granular gas (design.md sections 2 and 4; docs/kinetic.md): Enskog
+/// Homogeneous cooling of a granular gas (docs/model.md section 8; docs/kinetic.md): Enskog
 /// collision frequency, Haff's law for constant restitution, cooling with a velocity-dependent
 /// restitution coefficient e(g) and the small-damping viscoelastic law T ~ t^{-5/3}.
 ///
@@ -27,17 +27,17 @@ void validateFillingFraction(double phi);
 double numberDensity(double phi);
 
 /// Carnahan-Starling pair correlation at contact g2 = (1 - phi/2) / (1 - phi)^3 (dimensionless;
-/// Carnahan & Starling, J. Chem. Phys. 51, 635 (1969); design.md section 2).
+/// Carnahan & Starling, J. Chem. Phys. 51, 635 (1969); docs/model.md section 8).
 double carnahanStarlingG2(double phi);
 
 /// Enskog collision frequency per particle omega = 4 sqrt(pi) n g2 d^2 sqrt(T/m) (units
-/// sqrt(T0 / (m d^2)); Brilliantov & Poeschel (2004), tau_c^{-1}; design.md section 2).
+/// sqrt(T0 / (m d^2)); Brilliantov & Poeschel (2004), tau_c^{-1}; docs/model.md section 8).
 /// At phi = 0.076, T = 1: omega = 1.25490. Requires T >= 0 (std::invalid_argument).
 double enskogCollisionFrequency(double phi, double T);
 
 /// 1 / tau0 = (1 - eps^2) omega(T0) / 6 of Haff's law for constant restitution eps in [0, 1]
 /// (units of inverse time; Haff, J. Fluid Mech. 134, 401 (1983); Brilliantov & Poeschel (2004),
-/// design.md section 2).
+/// docs/model.md section 8).
 double haffInverseTau0(double eps, double phi, double T0 = 1.0);
 
 /// Haff's law T(t) = T0 / (1 + t / tau0)^2 for constant restitution eps (temperature units T0,

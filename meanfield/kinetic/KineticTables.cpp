@@ -228,7 +228,7 @@ void writeTable(const ChargingRequest& c, const CsvTarget& target) {
   prov.add("cooling_exponent", c.cooling_exponent);
   prov.add("law",
            std::string("d<|q|>/dt ~ T^(1/2) T^kappa with T ~ t^-a: exponent = -a (1/2 + kappa) "
-                       "(design.md section 2; -13/6 at kappa = 0.8, a = 5/3)"));
+                       "(docs/model.md section 8; -13/6 at kappa = 0.8, a = 5/3)"));
   common::CsvWriter w(target.path, prov, {"kappa", "cooling_exponent", "charging_rate_exponent"},
                       target.force);
   w.row({c.kappa, c.cooling_exponent, chargingRateExponent(c.kappa, c.cooling_exponent)});

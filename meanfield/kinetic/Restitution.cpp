@@ -1,5 +1,5 @@
 /// Viscoelastic restitution coefficient by integration of the scaled two-body contact
-/// (Restitution.h; design.md section 2).
+/// (Restitution.h; docs/model.md section 3).
 #include "meanfield/kinetic/Restitution.h"
 
 #include <algorithm>

@@ -1,12 +1,12 @@
 #pragma once
 /// \file Restitution.h
 /// Coefficient of normal restitution e(v) of two viscoelastic (Hertz + dissipative) spheres
-/// (design.md section 2; docs/kinetic.md).
+/// (docs/model.md section 3; docs/kinetic.md).
 ///
 /// Units: nondimensional, particle diameter d = 1, mass m = 1, initial granular temperature
 /// T0 = 1; speeds in sqrt(T0/m), times in sqrt(m d^2 / T0). Reduced mass m_eff = 1/2.
 ///
-/// Contact model (design.md section 2): for overlap xi = 1 - |r_ij| > 0 with rate xi' > 0 while
+/// Contact model (docs/model.md section 3): for overlap xi = 1 - |r_ij| > 0 with rate xi' > 0 while
 /// approaching, each partner feels the normal force F = E xi^{3/2} + D xi^{1/2} xi' and the
 /// relative coordinate obeys m_eff xi'' = -F. "Clamped" (default) uses max(F, 0): a contact never
 /// pulls (Poeschel & Schwager, Computational Granular Dynamics (Springer 2005), sec. 2.4; the
@@ -49,7 +49,8 @@ constexpr double RESTITUTION_C1 = 1.1534488580952884;
 constexpr double RESTITUTION_C2 = 0.6 * RESTITUTION_C1 * RESTITUTION_C1;
 /// Dimensionless duration of an elastic Hertz contact (b = 0) in units of tau:
 /// 2 (5/4)^{2/5} integral_0^1 (1 - u^{5/2})^{-1/2} du = (4/5) (5/4)^{2/5} B(2/5, 1/2)
-/// = 3.2180654597 (design.md: 3.218065; Hertz 1882, Landau & Lifshitz, Theory of Elasticity).
+/// = 3.2180654597 (docs/model.md section 6: 3.218065; Hertz 1882, Landau & Lifshitz, Theory of
+/// Elasticity).
 constexpr double HERTZ_CONTACT_TIME_FACTOR = 3.2180654597190435;
 
 /// Contact parameters of the viscoelastic normal force F = E xi^{3/2} + D xi^{1/2} xi'.
@@ -116,7 +117,7 @@ class Restitution {
   /// range (b = 0.69 at v = 0.05).
   double seriesRestitution(double v) const;
   /// Elastic Hertz contact time t_c = 3.218065 (m_eff^2 / (E^2 v))^{1/5}, units sqrt(m d^2/T0)
-  /// (design.md section 2).
+  /// (docs/model.md section 6).
   double elasticContactTime(double v) const;
 
   const ContactParams& params() const { return m_params; }

@@ -7,9 +7,9 @@
 /// 2 * range_factor * S (40 S by default), an FFT-friendly length, at most max_size) whenever S >
 /// M_active / range_factor. The scaling distribution decays exponentially in k/S, so with
 /// M_active/S >= 20 the mass beyond the range is far below round-off; a truncated grid with M/S
-/// below ~12 loses mass and its local slope collapses (design.md section 4). Each resize restarts
-/// CVODE from the current state (zero-padded), so the history of the multistep method is lost: a
-/// few small steps.
+/// below ~12 loses mass and its local slope collapses (docs/model.md section 12). Each resize
+/// restarts CVODE from the current state (zero-padded), so the history of the multistep method is
+/// lost: a few small steps.
 ///
 /// Truncation is detected, never hidden: every output sample carries the relative mass loss
 /// (M1(0) - M1(t)) / M1(0) and is marked invalid when it exceeds mass_loss_tolerance; by default

@@ -28,8 +28,8 @@ double monodisperseBlowUpTime(const Kernel& kernel, double initial_size) {
   const double lambda = kernel.homogeneity();
   if (lambda <= 1.0) return std::numeric_limits<double>::infinity();
   const double c = kernel(1.0, 1.0);  // K(i, i) = c i^lambda by homogeneity
-  // i^{1-lambda} = i0^{1-lambda} - (lambda - 1) c t reaches zero (design.md section 4; separation
-  // of variables)
+  // i^{1-lambda} = i0^{1-lambda} - (lambda - 1) c t reaches zero (docs/model.md section 12;
+  // separation of variables)
   return std::pow(initial_size, 1.0 - lambda) / ((lambda - 1.0) * c);
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 /// \file MonodisperseSolver.h
-/// Monodisperse approximation of the Smoluchowski equation (design.md section 4; Singh & Mazza
-/// 2018, the monodisperse kernel with its typo corrected in design.md section 2): all clusters have
-/// the same size i(t), their number density is n = M1 / i with M1 = 1 conserved, and
+/// Monodisperse approximation of the Smoluchowski equation (docs/model.md section 12; Singh & Mazza
+/// 2018, the monodisperse kernel with its typo corrected in docs/model.md section 9): all clusters
+/// have the same size i(t), their number density is n = M1 / i with M1 = 1 conserved, and
 ///
 ///     dn/dt = -K(i, i) n^2   <=>   di/dt = K(i, i)      (n = 1/i).
 ///

@@ -1,8 +1,8 @@
 #pragma once
 /// \file SectionalSolver.h
 /// Sectional Smoluchowski solver: the fixed-pivot method of Kumar & Ramkrishna, Chem. Eng. Sci. 51,
-/// 1311 (1996), eq. (27), for mean sizes far beyond what a discrete grid holds (design.md section
-/// 4).
+/// 1311 (1996), eq. (27), for mean sizes far beyond what a discrete grid holds (docs/model.md
+/// section 12).
 ///
 /// Grid: pivots x_i are the integers 1, 2, ..., m, with m the first integer for which the geometric
 /// step exceeds one size unit, m (r - 1) >= 1; then x_{i+1} = r x_i up to the first pivot >=
@@ -23,7 +23,7 @@
 /// both conserved exactly. The kernel is evaluated at the real pivot sizes. Each pair (j, k) and
 /// its target section and weight are tabulated once, so the right-hand side is an O(I^2) loop over
 /// the pairs of sections that hold non-negligible mass. The fixed-pivot error in S scales as (r -
-/// 1)^2 (design.md section 4: 3e-4 at r = 1.02).
+/// 1)^2 (docs/model.md section 12: 3e-4 at r = 1.02).
 ///
 /// Truncation: aggregates larger than the last pivot leave the grid. Their mass is integrated as an
 /// extra unknown, so that M1 + escaped mass is a linear invariant; every sample reports the

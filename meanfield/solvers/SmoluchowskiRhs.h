@@ -13,8 +13,8 @@
 /// A correlation with g(m) = m^e is conj(X) G in Fourier space (real x), so one forward transform
 /// per distinct exponent and one inverse for the gain plus one per distinct q suffice (beta
 /// kernel: 3 forward + 4 inverse real transforms of length L >= 2M+1). No kernel approximation;
-/// the only error is FFT round-off, about 1e-16 max_k(n_k) in every component (design.md
-/// section 4), which sets a floor for absolute tolerances. For e = 0 the correlation is a plain
+/// the only error is FFT round-off, about 1e-16 max_k(n_k) in every component (docs/model.md
+/// section 12), which sets a floor for absolute tolerances. For e = 0 the correlation is a plain
 /// sum and needs no transform.
 #include <memory>
 #include <vector>

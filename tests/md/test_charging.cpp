@@ -1,4 +1,4 @@
-// Collisional charging (design.md section 2): the exchange rule against its formula, and the
+// Collisional charging (docs/model.md section 7): the exchange rule against its formula, and the
 // engine's charges -- conserved, thread-independent, growing then saturating as the gas cools.
 #include <catch2/catch.hpp>
 
@@ -121,9 +121,9 @@ TEST_CASE(
   for (std::size_t k = 1; k < q_mark.size(); ++k) CHECK(q_mark[k] > q_mark[k - 1]);
   // saturation: as the gas cools both the collision rate (~T^{1/2}) and |dq| (~T^kappa) fall, so
   // the increment over a doubling of time shrinks; the rate law d<|q|>/dt ~ t^{-5/6 - 5 kappa/3}
-  // (design.md) makes each doubling's increment ~2^{-1.2} of the previous one, ~0.08 after three
-  // doublings. Required here: the last doubling adds less than a quarter of what the first did (a
-  // gas at constant temperature would add ~2^{1/2} times more, random-walk growth).
+  // (docs/model.md section 8) makes each doubling's increment ~2^{-1.2} of the previous one, ~0.08
+  // after three doublings. Required here: the last doubling adds less than a quarter of what the
+  // first did (a gas at constant temperature would add ~2^{1/2} times more, random-walk growth).
   const double first = q_mark[1] - q_mark[0], last = q_mark[4] - q_mark[3];
   UNSCOPED_INFO("mean |q|: " << q_mark[0] << " " << q_mark[1] << " " << q_mark[2] << " "
                              << q_mark[3] << " " << q_mark[4]);

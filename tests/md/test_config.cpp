@@ -77,7 +77,7 @@ std::string readText(const std::string& path) {
 
 TEST_CASE("defaults are the paper's values", "[md][config]") {
   const MdConfig c;
-  // design.md section 2: Singh & Mazza 2018 (silica), phi = 0.076, T0 = 1, clamped contacts,
+  // docs/model.md sections 3-6: Singh & Mazza 2018 (silica), phi = 0.076, T0 = 1, clamped contacts,
   // 50 steps per contact of the fastest impact.
   CHECK(c.input_version == 1);
   CHECK(c.system.phi == 0.076);

@@ -38,7 +38,7 @@ TEST_CASE("contact potentials: force is -dV/dxi, clamping, spring-dashpot restit
   CHECK(HertzViscoelastic::normalForce(1e-4, -1.0, hc) == 0.0);
   CHECK(HertzViscoelastic::normalForce(1e-4, -1.0, hu) ==
         Approx(std::sqrt(1e-4) * (278.6e-4 - 27.7)).epsilon(1e-14));
-  // design.md: t_c = 0.23 for v = 1.6 at the defaults
+  // docs/model.md section 6: t_c = 0.23 for v = 1.6 at the defaults
   CHECK(HertzViscoelastic::contactTime(1.6, hc) == Approx(0.233).margin(0.001));
 
   const auto sd = SpringDashpot::makeParams(1e4, 0.9, false);

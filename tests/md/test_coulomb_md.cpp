@@ -1,6 +1,6 @@
-// The MD engine with Coulomb forces (design.md section 2; issue 4): energy conservation with fixed
-// charges and elastic contacts, the engine's PPPM forces against the plain Ewald reference, and
-// the monopolar gas that cools more slowly than Haff's law (the paper's Fig. 1(a)).
+// The MD engine with Coulomb forces (docs/model.md section 4; issue 4): energy conservation with
+// fixed charges and elastic contacts, the engine's PPPM forces against the plain Ewald reference,
+// and the monopolar gas that cools more slowly than Haff's law (the paper's Fig. 1(a)).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -115,7 +115,8 @@ TEST_CASE("monopolar charges cool more slowly than Haff's law", "[md][coulomb]")
     return e.observables().temperature;
   };
   const double T0 = run(0.0), T1 = run(1.0);
-  // Haff: T = 1/(1 + t/tau0)^2 with 1/tau0 = (1 - eps^2) omega0 / 6 (design.md): T(12) = 0.12.
+  // Haff: T = 1/(1 + t/tau0)^2 with 1/tau0 = (1 - eps^2) omega0 / 6 (docs/model.md section 8):
+  // T(12) = 0.12.
   const double omega0 = meanfield::enskogCollisionFrequency(0.076, 1.0);
   const double haff = 1.0 / std::pow(1.0 + 12.0 * (1.0 - 0.25) * omega0 / 6.0, 2);
   INFO("T(12): neutral " << T0 << ", monopolar K = 1 " << T1 << ", Haff " << haff);

@@ -1,5 +1,5 @@
 // H5MD trajectories: exact round trip, layout against the H5MD 1.1 specification (and the
-// MDAnalysis reader quirks of design.md section 6), refusal to overwrite, clear errors for
+// MDAnalysis reader quirks of docs/ARCHITECTURE.md), refusal to overwrite, clear errors for
 // truncated / foreign / malformed files, restart truncation, the XDMF sidecar, and the
 // scripts/check_h5md.py checker.
 #include <catch2/catch.hpp>

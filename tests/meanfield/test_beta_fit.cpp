@@ -244,8 +244,8 @@ TEST_CASE("fit-beta full-curve intervals stay inside the search range, at a boun
 TEST_CASE("fit-beta inverts z at the data's S range through the full Smoluchowski z(beta)",
           "[meanfield][fitbeta]") {
   MeanFieldCurves curves;
-  // The paper's mean-field local slopes (design.md section 4): 1.19 near S ~ 250 at beta = 2 and
-  // 1.49 near S ~ 1650 at beta = 3. A local slope at S compares S(t) with S(t/2) ~ S / 2^z.
+  // The paper's mean-field local slopes (docs/model.md section 12): 1.19 near S ~ 250 at beta = 2
+  // and 1.49 near S ~ 1650 at beta = 3. A local slope at S compares S(t) with S(t/2) ~ S / 2^z.
   CHECK(curves.exponentBetween(250.0 / std::pow(2.0, 1.19), 250.0, 2.0) ==
         Approx(1.19).margin(0.01));
   CHECK(curves.exponentBetween(1650.0 / std::pow(2.0, 1.49), 1650.0, 3.0) ==
@@ -347,7 +347,7 @@ TEST_CASE(
   CHECK(b2.note.empty());
   CHECK(betaAsymptotic(1.5, 1.5, 1.5).beta == Approx(3.0).epsilon(1e-14));
   // Independent reference: the sectional solver's own exponent far out (S = 1e6..1e7, where it has
-  // converged within 1e-4, design.md section 4) maps back to the beta it was solved with.
+  // converged within 1e-4, docs/model.md section 12) maps back to the beta it was solved with.
   MeanFieldCurves curves;
   for (const double beta : {2.0, 3.0}) {
     const double z = curves.exponentBetween(1e6, 1e7, beta);

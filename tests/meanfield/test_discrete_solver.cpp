@@ -1,6 +1,6 @@
 // Discrete Smoluchowski solver (CVODE + FFT right-hand side) against the exact solutions of the
-// classic kernels from n_k(0) = delta_k1 (design.md section 4; Leyvraz 2003, Phys. Rep. 383, 95),
-// plus mass conservation, truncation detection and the growing size range.
+// classic kernels from n_k(0) = delta_k1 (docs/model.md section 12; Leyvraz 2003, Phys. Rep. 383,
+// 95), plus mass conservation, truncation detection and the growing size range.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -107,7 +107,7 @@ TEST_CASE("growing range conserves mass and reaches large S for the beta kernel"
   for (const auto& s : r.samples) worst = std::max(worst, std::fabs(s.mass_loss));
   // Adams with fixed-point iteration preserves the linear invariant M1 up to round-off.
   CHECK(worst < 1e-10);
-  // the local slope is on its way to 6/5 (about 1.19 near S ~ 250-2000, design.md section 4)
+  // the local slope is on its way to 6/5 (about 1.19 near S ~ 250-2000, docs/model.md section 12)
   std::vector<double> t, S;
   for (const auto& s : r.samples) {
     t.push_back(s.t);

@@ -1,5 +1,6 @@
 // Enskog collision frequency, Haff's time constant and the charging-rate exponent
-// (meanfield/kinetic/Cooling.h, Charging.h) against the reference numbers of design.md section 2.
+// (meanfield/kinetic/Cooling.h, Charging.h) against the reference numbers of docs/model.md section
+// 8.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -10,10 +11,10 @@
 
 using namespace granagg::meanfield;
 
-TEST_CASE("Enskog collision frequency at phi = 0.076 matches design.md",
+TEST_CASE("Enskog collision frequency at phi = 0.076 matches the reference values",
           "[meanfield][kinetic][enskog]") {
-  // design.md quotes n = 0.145149, g2 = 1.219436, omega = 1.25490: margins of half a unit in the
-  // last quoted digit (plus round-off).
+  // docs/model.md section 8 quotes n = 0.145149, g2 = 1.219436, omega = 1.25490: margins of half a
+  // unit in the last quoted digit (plus round-off).
   CHECK(numberDensity(0.076) == Approx(0.145149).epsilon(0).margin(6e-7));
   CHECK(carnahanStarlingG2(0.076) == Approx(1.219436).epsilon(0).margin(6e-7));
   CHECK(enskogCollisionFrequency(0.076, 1.0) == Approx(1.25490).epsilon(0).margin(1e-5));
@@ -34,7 +35,7 @@ TEST_CASE("Haff time constant and temperature", "[meanfield][kinetic][enskog]") 
 }
 
 TEST_CASE("charging-rate exponent", "[meanfield][kinetic][charging]") {
-  // design.md section 2: -5/6 - 5 kappa / 3, i.e. -13/6 at kappa = 0.8.
+  // docs/model.md section 8: -5/6 - 5 kappa / 3, i.e. -13/6 at kappa = 0.8.
   CHECK(chargingRateExponent(0.8) == Approx(-13.0 / 6.0).epsilon(1e-15));
   CHECK(chargingRateExponent(0.83) == Approx(-5.0 / 6.0 - 5.0 * 0.83 / 3.0).epsilon(1e-15));
   CHECK(chargingRateExponent(0.0) == Approx(-5.0 / 6.0).epsilon(1e-15));

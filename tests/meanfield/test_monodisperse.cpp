@@ -1,5 +1,5 @@
-// Monodisperse approximation di/dt = K(i, i) (design.md section 4): Boost.Odeint solution against
-// the closed form, and its growth exponent z = 3 beta / (beta + 3).
+// Monodisperse approximation di/dt = K(i, i) (docs/model.md section 12): Boost.Odeint solution
+// against the closed form, and its growth exponent z = 3 beta / (beta + 3).
 #include <catch2/catch.hpp>
 
 #include <cmath>

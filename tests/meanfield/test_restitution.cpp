@@ -1,5 +1,5 @@
 // Viscoelastic restitution coefficient e(v) (meanfield/kinetic/Restitution.h) against the
-// design.md reference values, closed forms of the elastic Hertz contact, the published
+// docs/model.md reference values, closed forms of the elastic Hertz contact, the published
 // small-damping series (Ramirez et al., PRE 60, 4465 (1999)) and an independent fixed-step
 // integration in physical units.
 #include <catch2/catch.hpp>
@@ -50,9 +50,9 @@ double referenceRestitution(double E, double D, double v, bool clamped) {
 
 }  // namespace
 
-TEST_CASE("restitution at v = 0.05 matches design.md, clamped and unclamped",
+TEST_CASE("restitution at v = 0.05 matches the model's reference values, clamped and unclamped",
           "[meanfield][kinetic][restitution]") {
-  // design.md section 2 quotes e(0.05) = 0.506 (clamped) and 0.469 (unclamped); the brief gives
+  // docs/model.md section 3 quotes e(0.05) = 0.506 (clamped) and 0.469 (unclamped); the brief gives
   // 0.5055 and 0.4691 and asks for 1e-3, the precision to which they are quoted.
   ContactParams clamped;  // defaults E = 278.6, D = 27.7
   ContactParams unclamped;
@@ -65,7 +65,7 @@ TEST_CASE("restitution at v = 0.05 matches design.md, clamped and unclamped",
   // a factor 20 of margin.
   CHECK(ec == Approx(referenceRestitution(278.6, 27.7, 0.05, true)).epsilon(0).margin(1e-8));
   CHECK(eu == Approx(referenceRestitution(278.6, 27.7, 0.05, false)).epsilon(0).margin(1e-8));
-  // design.md: e is about 0.3 to 0.5 for impact speeds 0.05 to 1 at these parameters.
+  // docs/model.md section 3: e is about 0.3 to 0.5 for impact speeds 0.05 to 1 at these parameters.
   CHECK(Restitution(clamped).restitution(1.0) == Approx(0.33).epsilon(0).margin(0.01));
 }
 
@@ -99,7 +99,7 @@ TEST_CASE("elastic Hertz contact: e = 1, contact time and largest overlap in clo
   const double beta = std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);
   const double factor = 0.8 * std::pow(1.25, 0.4) * beta;
   CHECK(HERTZ_CONTACT_TIME_FACTOR == Approx(factor).epsilon(1e-15));
-  CHECK(factor == Approx(3.218065).epsilon(2e-7));  // design.md's value, rounded to 7 digits
+  CHECK(factor == Approx(3.218065).epsilon(2e-7));  // docs/model.md section 6, rounded to 7 digits
   for (bool c : {true, false}) {
     ContactParams p;
     p.D = 0.0;
@@ -109,8 +109,9 @@ TEST_CASE("elastic Hertz contact: e = 1, contact time and largest overlap in clo
       const CollisionResult r = R.collide(v);
       // Energy conservation; the integrator is run at 1e-12, so 1e-8 is a loose bound.
       CHECK(r.restitution == Approx(1.0).epsilon(0).margin(1e-8));
-      // design.md: t_c = 3.218065 (m_eff^2/(E^2 v))^{1/5}, to 1e-6 relative as asked; against
-      // the closed form to 1e-10 (the dense-output crossing is accurate to ~1e-12, measured).
+      // docs/model.md section 6: t_c = 3.218065 (m_eff^2/(E^2 v))^{1/5}, to 1e-6 relative as asked;
+      // against the closed form to 1e-10 (the dense-output crossing is accurate to ~1e-12,
+      // measured).
       CHECK(r.contact_time ==
             Approx(3.218065 * std::pow(M_EFF * M_EFF / (p.E * p.E * v), 0.2)).epsilon(1e-6));
       CHECK(r.contact_time ==
@@ -119,7 +120,7 @@ TEST_CASE("elastic Hertz contact: e = 1, contact time and largest overlap in clo
       // Largest overlap from (1/2) m_eff v^2 = (2/5) E xi_max^{5/2}.
       CHECK(r.max_overlap == Approx(std::pow(1.25 * M_EFF * v * v / p.E, 0.4)).epsilon(1e-9));
     }
-    // design.md: 0.23 for v = 1.6 at the defaults.
+    // docs/model.md section 6: 0.23 for v = 1.6 at the defaults.
     CHECK(R.elasticContactTime(1.6) == Approx(0.23).epsilon(0).margin(0.005));
   }
 }

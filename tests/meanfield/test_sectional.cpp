@@ -88,9 +88,9 @@ TEST_CASE("sectional solver rejects bad options", "[meanfield][sectional]") {
 
 TEST_CASE("sectional constant kernel: exact M0 and small sizes, M2 within 1 %",
           "[meanfield][sectional]") {
-  // n_k = (1+a)^-2 (a/(1+a))^(k-1), a = K0 t / 2; M0 = 1/(1+a); M2 = 1 + K0 t (design.md section
-  // 4). Sizes 1..20 are pivots whose gains come only from pairs of integer pivots, and their loss
-  // K0 N_k M0 involves the exact M0: they follow the exact n_k.
+  // n_k = (1+a)^-2 (a/(1+a))^(k-1), a = K0 t / 2; M0 = 1/(1+a); M2 = 1 + K0 t (docs/model.md
+  // section 12). Sizes 1..20 are pivots whose gains come only from pairs of integer pivots, and
+  // their loss K0 N_k M0 involves the exact M0: they follow the exact n_k.
   const double K0 = 1.0;
   SectionalOptions o;
   o.times = logSpacedTimes(0.1, 1e4, 6);
@@ -137,7 +137,8 @@ TEST_CASE("sectional M2 error converges as (r - 1)^2", "[meanfield][sectional]")
 }
 
 TEST_CASE("sectional additive kernel against its exact moments", "[meanfield][sectional]") {
-  // i + j kernel: M0 = e^{-t}, M2 = e^{2t} (design.md section 4); M2 to 1 % up to t = 2 (header).
+  // i + j kernel: M0 = e^{-t}, M2 = e^{2t} (docs/model.md section 12); M2 to 1 % up to t = 2
+  // (header).
   SectionalOptions o;
   o.times = {0.25, 0.5, 1.0, 1.5, 2.0};
   const SmolResult r = solveSectional(Kernel::additive(), o);
@@ -151,7 +152,8 @@ TEST_CASE("sectional additive kernel against its exact moments", "[meanfield][se
 }
 
 TEST_CASE("sectional multiplicative kernel before the gel point", "[meanfield][sectional]") {
-  // i j kernel, t < 1: M0 = 1 - t/2, M2 = 1/(1 - t) (design.md section 4); M2 to 1 % up to t = 0.9.
+  // i j kernel, t < 1: M0 = 1 - t/2, M2 = 1/(1 - t) (docs/model.md section 12); M2 to 1 % up to t =
+  // 0.9.
   SectionalOptions o;
   o.times = {0.2, 0.5, 0.8, 0.9};
   const SmolResult r = solveSectional(Kernel::multiplicative(), o);
@@ -167,8 +169,8 @@ TEST_CASE("sectional multiplicative kernel before the gel point", "[meanfield][s
 TEST_CASE("sectional beta kernel: asymptotic local slope is 3 beta / (beta + 3)",
           "[meanfield][sectional]") {
   // Issue acceptance test. z(t) = log[S(t)/S(t/2)] / log 2 at the first output with S >= 1e7.
-  // z(t) ~ z_inf t / (t + t0) with t0 ~ 1 (design.md section 4), so at S = 1e7 (t ~ 1e4 to 1e5) it
-  // sits within ~1e-4 of z_inf; the fixed-pivot error in S is a near-constant factor in the
+  // z(t) ~ z_inf t / (t + t0) with t0 ~ 1 (docs/model.md section 12), so at S = 1e7 (t ~ 1e4 to
+  // 1e5) it sits within ~1e-4 of z_inf; the fixed-pivot error in S is a near-constant factor in the
   // self-similar regime and does not bias the slope. The reference study's values at S ~ 7e6
   // (1.20000 for beta = 2, 1.49996 for beta = 3) are checked to 1e-4. About 0.3 s per beta.
   SectionalOptions o;
