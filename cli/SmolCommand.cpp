@@ -53,10 +53,12 @@ void registerSmolCommand(CLI::App& app, const CliContext& ctx) {
   smol->add_option("--s-end", args->s_end,
                    "Stop once S reaches this mean size (default: no limit)");
   smol->add_option("--M", args->max_size,
-                   "discrete: largest size class (the active range grows with S up to M)")
+                   "discrete: largest size class (the active range grows with S up to M); the "
+                   "sectional grid needs no bound, it grows with S")
       ->capture_default_str();
   smol->add_option("--ratio", args->ratio,
-                   "sectional: geometric grid ratio (> 1); S errors scale as (ratio-1)^2")
+                   "sectional: geometric grid ratio (> 1); S errors scale as (ratio-1)^2; the "
+                   "grid holds at most 4096 sections, so a larger ratio reaches larger S")
       ->capture_default_str();
   smol->add_option("--rtol", args->rtol, "CVODE relative tolerance")->capture_default_str();
   smol->add_option("--atol", args->atol,
@@ -88,8 +90,11 @@ void registerSmolCommand(CLI::App& app, const CliContext& ctx) {
   auto ztarget = addOutOptions(zbeta, ctx);
 
   zbeta->callback([zargs, ztarget]() { mf::writeZbetaTable(*zargs, *ztarget, logLine); });
-  smol->callback([args, target, quiet, zbeta]() {
+  smol->callback([smol, args, target, quiet, zbeta]() {
     if (zbeta->parsed()) return;  // `smol zbeta` ran its own callback
+    if (smol->count("--M") > 0 && args->method != "discrete" && !*quiet)
+      logLine("smol: --M applies to --method discrete only; the " + args->method +
+              " method does not use it");
     mf::writeSmolTable(*args, *target, *quiet ? mf::LogLine() : mf::LogLine(logLine));
   });
 }

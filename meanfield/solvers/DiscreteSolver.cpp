@@ -145,14 +145,14 @@ SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o,
                                  " at t = " + common::formatReal(t) + " exceeds the tolerance " +
                                  common::formatReal(o.mass_loss_tolerance) +
                                  " (S = " + common::formatReal(s.S) + "): ";
-        res.stopped_early = s.mass_loss > 0.0
-                                ? head + "the size range M = " + std::to_string(M) +
-                                      (M >= o.max_size ? " (the largest allowed; raise --M)" : "") +
-                                      " truncates the distribution"
-                                : head +
-                                      "mass was gained, an integration error (tighten --rtol, or "
-                                      "use --integrator adams, which "
-                                      "conserves mass to round-off)";
+        res.stop_cause = s.mass_loss > 0.0 ? StopCause::Truncation : StopCause::MassGained;
+        res.stopped_early =
+            s.mass_loss > 0.0
+                ? head + "the size range M = " + std::to_string(M) +
+                      (M >= o.max_size ? " (the largest allowed)" : "") +
+                      " truncates the distribution"
+                : head + "mass was gained, an integration error (Adams conserves mass to "
+                         "round-off)";
         done = true;
         break;
       }

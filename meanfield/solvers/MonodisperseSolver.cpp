@@ -124,6 +124,7 @@ SmolResult solveMonodisperse(const Kernel& kernel, const MonodisperseOptions& op
     result.samples.push_back(m);
     if (!m.valid) {
       result.stopped_early = "mean size is no longer finite at t = " + formatReal(tout);
+      result.stop_cause = StopCause::NotFinite;
       break;
     }
     if (i >= o.s_end) break;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -14,7 +15,15 @@ namespace granagg::meanfield {
 
 namespace {
 
-constexpr int MAX_SECTIONS = 4096;
+constexpr int MAX_SECTIONS = SECTIONAL_MAX_SECTIONS;
+/// The grid grows at an output time when the largest section holding mass lies within this
+/// factor of the last pivot (SectionalSolver.h)...
+constexpr double GROW_TRIGGER = 100.0;
+/// ...to this factor beyond that section (about 280 more sections at r = 1.05).
+constexpr double GROW_TARGET = 1e6;
+/// Mass (relative to M1(0), in units of mass_loss_tolerance) that may escape during one output
+/// interval before the interval is integrated again on a larger grid.
+constexpr double ESCAPE_REDO_FRACTION = 1e-3;
 
 /// Index of the section pair (j, k), j <= k, in the upper-triangular pair table of I sections.
 inline size_t rowStart(size_t j, size_t I) {
@@ -181,40 +190,67 @@ void validate(const SectionalOptions& o) {
   if (!(o.section_cutoff >= 0.0) || !(o.section_cutoff < 1e-6))
     throw std::invalid_argument("sectional section_cutoff must lie in [0, 1e-6) (got " +
                                 formatReal(o.section_cutoff) + ").");
+  if (!(o.max_size >= 2.0))
+    throw std::invalid_argument("sectional max_size must be >= 2 (got " + formatReal(o.max_size) +
+                                ").");
+  if (!(o.initial_size >= 2.0 && o.initial_size <= SECTIONAL_MAX_PIVOT))
+    throw std::invalid_argument("sectional initial_size must lie in [2, " +
+                                formatReal(SECTIONAL_MAX_PIVOT) + "] (got " +
+                                formatReal(o.initial_size) + ").");
   CvodeSolver::parseMethod(o.integrator);  // throws for an unknown name
+}
+
+/// Adds the cost of one CVODE instance to the solve's totals.
+void addStats(SolveStats& acc, const CvodeSolver::Stats& s) {
+  acc.steps += s.steps;
+  acc.rhs_evaluations += s.rhs_evaluations;
+  acc.linear_iterations += s.linear_iterations;
+  acc.nonlinear_failures += s.nonlinear_failures;
+  acc.error_test_failures += s.error_test_failures;
+}
+
+/// The pivots of the file comment up to the first >= top, or up to `max_sections` pivots. Every
+/// grid of one ratio is a prefix of the grids with a larger top, so a grown grid keeps its pivots.
+SectionalGrid buildGrid(double ratio, double top, size_t max_sections) {
+  SectionalGrid g;
+  // integers 1..m with m the first integer whose geometric step m (r - 1) is at least one
+  const int m = std::max(1, static_cast<int>(std::ceil(1.0 / (ratio - 1.0) - 1e-12)));
+  for (int k = 1; k <= m && g.pivots.size() < max_sections; ++k) {
+    g.pivots.push_back(k);
+    if (k >= top) break;
+  }
+  g.integer_pivots = static_cast<int>(g.pivots.size());
+  while (g.pivots.back() < top && g.pivots.size() < max_sections)
+    g.pivots.push_back(g.pivots.back() * ratio);
+  return g;
+}
+
+/// Throws std::invalid_argument unless ratio > 1 leaves room for the integer pivots.
+void checkRatio(double ratio) {
+  using common::formatReal;
+  if (!(ratio > 1.0) || !std::isfinite(ratio))
+    throw std::invalid_argument("sectional ratio must be a finite number > 1 (got " +
+                                formatReal(ratio) + ").");
+  if (std::ceil(1.0 / (ratio - 1.0) - 1e-12) > MAX_SECTIONS)
+    throw std::invalid_argument("sectional ratio " + formatReal(ratio) +
+                                " is too close to 1: more than " + std::to_string(MAX_SECTIONS) +
+                                " integer pivots.");
 }
 
 }  // namespace
 
 SectionalGrid makeSectionalGrid(double ratio, double max_size) {
   using common::formatReal;
-  if (!(ratio > 1.0) || !std::isfinite(ratio))
-    throw std::invalid_argument("sectional ratio must be a finite number > 1 (got " +
-                                formatReal(ratio) + ").");
-  if (!(max_size >= 2.0) || !std::isfinite(max_size))
-    throw std::invalid_argument("sectional max_size must be finite and >= 2 (got " +
+  checkRatio(ratio);
+  if (!(max_size >= 2.0 && max_size <= SECTIONAL_MAX_PIVOT))
+    throw std::invalid_argument("sectional max_size must lie in [2, " +
+                                formatReal(SECTIONAL_MAX_PIVOT) + "] (got " +
                                 formatReal(max_size) + ").");
-  SectionalGrid g;
-  // integers 1..m with m the first integer whose geometric step m (r - 1) is at least one
-  const double m_real = std::ceil(1.0 / (ratio - 1.0) - 1e-12);
-  if (m_real > MAX_SECTIONS)
-    throw std::invalid_argument("sectional ratio " + formatReal(ratio) +
-                                " is too close to 1: more than " + std::to_string(MAX_SECTIONS) +
-                                " integer pivots.");
-  const int m = std::max(1, static_cast<int>(m_real));
-  for (int k = 1; k <= m; ++k) {
-    g.pivots.push_back(k);
-    if (k >= max_size) break;
-  }
-  g.integer_pivots = static_cast<int>(g.pivots.size());
-  while (g.pivots.back() < max_size) {
-    g.pivots.push_back(g.pivots.back() * ratio);
-    if (g.pivots.size() > static_cast<size_t>(MAX_SECTIONS))
-      throw std::invalid_argument(
-          "sectional grid with ratio " + formatReal(ratio) + " and max_size " +
-          formatReal(max_size) + " needs more than " + std::to_string(MAX_SECTIONS) +
-          " sections: raise the ratio (--ratio) or lower the largest size (--M).");
-  }
+  SectionalGrid g = buildGrid(ratio, max_size, MAX_SECTIONS + 1);
+  if (g.pivots.size() > static_cast<size_t>(MAX_SECTIONS))
+    throw std::invalid_argument("sectional grid with ratio " + formatReal(ratio) +
+                                " up to size " + formatReal(max_size) + " needs more than " +
+                                std::to_string(MAX_SECTIONS) + " sections: raise the ratio.");
   return g;
 }
 
@@ -223,12 +259,17 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
   using common::formatReal;
   const auto wall_start = std::chrono::steady_clock::now();
   validate(options);
-  const SectionalGrid grid = makeSectionalGrid(options.ratio, options.max_size);
-  const std::vector<double>& x = grid.pivots;
-  const size_t I = x.size();
+  // The first grid also covers the initial distribution; beyond max_size it is refused below.
+  double first_top = std::min(options.initial_size, options.max_size);
+  if (initial) first_top = std::min(options.max_size, std::max(first_top, double(initial->size())));
+  checkRatio(options.ratio);
+  // A growing grid may start within the section budget and stop growing there; a fixed grid
+  // that does not fit is refused.
+  SectionalGrid grid = options.grow ? buildGrid(options.ratio, first_top, MAX_SECTIONS)
+                                    : makeSectionalGrid(options.ratio, first_top);
 
   // Initial state: n_k for k = 1..len onto the pivots (number- and mass-conserving split).
-  std::vector<double> y(I + 1, 0.0);
+  std::vector<double> y(grid.pivots.size() + 1, 0.0);
   if (initial) {
     if (initial->empty()) throw std::invalid_argument("sectional initial distribution is empty.");
     for (size_t k = 0; k < initial->size(); ++k) {
@@ -239,7 +280,7 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
       if (n == 0.0) continue;
       int t;
       double b;
-      splitSize(x, static_cast<double>(k + 1), t, b);
+      splitSize(grid.pivots, static_cast<double>(k + 1), t, b);
       if (t < 0)
         throw std::invalid_argument("sectional initial distribution reaches size " +
                                     std::to_string(k + 1) + ", beyond max_size " +
@@ -251,9 +292,9 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
     y[0] = 1.0;  // monodisperse n_1 = 1
   }
   double M1_0 = 0.0, M2_0 = 0.0;
-  for (size_t i = 0; i < I; ++i) {
-    M1_0 += x[i] * y[i];
-    M2_0 += x[i] * x[i] * y[i];
+  for (size_t i = 0; i < grid.pivots.size(); ++i) {
+    M1_0 += grid.pivots[i] * y[i];
+    M2_0 += grid.pivots[i] * grid.pivots[i] * y[i];
   }
   if (!(M1_0 > 0.0)) throw std::invalid_argument("sectional initial distribution has no mass.");
 
@@ -270,25 +311,63 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
                                 "' gels; no gel time known.");
   }
 
-  FixedPivotRhs rhs(kernel, x, options.section_cutoff * M1_0);
-
+  SmolResult result;
+  result.method = "sectional";
   CvodeSolver::Options co;
   co.method = CvodeSolver::parseMethod(options.integrator);
   co.rtol = options.rtol;
-  co.atol_vector.resize(I + 1);
-  for (size_t i = 0; i < I; ++i) co.atol_vector[i] = options.atol * M1_0 / x[i];  // mass-weighted
-  co.atol_vector[I] = options.atol * M1_0;                                        // escaped mass
   co.max_steps = 1000000;
-  const int n_unknowns = static_cast<int>(I + 1);
-  CvodeSolver cvode(
-      n_unknowns, [&rhs](double, const double* yy, double* dd) { rhs(yy, dd); }, co, 0.0, y.data());
-  cvode.setStopTime(options.times.back());  // never step past the last output (gel time, blow-up)
+  std::unique_ptr<FixedPivotRhs> rhs;
+  std::unique_ptr<CvodeSolver> cvode;
+  // The right-hand side and CVODE on the current grid, from y(t0) = y0.
+  auto startSolver = [&](double t0, const std::vector<double>& y0) {
+    if (cvode) addStats(result.stats, cvode->stats());
+    cvode.reset();
+    const std::vector<double>& x = grid.pivots;
+    const size_t I = x.size();
+    rhs = std::make_unique<FixedPivotRhs>(kernel, x, options.section_cutoff * M1_0);
+    co.atol_vector.resize(I + 1);
+    for (size_t i = 0; i < I; ++i) co.atol_vector[i] = options.atol * M1_0 / x[i];  // by mass
+    co.atol_vector[I] = options.atol * M1_0;                                        // escaped
+    FixedPivotRhs* r = rhs.get();
+    cvode = std::make_unique<CvodeSolver>(
+        static_cast<int>(I + 1), [r](double, const double* yy, double* dd) { (*r)(yy, dd); }, co,
+        t0, y0.data());
+    cvode->setStopTime(options.times.back());  // never past the last output (gel time, blow-up)
+  };
+  // Appends pivots up to min(top, max_size) within the section budget, and zero sections to
+  // `state` (the escaped mass stays last). False when the grid cannot grow.
+  auto growGrid = [&](double top, std::vector<double>& state) {
+    const size_t I_old = grid.pivots.size();
+    const double ceiling = std::min(options.max_size, SECTIONAL_MAX_PIVOT);
+    if (!options.grow || grid.pivots.back() >= ceiling) return false;
+    grid = buildGrid(options.ratio, std::min(top, ceiling), MAX_SECTIONS);
+    const size_t I = grid.pivots.size();
+    if (I == I_old) return false;
+    const double escaped = state[I_old];
+    state.resize(I + 1, 0.0);
+    state[I_old] = 0.0;
+    state[I] = escaped;
+    ++result.stats.resizes;
+    return true;
+  };
+  startSolver(0.0, y);
 
-  SmolResult result;
-  result.method = "sectional";
-  std::vector<double> yout(I + 1);
-  for (double tout : options.times) {
-    cvode.advance(tout, yout.data());
+  double t_prev = 0.0;
+  std::vector<double> y_prev = y;  // the state at t_prev, on the current grid
+  std::vector<double> yout;
+  for (size_t k = 0; k < options.times.size();) {
+    const double tout = options.times[k];
+    const std::vector<double>& x = grid.pivots;
+    const size_t I = x.size();
+    yout.resize(I + 1);
+    cvode->advance(tout, yout.data());
+    // Mass left the grid during this interval: integrate it again from t_prev on a larger grid.
+    if (yout[I] - y_prev[I] > ESCAPE_REDO_FRACTION * options.mass_loss_tolerance * M1_0 &&
+        growGrid(GROW_TARGET * x.back(), y_prev)) {
+      startSolver(t_prev, y_prev);
+      continue;
+    }
     MomentSample s;
     s.t = tout;
     for (size_t i = 0; i < I; ++i) {
@@ -301,7 +380,7 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
     s.mass_loss = (M1_0 - s.M1) / M1_0;
     s.valid = std::fabs(s.mass_loss) <= options.mass_loss_tolerance;
     size_t lo, hi;
-    rhs.activeRange(yout.data(), lo, hi);
+    rhs->activeRange(yout.data(), lo, hi);
     s.max_size = lo < I ? x[hi] : 0.0;
     result.samples.push_back(s);
     if (options.snapshots) {
@@ -312,22 +391,40 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
       result.snapshots.push_back(std::move(snap));
     }
     if (!s.valid && options.stop_on_truncation) {
-      result.stopped_early = "mass loss " + formatReal(s.mass_loss) +
-                             " at t = " + formatReal(tout) + " exceeds mass_loss_tolerance " +
-                             formatReal(options.mass_loss_tolerance) +
-                             " (aggregates beyond the last pivot " + formatReal(x.back()) +
-                             "; raise the largest size, --M on the command line)";
+      const std::string head = "mass loss " + formatReal(s.mass_loss) + " at t = " +
+                               formatReal(tout) + " exceeds mass_loss_tolerance " +
+                               formatReal(options.mass_loss_tolerance);
+      if (s.mass_loss < 0.0) {
+        result.stop_cause = StopCause::MassGained;
+        result.stopped_early = head + ": mass was gained, an integration error";
+      } else {
+        result.stop_cause = StopCause::Truncation;
+        std::string limit = "the grid holds its most sections, " + std::to_string(MAX_SECTIONS) +
+                            ", at ratio " + formatReal(options.ratio);
+        if (!options.grow) {
+          limit = "the grid is fixed";
+        } else if (x.back() >= options.max_size) {
+          limit = "the largest size allowed, max_size " + formatReal(options.max_size);
+        } else if (x.back() >= SECTIONAL_MAX_PIVOT) {
+          result.stop_cause = StopCause::SizeCeiling;
+          limit = "no grid goes beyond " + formatReal(SECTIONAL_MAX_PIVOT);
+        }
+        result.stopped_early = head + ": aggregates left the grid beyond its last pivot " +
+                               formatReal(x.back()) + " (" + limit + ")";
+      }
       break;
     }
     if (s.S >= options.s_end) break;
+    // The distribution nears the grid's end: more pivots before the next interval.
+    if (k + 1 < options.times.size() && lo < I && x[hi] * GROW_TRIGGER > x.back() &&
+        growGrid(GROW_TARGET * x[hi], yout))
+      startSolver(tout, yout);
+    y_prev = yout;
+    t_prev = tout;
+    ++k;
   }
 
-  const CvodeSolver::Stats cs = cvode.stats();
-  result.stats.steps = cs.steps;
-  result.stats.rhs_evaluations = cs.rhs_evaluations;
-  result.stats.linear_iterations = cs.linear_iterations;
-  result.stats.nonlinear_failures = cs.nonlinear_failures;
-  result.stats.error_test_failures = cs.error_test_failures;
+  addStats(result.stats, cvode->stats());
   result.stats.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;

@@ -25,10 +25,21 @@
 /// the pairs of sections that hold non-negligible mass. The fixed-pivot error in S scales as (r -
 /// 1)^2 (docs/model.md section 12: 3e-4 at r = 1.02).
 ///
+/// Growing grid: the solve starts on the grid up to min(initial_size, max_size) and appends
+/// geometric pivots as the distribution spreads, so S is bounded by the section budget
+/// (4096 sections: a last pivot of 5e87 at r = 1.05; at most ~1e100 at any r), not by a size
+/// fixed in advance. Appending keeps every pivot and N_i, so no state is remapped; CVODE restarts
+/// from the current state (a few small steps). The grid grows (a) at an output time when the largest section holding mass, x_hi,
+/// has come within a factor GROW_TRIGGER = 100 of the last pivot, to GROW_TARGET = 1e6 x_hi;
+/// (b) when mass escaped during the last output interval all the same (sparse output times,
+/// fast growth): the interval is integrated again from the previous output on the larger grid.
+/// A solve that never comes near the initial grid's end takes exactly the steps of a fixed grid.
+///
 /// Truncation: aggregates larger than the last pivot leave the grid. Their mass is integrated as an
 /// extra unknown, so that M1 + escaped mass is a linear invariant; every sample reports the
 /// relative mass lost, (M1(0) - M1(t)) / M1(0), and is marked invalid when it exceeds
-/// mass_loss_tolerance.
+/// mass_loss_tolerance. With the growing grid this happens only at max_size or at the section
+/// budget (SmolResult::stop_cause = Truncation), or at SECTIONAL_MAX_PIVOT (SizeCeiling).
 ///
 /// Gelling kernels (multiplicative, K0 i j): the solution only exists before the gel time
 /// t_gel = 1 / (K0 M2(0)) (Ziff 1980; 1/K0 for the monodisperse start); later output times are
@@ -45,8 +56,14 @@ namespace granagg::meanfield {
 struct SectionalOptions {
   /// Grid ratio r = x_{i+1} / x_i of the geometric part (> 1). The error in S scales as (r - 1)^2.
   double ratio = 1.05;
-  /// Largest size the grid must cover (monomer masses, >= 2); the last pivot is the first >= it.
-  double max_size = 1e12;
+  /// Largest size the grid may grow to (monomer masses, >= 2; the last pivot is the first >= it).
+  /// Infinity: as far as the section budget and SECTIONAL_MAX_PIVOT allow.
+  double max_size = std::numeric_limits<double>::infinity();
+  /// Last pivot of the first grid (>= 2); the grid starts at min(initial_size, max_size).
+  double initial_size = 1e12;
+  /// Append pivots as the distribution spreads (see the file comment); false: a fixed grid up to
+  /// min(initial_size, max_size).
+  bool grow = true;
   /// CVODE relative tolerance (dimensionless).
   double rtol = 1e-8;
   /// CVODE absolute tolerance on the mass x_i N_i of each section, relative to M1(0) (the tolerance
@@ -80,13 +97,18 @@ struct SectionalOptions {
   double section_cutoff = 1e-20;
 };
 
+/// The section budget: the pair table holds I (I + 1) / 2 entries (8 million at 4096).
+constexpr int SECTIONAL_MAX_SECTIONS = 4096;
+/// No pivot lies far beyond this size, so that x^2 N and K(x, x) N^2 stay finite in double.
+constexpr double SECTIONAL_MAX_PIVOT = 1e100;
+
 /// The pivot grid described above (exposed for tests and plots).
 struct SectionalGrid {
   std::vector<double> pivots;  ///< x_i, monomer masses, strictly increasing, x_0 = 1
   int integer_pivots = 0;      ///< number of leading integer pivots 1..m
 };
-/// Builds the grid for ratio > 1 and max_size >= 2; throws std::invalid_argument otherwise, or
-/// when it would exceed 4096 sections (the pair table holds I (I + 1) / 2 entries).
+/// Builds the grid for ratio > 1 and max_size in [2, SECTIONAL_MAX_PIVOT]; throws
+/// std::invalid_argument otherwise, or when it would exceed SECTIONAL_MAX_SECTIONS sections.
 SectionalGrid makeSectionalGrid(double ratio, double max_size);
 
 /// Solves the fixed-pivot equations from `initial` (n_k for sizes k = 1..initial.size(), mapped

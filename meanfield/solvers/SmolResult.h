@@ -45,13 +45,24 @@ struct SolveStats {
   double wall_seconds = 0.0;
 };
 
+/// Why a solve stopped before the requested end. The solvers describe the cause in their own
+/// terms; a caller turns it into advice that names its own options (SmolTables.cpp).
+enum class StopCause {
+  None,        ///< reached the last output time or s_end
+  Truncation,  ///< mass left the size range, which had reached the largest size allowed
+  SizeCeiling,  ///< mass left the size range at the largest size the solver represents at all
+  MassGained,  ///< M1 grew beyond the tolerance: an integration error
+  NotFinite,   ///< the mean size overflowed
+};
+
 struct SmolResult {
   std::string method;  ///< "discrete", "sectional" or "mono"
   std::vector<MomentSample> samples;
   std::vector<Snapshot> snapshots;
   SolveStats stats;
-  /// Why the solve stopped before the requested end, empty if it reached it.
+  /// Why the solve stopped before the requested end, empty if it reached it (names no option).
   std::string stopped_early;
+  StopCause stop_cause = StopCause::None;
 };
 
 /// Log-spaced times from t_min to t_max, `count` points (count >= 2).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "common/Strings.h"
@@ -49,6 +50,49 @@ void validSeries(const SmolResult& r, std::vector<double>& t, std::vector<double
     }
 }
 
+/// What the user of `granagg smol` can change when a solve stops early: options of that
+/// command that act on `method`.
+std::string smolAdvice(const SmolResult& r, const std::string& method) {
+  switch (r.stop_cause) {
+    case StopCause::Truncation:
+      return method == "discrete" ? "raise --M, or use --method sectional (its grid grows with S)"
+                                  : "raise --ratio (coarser sections reach larger sizes)";
+    case StopCause::MassGained:
+      return method == "discrete" ? "tighten --rtol, or use --integrator adams (it conserves "
+                                    "mass to round-off)"
+                                  : "tighten --rtol or --atol";
+    case StopCause::SizeCeiling:
+    case StopCause::NotFinite:
+      return "lower --t-end, or stop at a mean size with --s-end";
+    case StopCause::None:
+      break;
+  }
+  return "";
+}
+
+/// The same for `granagg smol zbeta`, whose solves take only --method, --s-end and --ratio.
+std::string zbetaAdvice(const SmolResult& r, const std::string& method) {
+  switch (r.stop_cause) {
+    case StopCause::Truncation:
+      return method == "discrete"
+                 ? "lower --s-end, or use --method sectional (its grid grows with S)"
+                 : "raise --ratio (coarser sections reach larger sizes)";
+    case StopCause::MassGained:
+    case StopCause::SizeCeiling:
+    case StopCause::NotFinite:
+      return "lower --s-end";
+    case StopCause::None:
+      break;
+  }
+  return "";
+}
+
+/// "cause; advice", or "" when the solve reached its end.
+std::string stopLine(const SmolResult& r, const std::string& advice) {
+  if (r.stopped_early.empty()) return "";
+  return advice.empty() ? r.stopped_early : r.stopped_early + "; " + advice;
+}
+
 }  // namespace
 
 /// Runs the chosen method; all three return moments on the same output times.
@@ -87,7 +131,9 @@ SmolResult solveSmoluchowski(const Kernel& kernel, const std::string& method,
 
 void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const LogLine& log) {
   const Kernel kernel = Kernel::fromName(a.kernel, a.beta, a.K0);
-  requireRange(a.max_size >= 2, "--M must be at least 2 (got " + std::to_string(a.max_size) + ").");
+  requireRange(a.max_size >= 2 && a.max_size <= std::numeric_limits<int>::max(),
+               "--M must lie in [2, " + std::to_string(std::numeric_limits<int>::max()) +
+                   "] (got " + std::to_string(a.max_size) + ").");
   requireRange(a.ratio > 1.0, "--ratio must be > 1 (got " + common::formatReal(a.ratio) + ").");
   requireRange(a.rtol > 0.0 && a.rtol < 1.0, "--rtol must lie in (0, 1).");
   requireRange(a.atol > 0.0, "--atol must be positive.");
@@ -99,8 +145,9 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
   target.refuseToOverwrite();
 
   const auto wall0 = std::chrono::steady_clock::now();
-  const SmolResult r = solveSmoluchowski(kernel, a.method, times, a.s_end, a.max_size, a.ratio,
-                                         a.rtol, a.atol, a.integrator);
+  const SmolResult r =
+      solveSmoluchowski(kernel, a.method, times, a.s_end, static_cast<int>(a.max_size), a.ratio,
+                        a.rtol, a.atol, a.integrator);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
@@ -138,7 +185,8 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
     if (s.valid && j < ls.t.size() && ls.t[j] == s.t) z = ls.z[j++];
     w.row({s.t, s.S, s.M0, s.M1, s.M2, z, s.mass_loss, s.valid ? 1.0 : 0.0, s.max_size});
   }
-  if (!r.stopped_early.empty()) w.comment("stopped early: " + r.stopped_early);
+  const std::string stopped = stopLine(r, smolAdvice(r, a.method));
+  if (!stopped.empty()) w.comment("stopped early: " + stopped);
   w.close();
 
   if (!log) return;
@@ -149,7 +197,7 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
       kernel.type() == KernelType::Beta ? (" beta=" + common::formatReal(a.beta)).c_str() : "",
       a.method.c_str(), r.samples.size(), r.samples.empty() ? 0.0 : r.samples.back().t,
       r.samples.empty() ? 0.0 : r.samples.back().S, wall, r.stats.steps, r.stats.rhs_evaluations));
-  if (!r.stopped_early.empty()) log("smol: stopped early: " + r.stopped_early);
+  if (!stopped.empty()) log("smol: stopped early: " + stopped);
   if (kernel.homogeneity() < 1.0) {
     log(common::printfString("smol: scaling prediction z = 1/(1 - lambda) = %.6f",
                              kernel.scalingExponent()));
@@ -210,10 +258,13 @@ void writeZbetaTable(const ZbetaRequest& a, const common::CsvTarget& target, con
     };
     w.row({beta, az.z, z_th, az.z - z_th, az.converged ? 1.0 : 0.0, S.back(), slopeAt(250.0),
            slopeAt(2500.0)});
-    if (log)
+    if (log) {
       log(common::printfString(
           "zbeta: beta = %.4f  z = %.5f  3beta/(beta+3) = %.5f  diff = %+.1e  (S_final = %.3g%s)",
           beta, az.z, z_th, az.z - z_th, S.back(), az.converged ? "" : ", NOT converged"));
+      const std::string stopped = stopLine(r, zbetaAdvice(r, a.method));
+      if (!stopped.empty()) log("zbeta: stopped early: " + stopped);
+    }
   }
   w.close();
   if (log && target.path != "-") log("zbeta: wrote " + target.path);

@@ -24,7 +24,7 @@ struct SmolRequest {
   double t_min = 1e-2, t_end = 1e6;
   int per_decade = 20;
   double s_end = std::numeric_limits<double>::infinity();
-  int max_size = 1 << 21;
+  long long max_size = 1 << 21;  ///< --M: the discrete method's largest size class
   double ratio = 1.05, rtol = 1e-8, atol = 1e-14;
   std::string integrator = "adams";
   double p = 2.0, z_tolerance = 1e-3;

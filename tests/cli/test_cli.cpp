@@ -8,9 +8,12 @@
 #include <unistd.h>
 #include <array>
 #include <cstdio>
+#include <cctype>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "TestUtil.h"
 
@@ -87,6 +90,94 @@ TEST_CASE("smol writes a table with provenance and refuses to overwrite it", "[c
   CHECK_THAT(again.output, Catch::Contains("already exists"));
   CHECK(runGranagg("smol --beta 3 --method mono --t-end 100 --force --out " + out).status == 0);
   std::remove(out.c_str());
+}
+
+namespace {
+
+/// The options a piece of advice names ("--ratio", ...), in order.
+std::vector<std::string> optionsNamed(const std::string& text) {
+  std::vector<std::string> names;
+  const std::regex option("--[a-z][a-z-]*");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), option);
+       it != std::sregex_iterator(); ++it)
+    names.push_back(it->str());
+  return names;
+}
+
+/// True when `option` is listed by `smol --help` without being reserved for another method
+/// (help texts start with "discrete:" or "sectional:" for options of one method only).
+bool smolOptionServes(const std::string& option, const std::string& method) {
+  std::istringstream help(runGranagg("smol --help").output);
+  for (std::string line; std::getline(help, line);) {
+    const std::size_t at = line.find(option);
+    if (at == std::string::npos) continue;
+    const std::size_t end = at + option.size();
+    if (end < line.size() && (std::isalnum(static_cast<unsigned char>(line[end])) ||
+                              line[end] == '-'))
+      continue;  // a longer option name
+    for (const char* other : {"discrete:", "sectional:", "mono:"})
+      if (line.find(other) != std::string::npos && std::string(other) != method + ":")
+        return false;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("the README's sectional smol example reaches its t_end", "[cli][smol]") {
+  // README, CLI tour: "$G smol --beta 3 --method sectional --t-end 1e7 --out S.csv". It used to
+  // stop at t = 5.6e6 ("raise the largest size, --M", an option the sectional method ignores).
+  const std::string readme = granagg::test::slurp(std::string(GRANAGG_SOURCE_DIR) + "/README.md");
+  const std::string example = "$G smol --beta 3 --method sectional --t-end 1e7 --out S.csv";
+  REQUIRE_THAT(readme, Catch::Contains(example));
+  const std::string out = tempPath("readme_S.csv");
+  std::remove(out.c_str());
+  const Run r = runGranagg("smol --beta 3 --method sectional --t-end 1e7 --out " + out);
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK_THAT(r.output, !Catch::Contains("stopped early"));
+  // the last row: t = t_end, valid, and the local slope at 3 beta / (beta + 3) = 1.5
+  std::istringstream table(granagg::test::slurp(out));
+  std::string line, last;
+  while (std::getline(table, line))
+    if (!line.empty() && line[0] != '#') last = line;
+  std::vector<std::string> cells;
+  std::istringstream row(last);
+  for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+  REQUIRE(cells.size() == 9);  // t,S,M0,M1,M2,z_local,mass_loss,valid,max_size
+  CHECK(std::stod(cells[0]) == Approx(1e7).epsilon(1e-12));
+  CHECK(std::stod(cells[5]) == Approx(1.5).margin(1e-4));
+  CHECK(cells[7] == "1");
+  std::remove(out.c_str());
+}
+
+TEST_CASE("a smol that stops early advises options of its own method", "[cli][smol]") {
+  struct Case {
+    std::string method, args;
+  };
+  // discrete: the size range M is too small; sectional: S beyond what any grid holds; mono: the
+  // mean size overflows (that one is an error, exit 1, and names --t-end).
+  for (const Case& c : {Case{"discrete", "--beta 3 --method discrete --M 100 --t-end 1e4"},
+                        Case{"sectional", "--beta 3 --method sectional --ratio 1.5 --t-end 1e80 "
+                                          "--per-decade 1"},
+                        Case{"mono", "--beta 3 --method mono --t-end 1e300"}}) {
+    INFO(c.args);
+    const Run r = runGranagg("smol " + c.args + " --out -");
+    INFO(r.output);
+    std::string advice;
+    for (std::istringstream in(r.output); std::getline(in, advice);)
+      if (advice.find("stopped early") != std::string::npos ||
+          advice.find("granagg: failed") != std::string::npos)
+        break;
+    REQUIRE_FALSE(advice.empty());
+    const std::vector<std::string> named = optionsNamed(advice);
+    CHECK_FALSE(named.empty());
+    for (const std::string& option : named) {
+      INFO(option);
+      CHECK(smolOptionServes(option, c.method));
+    }
+  }
 }
 
 TEST_CASE("kinetic restitution warns where the overlap exceeds a diameter", "[cli]") {

@@ -123,7 +123,8 @@ TEST_CASE("truncation is detected and never reported as valid", "[meanfield][dis
   o.max_size = 100;  // far too small for S ~ 1e2..1e3
   const SmolResult r = solveDiscrete(Kernel::beta(3.0), o);
   REQUIRE_FALSE(r.stopped_early.empty());
-  CHECK_THAT(r.stopped_early, Catch::Contains("raise --M"));
+  CHECK(r.stop_cause == StopCause::Truncation);
+  CHECK_THAT(r.stopped_early, Catch::Contains("M = 100 (the largest allowed)"));
   CHECK_FALSE(r.samples.back().valid);
   CHECK(r.samples.back().mass_loss > o.mass_loss_tolerance);
   for (std::size_t i = 0; i + 1 < r.samples.size(); ++i) CHECK(r.samples[i].valid);

@@ -219,6 +219,9 @@ TEST_CASE("sectional truncation is reported, never hidden", "[meanfield][section
   const SmolResult r = solveSectional(Kernel::constant(), o);
   REQUIRE(!r.samples.empty());
   CHECK(!r.stopped_early.empty());
+  CHECK(r.stop_cause == StopCause::Truncation);
+  CHECK_THAT(r.stopped_early, Catch::Contains("max_size 1000"));
+  CHECK_THAT(r.stopped_early, !Catch::Contains("--"));  // the solver names no command option
   CHECK(!r.samples.back().valid);
   CHECK(r.samples.back().mass_loss > o.mass_loss_tolerance);
   CHECK(r.samples.front().valid);
@@ -234,6 +237,73 @@ TEST_CASE("sectional truncation is reported, never hidden", "[meanfield][section
   // M0 still follows dM0/dt = -M0^2/2 minus nothing: escaping pairs leave as a pair, so M0 falls
   // below the exact value once mass escapes.
   CHECK(all.samples.back().M0 < 1.0 / (1.0 + 1e4 / 2.0));
+}
+
+TEST_CASE("sectional grid grows with S and agrees with a fixed grid that covers the solve",
+          "[meanfield][sectional]") {
+  // The README's example: beta = 3 to t = 1e7 (S ~ 2e11) outgrows the first grid (last pivot
+  // 1e12; the distribution's tail reaches it at t ~ 5e6). Reference: one fixed grid up to 1e16,
+  // which holds the whole solve. Growing only appends pivots, so both grids discretise the
+  // equation identically and differ only by CVODE's restarts: S to 1e-6 (rtol 1e-8, ~200
+  // outputs). Mass is conserved to 1e-10 as on any grid (the escaped mass stays ~0).
+  SectionalOptions o;
+  o.times = logSpacedTimes(0.01, 1e7, 181);
+  const SmolResult grown = solveSectional(Kernel::beta(3.0), o);
+  SectionalOptions fixed = o;
+  fixed.grow = false;
+  fixed.initial_size = 1e16;
+  const SmolResult ref = solveSectional(Kernel::beta(3.0), fixed);
+  CHECK(grown.stopped_early.empty());
+  CHECK(grown.stop_cause == StopCause::None);
+  CHECK(grown.stats.resizes >= 1);
+  CHECK(ref.stats.resizes == 0);
+  REQUIRE(grown.samples.size() == o.times.size());
+  REQUIRE(ref.samples.size() == o.times.size());
+  checkMass(grown);
+  checkMass(ref);
+  for (size_t i = 0; i < o.times.size(); ++i) {
+    INFO("t = " << o.times[i]);
+    CHECK(grown.samples[i].S == Approx(ref.samples[i].S).epsilon(1e-6));
+  }
+  CHECK(grown.samples.back().S > 1e11);
+  // local slope over the last factor 2 in t: z = 3 beta / (beta + 3) = 1.5
+  // (docs/model.md section 12)
+  const auto& s = grown.samples;
+  const size_t back = s.size() - 1, half = back - 6;  // 20 per decade: 6 outputs ~ factor 2
+  CHECK(std::log(s[back].S / s[half].S) / std::log(s[back].t / s[half].t) ==
+        Approx(1.5).margin(1e-4));
+
+  // The same end with one output time: nothing to check in between, so the mass that escaped
+  // past the first grid is noticed at t = 1e7 and the interval is integrated again.
+  SectionalOptions sparse;
+  sparse.times = {1e7};
+  const SmolResult one = solveSectional(Kernel::beta(3.0), sparse);
+  CHECK(one.stats.resizes >= 1);
+  REQUIRE(one.samples.size() == 1);
+  checkMass(one);
+  CHECK(one.samples[0].S == Approx(ref.samples.back().S).epsilon(1e-6));
+
+  // A fixed grid of the first size truncates, as before growth existed.
+  SectionalOptions small = o;
+  small.grow = false;
+  const SmolResult cut = solveSectional(Kernel::beta(3.0), small);
+  CHECK(cut.stop_cause == StopCause::Truncation);
+  CHECK_THAT(cut.stopped_early, Catch::Contains("the grid is fixed"));
+}
+
+TEST_CASE("sectional grid stops growing at its ceiling and says so", "[meanfield][sectional]") {
+  // ratio 1.5 reaches the largest pivot any grid holds, 1e100, in ~570 sections: S ~ 1e99 cannot
+  // be followed further, and no option changes that (StopCause::SizeCeiling, not Truncation).
+  SectionalOptions o;
+  o.ratio = 1.5;
+  o.times = logSpacedTimes(1.0, 1e80, 81);
+  const SmolResult r = solveSectional(Kernel::beta(3.0), o);
+  CHECK(r.stop_cause == StopCause::SizeCeiling);
+  CHECK_THAT(r.stopped_early, Catch::Contains("no grid goes beyond 1e+100"));
+  REQUIRE(r.samples.size() >= 2);
+  CHECK(std::isfinite(r.samples.back().S));
+  CHECK(r.samples[r.samples.size() - 2].valid);
+  CHECK(r.samples[r.samples.size() - 2].S > 1e90);
 }
 
 TEST_CASE("sectional initial distribution is mapped conserving number and mass",
