@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs what granagg needs from Debian's packages (idempotent: quiet when all is there) and
 # configures + builds the CPU build in ./build. Used by scripts/test.sh and scripts/demo.sh.
+# LAMMPS, fmt and Open MPI are for granagg-lammps (docs/lammps.md; `lammps` for the lmp binary
+# of the benchmarks); the build works without them and then leaves granagg-lammps out.
 #   GRANAGG_BUILD_DIR   build folder (default: build)
 #   GRANAGG_JOBS        parallel compile jobs (default: nproc)
 #   GRANAGG_SETUP_NO_BUILD=1   install the packages only (scripts/gpu_check.sh builds its own)
@@ -11,6 +13,7 @@ PACKAGES=(build-essential cmake pkg-config git
           libsundials-dev libeigen3-dev libboost-dev libgsl-dev libhdf5-dev catch2 libfftw3-dev
           librandom123-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libthrust-dev
           libomp-dev
+          liblammps-dev libfmt-dev libopenmpi-dev openmpi-bin lammps
           python3-matplotlib python3-numpy python3-h5py python3-mdanalysis)
 
 missing=()

@@ -1,0 +1,197 @@
+#include "md/lammps/LammpsInput.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/Csv.h"
+#include "md/config/ConfigParser.h"
+#include "md/engine/Engine.h"
+#include "md/io/InitialState.h"
+#include "md/potentials/SpringDashpot.h"
+
+namespace granagg::md::lammps {
+
+namespace {
+
+using common::formatReal;
+
+/// The density that gives a unit sphere unit mass (LAMMPS computes 4/3 pi R^3 density).
+constexpr double UNIT_DENSITY = 6.0 / M_PI;
+
+[[noreturn]] void cannot(const std::string& key, const std::string& value,
+                         const std::string& why) {
+  throw std::invalid_argument(key + " = " + value + " cannot run on LAMMPS: " + why);
+}
+
+}  // namespace
+
+void checkLammpsCanRun(const MdConfig& c) {
+  if (c.coulomb.K > 0.0) {
+    const CoulombConfig& cc = c.coulomb;
+    if (cc.method != "pppm")
+      cannot("coulomb.method", "\"" + cc.method + "\"",
+             "granagg-lammps runs LAMMPS's PPPM; use coulomb.method = \"pppm\"");
+    if (cc.every > 1)
+      cannot("coulomb.every", std::to_string(cc.every),
+             "granagg-lammps evaluates every force at every step (run_style verlet; granagg's "
+             "multiple time stepping is not translated); use 1 or \"auto\"");
+    if (cc.every_max > 1)
+      cannot("coulomb.every_max", std::to_string(cc.every_max),
+             "LAMMPS has no Coulomb interval that follows the gas; use 1 or \"auto\"");
+    if (cc.r_fast > 0.0)
+      cannot("coulomb.r_fast", formatReal(cc.r_fast),
+             "granagg-lammps has no near/far split of the Coulomb force (every force at every "
+             "step); use \"auto\"");
+    if (cc.skin > 0.0 && cc.skin != c.neighbor.skinCap())
+      cannot("coulomb.skin", formatReal(cc.skin),
+             "LAMMPS has one neighbour skin for all lists, neighbor.skin = " +
+                 formatReal(c.neighbor.skinCap()) + "; use \"auto\" or that value");
+  }
+}
+
+Frame initialStateOf(const MdConfig& cfg) {
+  // the rule of md::Simulation for a new run
+  if (cfg.system.initial == "random") return randomInitialState(cfg);
+  Frame init = readInitialState(cfg.system.initial, boxLength(cfg.system));
+  if (static_cast<int>(init.size()) != cfg.system.N)
+    throw std::invalid_argument("system.initial '" + cfg.system.initial + "' holds " +
+                                std::to_string(init.size()) +
+                                " particles but system.N = " + std::to_string(cfg.system.N));
+  assignInitialCharges(cfg, init);
+  return init;
+}
+
+std::string LammpsInput::text(const std::string& header) const {
+  std::string t = header;
+  if (!t.empty() && t.back() != '\n') t += '\n';
+  for (const auto& c : commands) t += c + '\n';
+  t += "run " + std::to_string(steps) + '\n';
+  return t;
+}
+
+LammpsInput translateConfig(const MdConfig& c, const Frame& state, const std::string& data_file,
+                            bool record_collisions) {
+  checkLammpsCanRun(c);
+  if (data_file.find_first_of(" \t\n\"'") != std::string::npos)
+    throw std::invalid_argument("--out: the output folder's path must not contain blanks or "
+                                "quotes (LAMMPS reads it as a word): " + data_file);
+  LammpsInput in;
+  auto& cmd = in.commands;
+  const double L = state.box;
+  const double skin = c.neighbor.skinCap();
+
+  cmd.push_back("units lj");
+  cmd.push_back("atom_style hybrid sphere charge");
+  cmd.push_back("boundary p p p");
+  cmd.push_back("newton on");
+  cmd.push_back("comm_modify vel yes");
+  cmd.push_back("read_data " + data_file);
+  cmd.push_back("set group all mass 1.0");
+
+  // contact model
+  std::string gran;
+  if (c.contact.model == "hertz") {
+    in.pair_style = "gran/hertz/history";
+    gran = in.pair_style + " " + formatReal(2.0 * c.contact.E) + " 0.0 " +
+           formatReal(4.0 * c.contact.D) + " 0.0 0.0 0";
+  } else if (c.contact.model == "spring_dashpot") {
+    const SpringDashpot::Params p =
+        SpringDashpot::makeParams(c.contact.stiffness, c.contact.restitution, c.contact.clamp);
+    in.pair_style = "gran/hooke/history";
+    gran = in.pair_style + " " + formatReal(p.k) + " 0.0 " + formatReal(p.gamma / 0.5) +
+           " 0.0 0.0 0";
+  } else {
+    cannot("contact.model", "\"" + c.contact.model + "\"", "no LAMMPS pair style for it");
+  }
+  if (c.contact.clamp) gran += " limit_damping";
+
+  in.coulomb = c.coulomb.K > 0.0;
+  if (in.coulomb) {
+    double sum_q2 = 0.0;
+    for (double q : state.charge) sum_q2 += q * q;
+    const CoulombDesign d =
+        designCoulomb(c.coulomb, state.size(), L, skin, 1, 1,
+                      std::max(sum_q2, static_cast<double>(state.size())));
+    in.coulomb_setup = d.setup;
+    cmd.push_back("pair_style hybrid/overlay " + gran + " coul/long " + formatReal(d.pppm.r_cut));
+    cmd.push_back("pair_coeff * * " + in.pair_style);
+    cmd.push_back("pair_coeff * * coul/long");
+    cmd.push_back("dielectric " + formatReal(1.0 / c.coulomb.K));
+    // LAMMPS's accuracy is an absolute force (relative to two unit charges at unit distance,
+    // without the dielectric) and granagg's is relative to K: a K
+    cmd.push_back("kspace_style pppm " + formatReal(c.coulomb.accuracy * c.coulomb.K));
+    const std::string m = std::to_string(d.pppm.mesh);
+    cmd.push_back("kspace_modify gewald " + formatReal(d.pppm.alpha) + " mesh " + m + " " + m +
+                  " " + m + " order " + std::to_string(d.pppm.order));
+    std::ostringstream s;
+    s << "coulomb: PPPM as granagg designs it for coulomb.accuracy = " << c.coulomb.accuracy
+      << ": alpha = " << d.pppm.alpha << ", r_cut = " << d.pppm.r_cut << ", mesh " << d.pppm.mesh
+      << "^3, order " << d.pppm.order << " (estimated relative error " << d.setup.estimated_error
+      << "); every force at every step (coulomb.every = 1)";
+    in.notes.push_back(s.str());
+  } else {
+    cmd.push_back("pair_style " + gran);
+    cmd.push_back("pair_coeff * *");
+  }
+
+  cmd.push_back("neighbor " + formatReal(skin) + " bin");
+  cmd.push_back("neigh_modify delay 0 every 1 check yes");
+  cmd.push_back("fix integrate all nve/sphere");
+  {
+    const ChargingConfig& q = c.charging;
+    std::string fix = std::string("fix ") + CHARGING_FIX_ID + " all granagg/charging pair " +
+                      in.pair_style + " seed " + std::to_string(c.system.seed) + " Q " +
+                      formatReal(q.Q) + " kappa " + formatReal(q.kappa) + " psi1 " +
+                      formatReal(q.psi1_min) + " " + formatReal(q.psi1_max) + " psi2 " +
+                      formatReal(q.psi2_fraction * q.kappa) + " exchange " +
+                      (q.mode == "exchange" ? "yes" : "no") + " max_overlap " +
+                      formatReal(c.run.max_overlap);
+    if (record_collisions) fix += " record yes";
+    cmd.push_back(fix);
+  }
+  in.dt = Engine::chooseTimeStep(c, &in.dt_reason);
+  in.steps = static_cast<std::int64_t>(std::llround(c.run.t_end / in.dt));
+  cmd.push_back("timestep " + formatReal(in.dt));
+  cmd.push_back("thermo_style custom step time temp pe");
+  cmd.push_back("thermo_modify norm no");
+  cmd.push_back("thermo " + std::to_string(std::max(1, c.output.observable_interval)));
+
+  const OutputConfig& o = c.output;
+  if (o.frames_per_decade > 0 || o.frame_interval > 0.0)
+    in.notes.push_back(
+        "output: granagg-lammps writes no trajectory yet (output.frames_per_decade, "
+        "output.frame_interval): observables.csv and final_state.csv only");
+  if (o.checkpoint_interval > 0 || o.checkpoint_wall_seconds > 0.0)
+    in.notes.push_back(
+        "output: granagg-lammps writes no checkpoint yet (output.checkpoint_interval, "
+        "output.checkpoint_wall_seconds)");
+  return in;
+}
+
+std::string lammpsDataText(const Frame& s) {
+  std::ostringstream t;
+  const std::string L = formatReal(s.box);
+  t << "granagg initial state (atom_style hybrid sphere charge; id = particle index + 1)\n\n"
+    << s.size() << " atoms\n1 atom types\n\n"
+    << "0 " << L << " xlo xhi\n0 " << L << " ylo yhi\n0 " << L << " zlo zhi\n\n"
+    << "Masses\n\n1 1\n\n"
+    << "Atoms # hybrid\n\n";
+  const std::string density = formatReal(UNIT_DENSITY);
+  const bool images = s.ix.size() == s.size();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    t << i + 1 << " 1 " << formatReal(s.x[i]) << ' ' << formatReal(s.y[i]) << ' '
+      << formatReal(s.z[i]) << " 1 " << density << ' '
+      << formatReal(s.charge.empty() ? 0.0 : s.charge[i]);
+    if (images) t << ' ' << s.ix[i] << ' ' << s.iy[i] << ' ' << s.iz[i];
+    t << '\n';
+  }
+  t << "\nVelocities\n\n";
+  for (std::size_t i = 0; i < s.size(); ++i)
+    t << i + 1 << ' ' << formatReal(s.vx[i]) << ' ' << formatReal(s.vy[i]) << ' '
+      << formatReal(s.vz[i]) << " 0 0 0\n";
+  return t.str();
+}
+
+}  // namespace granagg::md::lammps

@@ -1,0 +1,258 @@
+// granagg-lammps under mpirun: the charge exchanged at a collision (to the bit), the restitution
+// of a collision against granagg's engine, a charged gas on 2 ranks (charge conservation, every
+// collision charging exactly once, the same collisions as on 1 rank) and bad input.
+#include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "cli/RunCommand.h"
+#include "common/Csv.h"
+#include "md/config/ConfigParser.h"
+#include "md/engine/Engine.h"
+#include "md/io/InitialState.h"
+#include "md/potentials/ChargeExchange.h"
+
+#include "TestUtil.h"
+
+using namespace granagg;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// granagg-lammps on `ranks` MPI ranks (Open MPI's mpirun; everything may run as root here, and
+/// a machine may have fewer cores than ranks).
+Run lammpsRun(int ranks, const std::string& args) {
+  std::string launch = std::string(GRANAGG_MPIEXEC) + " --oversubscribe -np " +
+                       std::to_string(ranks);
+  if (::geteuid() == 0) launch += " --allow-run-as-root";
+  return sh("OMP_NUM_THREADS=1 " + launch + " " + GRANAGG_LAMMPS_BINARY + " " + args);
+}
+
+std::string writeFile(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+/// Two particles on the x axis at y = z = 2.5 in a box of edge 5, approaching head-on at
+/// relative speed v, 0.002 apart; on 2 ranks the box is cut at x = 2.5, between them.
+const double TWO_BODY_L = 5.0;
+const char* TWO_BODY_PHI = "0.008377580409572781";  // 2 pi / (6 * 125): L = 5
+std::string twoBodyState(const fs::path& dir, double v) {
+  const std::string h = common::formatReal(0.5 * v);
+  return writeFile(dir / "two.csv", "x,y,z,vx,vy,vz,q\n1.999,2.5,2.5," + h + ",0,0,0\n" +
+                                        "3.001,2.5,2.5,-" + h + ",0,0,0\n");
+}
+
+std::string twoBodyConfig(const fs::path& dir, const std::string& state, const std::string& mode,
+                          double dt, double t_end) {
+  return writeFile(dir / "two.toml",
+                   std::string("[system]\nN = 2\nphi = ") + TWO_BODY_PHI + "\nseed = 987654321\n" +
+                       "initial = \"" + state + "\"\n[charging]\nmode = \"" + mode +
+                       "\"\n[integrator]\ndt = " + common::formatReal(dt) +
+                       "\n[run]\nt_end = " + common::formatReal(t_end) +
+                       "\n[output]\nobservable_interval = 1000000000\nframes_per_decade = 0\n" +
+                       "checkpoint_wall_seconds = 0.0\n");
+}
+
+}  // namespace
+
+TEST_CASE("granagg-lammps exchanges at a collision exactly the charge of ChargeExchange",
+          "[lammps][mpi]") {
+  const fs::path dir = test::tempDir("lammps_charge");
+  const double v = 0.5, dt = 1e-3;
+  const std::string state = twoBodyState(dir, v);
+  const std::string cfg = twoBodyConfig(dir, state, "exchange", dt, 0.05);
+  // 2 ranks: the pair meets across the rank boundary (each rank owns one particle)
+  const Run r = lammpsRun(2, "--config " + cfg + " --out " + (dir / "o").string() +
+                                 " --collisions -q");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+
+  // the step of the collision, independently: the free drift x += dt u of both particles (fix
+  // nve/sphere's arithmetic; no force acts before the contact) until their distance is below 1
+  double x0 = 1.999, x1 = 3.001;
+  std::int64_t step = 0;
+  double rx = 0.0;
+  do {
+    x0 += dt * (0.5 * v);
+    x1 += dt * -(0.5 * v);
+    ++step;
+    rx = x0 - x1;
+  } while (!(rx * rx < 1.0));
+  // the approach speed as the engine computes it (md/compute/ContactForce.cpp) from the velocities,
+  // which before the contact are the initial ones: xi' = -(v_0 - v_1).(r/|r|)
+  const double r_len = std::sqrt(rx * rx);
+  const double xi_dot = -((0.5 * v - -(0.5 * v)) * (rx * (1.0 / r_len)));
+  md::ChargeExchange::Params p;
+  p.seed = 987654321;
+  const double dq0 = md::ChargeExchange::transferTo(p, step, 0, 1, xi_dot);
+
+  const common::CsvTable coll = common::readCsv((dir / "o" / "collisions.csv").string());
+  REQUIRE(coll.rows.size() == 1);
+  const auto& c = coll.rows[0];
+  CHECK(c[coll.column("step")] == step);
+  CHECK(c[coll.column("id_lo")] == 0);
+  CHECK(c[coll.column("id_hi")] == 1);
+  CHECK(test::sameBits(c[coll.column("xi_dot")], xi_dot));
+  CHECK(test::sameBits(c[coll.column("dq_lo")], dq0));
+  CHECK(dq0 != 0.0);
+  // the charges at the end: the exchange and nothing else, to the bit
+  const common::CsvTable fin = common::readCsv((dir / "o" / "final_state.csv").string());
+  REQUIRE(fin.rows.size() == 2);
+  CHECK(test::sameBits(fin.rows[0][fin.column("q")], dq0));
+  CHECK(test::sameBits(fin.rows[1][fin.column("q")], -dq0));
+
+  // granagg's engine from the same state gives the same charges at the same step
+  const md::MdConfig mc = md::parseConfigFile(cfg);
+  md::Engine engine(mc, md::readInitialState(state, TWO_BODY_L));
+  engine.run(step - 1);
+  CHECK(engine.observables().collisions == 0);
+  engine.run(1);
+  CHECK(engine.observables().collisions == 1);
+  const md::Frame f = engine.frame();
+  CHECK(test::sameBits(f.charge[0], dq0));
+  CHECK(test::sameBits(f.charge[1], -dq0));
+}
+
+TEST_CASE("granagg-lammps gives a two-body collision the restitution of granagg's engine",
+          "[lammps][mpi]") {
+  const fs::path dir = test::tempDir("lammps_restitution");
+  // dt = 1e-6: LAMMPS's fix nve/sphere evaluates the damping with the half-step velocity, an
+  // error first order in dt in the restitution (3.9e-7 here, 4e-6 at dt = 1e-5;
+  // docs/benchmarks.md); the engine predicts the full-step velocity
+  const double v = 0.5, dt = 1e-6, t_end = 0.45;  // the contact ends by t = 0.4
+  const std::string state = twoBodyState(dir, v);
+  const std::string cfg = twoBodyConfig(dir, state, "fixed", dt, t_end);
+  const Run r = lammpsRun(1, "--config " + cfg + " --out " + (dir / "o").string() + " -q");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const common::CsvTable fin = common::readCsv((dir / "o" / "final_state.csv").string());
+  REQUIRE(fin.rows.size() == 2);
+  const std::size_t vx = fin.column("vx");
+  const double e_lammps = (fin.rows[1][vx] - fin.rows[0][vx]) / v;
+
+  const md::MdConfig mc = md::parseConfigFile(cfg);  // the same configuration, dt included
+  md::Engine engine(mc, md::readInitialState(state, TWO_BODY_L));
+  engine.run(std::llround(t_end / dt));
+  const md::Frame f = engine.frame();
+  const double e_engine = (f.vx[1] - f.vx[0]) / v;
+  INFO("e LAMMPS " << std::setprecision(12) << e_lammps << ", engine " << e_engine);
+  CHECK(e_engine == Approx(0.370093).margin(1e-6));  // `granagg kinetic restitution --v 0.5`
+  CHECK(std::fabs(e_lammps - e_engine) < 1e-6);
+  CHECK(engine.observables().elastic_energy == 0.0);  // the contact is over in both
+}
+
+TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collision",
+          "[lammps][mpi]") {
+  const fs::path dir = test::tempDir("lammps_gas");
+  const int N = 1000;
+  const double dt = 0.003;
+  auto config = [&](const std::string& name, int steps) {
+    return writeFile(dir / name,
+                     "[system]\nN = " + std::to_string(N) +
+                         "\nseed = 42\n[charging]\ninitial = \"bipolar\"\nq0 = 0.05\nQ = 0.05\n"
+                         "[coulomb]\nK = 5\n[integrator]\ndt = 0.003\n[run]\nt_end = " +
+                         common::formatReal(steps * dt) +
+                         "\n[output]\nobservable_interval = 25\nframes_per_decade = 0\n"
+                         "checkpoint_wall_seconds = 0.0\n");
+  };
+  const Run two = lammpsRun(2, "--config " + config("long.toml", 500) + " --out " +
+                                   (dir / "two").string() + " --collisions");
+  INFO(two.output);
+  REQUIRE(two.status == 0);
+  const Run one = lammpsRun(1, "--config " + config("short.toml", 50) + " --out " +
+                                   (dir / "one").string() + " --collisions -q");
+  INFO(one.output);
+  REQUIRE(one.status == 0);
+
+  // particles crossed the boundaries between the ranks' domains
+  std::smatch m;
+  REQUIRE(std::regex_search(two.output, m, std::regex("([0-9]+) migrations between ranks")));
+  CHECK(std::stol(m[1]) > 100);
+
+  // the total charge at every sample, to 1e-12 N max|q| (the exchange rule conserves it exactly;
+  // what remains is the rounding of the per-particle sums)
+  const common::CsvTable obs = common::readCsv((dir / "two" / "observables.csv").string());
+  REQUIRE(obs.rows.size() == 21);  // steps 0, 25, ..., 500
+  const md::Frame init = md::readInitialStateLammps((dir / "two" / "initial.data").string());
+  double q_init = 0.0;
+  for (double q : init.charge) q_init += q;
+  for (const auto& row : obs.rows)
+    CHECK(std::fabs(row[obs.column("total_charge")] - q_init) <=
+          1e-12 * N * row[obs.column("max_abs_charge")]);
+  CHECK(obs.rows.back()[obs.column("mean_abs_charge")] > 0.06);  // charges grew
+
+  // every collision charged each partner exactly once: the final charges are the initial ones plus
+  // the sum of the logged exchanges, within the rounding of the per-step sums
+  const common::CsvTable coll = common::readCsv((dir / "two" / "collisions.csv").string());
+  const std::size_t cs = coll.column("step"), clo = coll.column("id_lo"),
+                    chi = coll.column("id_hi"), cdq = coll.column("dq_lo");
+  std::vector<double> q = init.charge;
+  double max_q = 0.0;
+  std::set<std::tuple<long, long, long>> seen;
+  for (const auto& row : coll.rows) {
+    CHECK(seen.insert({std::lround(row[cs]), std::lround(row[clo]), std::lround(row[chi])}).second);
+    q[static_cast<std::size_t>(row[clo])] += row[cdq];
+    q[static_cast<std::size_t>(row[chi])] -= row[cdq];
+  }
+  const common::CsvTable fin = common::readCsv((dir / "two" / "final_state.csv").string());
+  REQUIRE(fin.rows.size() == static_cast<std::size_t>(N));
+  for (double x : q) max_q = std::max(max_q, std::fabs(x));
+  int wrong = 0;
+  for (int i = 0; i < N; ++i)
+    wrong += !(std::fabs(fin.rows[i][fin.column("q")] - q[i]) <= 1e-12 * max_q);
+  CHECK(wrong == 0);
+  CHECK(coll.rows.back()[cs] > 400);
+  CHECK(static_cast<double>(coll.rows.size()) == obs.rows.back()[obs.column("collisions")]);
+
+  // the same collisions as on 1 rank over the first 50 steps (the trajectories agree to rounding
+  // there), with the same exchanges up to that rounding
+  const common::CsvTable ref = common::readCsv((dir / "one" / "collisions.csv").string());
+  std::vector<std::vector<double>> first;
+  for (const auto& row : coll.rows)
+    if (row[cs] <= 50) first.push_back(row);
+  CHECK(ref.rows.size() >= 20);
+  REQUIRE(first.size() == ref.rows.size());
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    INFO("collision " << k);
+    CHECK(first[k][cs] == ref.rows[k][cs]);
+    CHECK(first[k][clo] == ref.rows[k][clo]);
+    CHECK(first[k][chi] == ref.rows[k][chi]);
+    CHECK(first[k][cdq] == Approx(ref.rows[k][cdq]).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("granagg-lammps rejects a key LAMMPS cannot honour: exit 2, the key named, nothing "
+          "written",
+          "[lammps][mpi]") {
+  const fs::path dir = test::tempDir("lammps_bad");
+  for (const std::string& set : {std::string("--set coulomb.K=5 --set coulomb.every=8"),
+                                 std::string("--set coulomb.K=5 --set coulomb.r_fast=3"),
+                                 std::string("--set system.bogus=1")}) {
+    INFO(set);
+    const Run r = lammpsRun(2, "--preset quick " + set + " --out " + (dir / "o").string());
+    CHECK(r.status == 2);
+    const std::size_t from = set.rfind("--set ") + 6;
+    const std::string key = set.substr(from, set.rfind('=') - from);
+    CHECK_THAT(r.output, Catch::Contains(key));
+    CHECK(!fs::exists(dir / "o"));
+  }
+  // an output folder in the way
+  fs::create_directories(dir / "full");
+  writeFile(dir / "full" / "x", "x");
+  const Run r = lammpsRun(1, "--preset quick --out " + (dir / "full").string());
+  CHECK(r.status == 2);
+  CHECK_THAT(r.output, Catch::Contains("--force"));
+}
