@@ -140,6 +140,10 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
                   const std::string& command_line, const common::PaperValues& paper, bool force) {
   const FitBetaFiles f = fitBetaFiles(folder);
   const double nan = NaN;
+  // A beta at a bound of the search range is not a result: NaN in the CSVs, null in the JSON
+  // (the bound is in curve_fit_note). S_c, tau_c stay: the best curve at that bound.
+  const bool beta_fit_known = r.request.curve_fit && !r.curve.at_bound;
+  const double beta_fit = beta_fit_known ? r.curve.beta : nan;
   const common::FolderLock lock = common::FolderLock::acquire(folder, command_line, force);
   if (!r.request.curve_fit && force) fs::remove(f.curve);  // a stale curve would mislead
   common::Provenance prov(command_line);
@@ -185,8 +189,8 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
           "t0, t1; n_runs: runs in the input; beta_from_z_scaled*: as beta_from_z at [S0, S1] / "
           "S_c; "
           "beta_asymptotic*: 3 z / (3 - z) (the large-S law inverted) at z, z_low, z_high; "
-          "beta_fit_determined: 0 when beta_fit lies at a bound of the search range; NaN = not "
-          "available"));
+          "beta_fit_determined: 0 when beta_fit lies at a bound of the search range (beta_fit "
+          "is NaN then); NaN = not available"));
   {
     common::CsvWriter w(f.csv, sp,
                         {"z",
@@ -228,7 +232,7 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
            r.from_z.beta,
            r.from_z.beta_low,
            r.from_z.beta_high,
-           r.curve.beta,
+           beta_fit,
            r.curve.beta_low,
            r.curve.beta_high,
            r.curve.S_c,
@@ -255,12 +259,14 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
     cp.add(
         "columns",
         std::string(
-            "t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit); "
+            "t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit) "
+            "(NaN when beta_fit is not determined); "
             "S_mf_beta2, S_mf_beta3: the mean field for beta = 2 and 3 with the same S_c, tau_c"));
     common::CsvWriter w(f.curve, cp, {"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"},
                         force);
     for (std::size_t i = 0; i < r.data.t.size(); ++i)
-      w.row({r.data.t[i], r.data.S[i], r.curve.S_fitted[i], r.S_mf_beta2[i], r.S_mf_beta3[i]});
+      w.row({r.data.t[i], r.data.S[i], beta_fit_known ? r.curve.S_fitted[i] : nan,
+             r.S_mf_beta2[i], r.S_mf_beta3[i]});
     w.close();
   }
   {
@@ -301,8 +307,8 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
     j["z_mf_beta2_window"] = num(r.z_mf_beta2);
     j["z_mf_beta3_window"] = num(r.z_mf_beta3);
     j["curve_fit"] = r.request.curve_fit;
-    j["beta_fit_determined"] = r.request.curve_fit && !r.curve.at_bound;
-    j["beta_fit"] = num(r.curve.beta);
+    j["beta_fit_determined"] = beta_fit_known;
+    j["beta_fit"] = num(beta_fit);
     j["beta_fit_low"] = num(r.curve.beta_low);
     j["beta_fit_high"] = num(r.curve.beta_high);
     j["S_c"] = num(r.curve.S_c);

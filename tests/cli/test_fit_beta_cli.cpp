@@ -182,6 +182,42 @@ TEST_CASE("fit-beta recovers z of an exact power law exactly", "[cli][fitbeta]")
   fs::remove_all(dir);
 }
 
+TEST_CASE("fit-beta writes no number for a beta_fit at a bound of the search range",
+          "[cli][fitbeta]") {
+  // S = t^2.6 grows faster than every mean-field curve in [1.5, 6] (z = 3 beta / (beta + 3) <= 2):
+  // the curve fit ends at beta = 6, which is the search bound, not a result. It used to be
+  // written as beta_fit = 6 in fit_beta.csv and fit_beta.json.
+  const fs::path dir = tempDir("bound");
+  std::vector<std::vector<double>> rows;
+  for (int i = 0; i < 30; ++i) {
+    const double t = std::pow(10.0, 0.1 * i);
+    rows.push_back({t, std::pow(t, 2.6)});
+  }
+  writeCsv(dir / "S.csv", "t,S", rows);
+  const Run r = runGranagg("fit-beta " + (dir / "S.csv").string() + " --out " +
+                           (dir / "o").string());
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK_THAT(r.output, Catch::Contains("not determined (at the bound 6"));
+  const auto row = readRow(dir / "o" / "fit_beta.csv");
+  CHECK(std::isnan(row.at("beta_fit")));
+  CHECK(std::isnan(row.at("beta_fit_low")));
+  CHECK(std::isnan(row.at("beta_fit_high")));
+  CHECK(row.at("beta_fit_determined") == 0.0);
+  const std::string json = slurp(dir / "o" / "fit_beta.json");
+  CHECK_THAT(json, Catch::Contains("\"beta_fit\": null"));
+  CHECK_THAT(json, Catch::Contains("\"beta_fit_determined\": false"));
+  CHECK_THAT(json, Catch::Contains("\"beta_max\": 6.0"));  // the bound is still recorded
+  // no curve drawn for an undetermined beta; the data and the beta = 2, 3 curves stay
+  const auto curve = granagg::common::readCsv((dir / "o" / "fit_curve.csv").string());
+  REQUIRE(curve.rows.size() == rows.size());
+  for (const auto& c : curve.rows) {
+    CHECK(std::isnan(c[curve.column("S_mf_fitted")]));
+    CHECK(std::isfinite(c[curve.column("S_md")]));
+    CHECK(std::isfinite(c[curve.column("S_mf_beta3")]));
+  }
+}
+
 TEST_CASE("fit-beta recovers beta = 2.5 from noisy mean-field S(t) given as CSV",
           "[cli][fitbeta]") {
   // S = S_c S_MF(t / tau_c; 2.5) exp(0.03 eps), S_c = 1.4, tau_c = 6: the curve fit's interval
