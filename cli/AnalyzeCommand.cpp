@@ -52,6 +52,8 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
                         (hint ? "/" + std::to_string(hint) : std::string()));
       });
   progress.finish();
+  for (const std::string& line : an::analysisWarnings(folder, o))  // even with -q
+    std::fprintf(stderr, "analyze: warning: %s\n", line.c_str());
   if (a.quiet) return;
   for (const std::string& line : an::analysisReport(folder))
     std::fprintf(stderr, "analyze: %s\n", line.c_str());

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "analysis/io/AnalysisFile.h"
+#include "analysis/stats/PowerLawFit.h"
 #include "common/FolderLock.h"
 #include "common/Strings.h"
 
@@ -202,6 +203,52 @@ std::vector<std::string> analysisReport(const AnalysisFolder& folder) {
             "onset (S_grid reaches %g x its median %.4g over t <= %g) at t_c = %.4g",
             c("onset_factor"), c("onset_S_base_grid"), c("onset_t_base"), c("onset_time_grid")));
     }
+  return lines;
+}
+
+std::vector<std::string> analysisWarnings(const AnalysisFolder& folder,
+                                          const AnalysisOptions& o) {
+  std::vector<std::string> lines;
+  using common::formatReal;
+  // A run stopped before its end: the last frame lies more than a step before run.t_end (the
+  // final step is the nearest whole step to t_end, within dt / 2 of it).
+  for (std::size_t k = 0; k < folder.runs.size(); ++k) {
+    const RunResult& r = folder.runs[k];
+    const auto t_end_text = r.parameters.find("run.t_end");
+    const auto dt_text = r.parameters.find("dt");
+    double t_end = 0.0, dt = 0.0;
+    if (t_end_text == r.parameters.end() || !common::parseReal(t_end_text->second, t_end) ||
+        !(t_end > 0.0) || !r.hasTable("S_t"))
+      continue;
+    if (dt_text == r.parameters.end() || !common::parseReal(dt_text->second, dt) || !(dt > 0.0))
+      dt = 1e-9 * t_end;
+    const std::vector<double> t = r.table("S_t").values("t");
+    if (!t.empty() && t.back() < t_end - dt)
+      lines.push_back("run " + std::to_string(k) + " (" + r.source + ") ends at t = " +
+                      formatReal(t.back()) + ", before its run.t_end = " + formatReal(t_end) +
+                      ": an unfinished run (granagg md --restart on its folder continues it)");
+  }
+  // The growth-exponent window: the frames a fit would use (fitPowerLaw's rule, 3 at least).
+  const Table* st = nullptr;
+  for (const Table& t : folder.ensemble)
+    if (t.name == "S_t") st = &t;
+  if (!st && !folder.runs.empty() && folder.runs.front().hasTable("S_t"))
+    st = &folder.runs.front().table("S_t");
+  if (st && !st->rows.empty()) {
+    const std::vector<double> t = st->values("t");
+    const bool given = o.fit_t_min > 0 || o.fit_t_max > 0;
+    const double w0 = given ? o.fit_t_min : t.back() / 10.0;
+    const double w1 = given && o.fit_t_max > 0 ? o.fit_t_max : t.back();
+    std::size_t inside = 0;
+    for (double x : t)
+      inside += x > 0 && x >= w0 * (1 - WINDOW_SLACK) && x <= w1 * (1 + WINDOW_SLACK);
+    if (inside < 3)
+      lines.push_back(
+          std::string(given ? "--fit-window" : "the growth-exponent window (the last decade)") +
+          " [" + formatReal(w0) + ", " + formatReal(w1) + "] holds " + std::to_string(inside) +
+          " frame" + (inside == 1 ? "" : "s") + " (a fit needs 3; the frames span t = " +
+          formatReal(t.front()) + " .. " + formatReal(t.back()) + "): z is NaN in fits.csv");
+  }
   return lines;
 }
 

@@ -47,4 +47,10 @@ common::Provenance analysisProvenance(const std::string& command_line,
 /// The summary for the terminal, one line each (without a prefix).
 std::vector<std::string> analysisReport(const AnalysisFolder& folder);
 
+/// What a reader of the tables must be told even when the summary is not wanted, one line each
+/// (without a prefix): a growth-exponent window holding too few frames for a fit (z is NaN), and
+/// a trajectory that ends before the run.t_end in its /parameters (an unfinished run).
+std::vector<std::string> analysisWarnings(const AnalysisFolder& folder,
+                                          const AnalysisOptions& options);
+
 }  // namespace granagg::analysis

@@ -6,11 +6,13 @@
 #include "RunCommand.h"
 
 #include <unistd.h>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include "common/Csv.h"
+#include "common/Hdf5.h"
 
 #include "TestUtil.h"
 
@@ -172,5 +174,69 @@ TEST_CASE("analyze of an md ensemble writes ensemble and per-run tables and anal
   } else {
     WARN("h5py not available: analysis.h5 layout not checked from Python");
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("analyze warns when the growth-exponent window holds too few frames",
+          "[cli][analyze]") {
+  // The run's frames lie in t = 0 .. 1; a window over [100, 200] holds none, so z is NaN. That
+  // used to pass in silence with exit status 0.
+  const fs::path dir = tempDir("window");
+  const fs::path run = mdRun(dir, "run", 4);
+  const Run r = runGranagg("analyze " + run.string() + " --out " + (dir / "o").string() +
+                           " --fit-window 100 200 -q");
+  INFO(r.output);
+  CHECK(r.status == 0);  // the tables are still written: a warning, not an error
+  CHECK_THAT(r.output, Catch::Contains("analyze: warning: --fit-window [100, 200] holds 0 frames"));
+  CHECK_THAT(r.output, Catch::Contains("the frames span t = 0 .. 0.99"));
+  const auto fits = granagg::common::readCsv((dir / "o" / "fits.csv").string());
+  REQUIRE(fits.rows.size() == 1);
+  CHECK(std::isnan(fits.rows[0][fits.column("z_particle")]));
+  // a window holding frames, and the default window (the last decade): no such warning
+  for (const std::string window : {" --fit-window 0.1 1", ""}) {
+    const Run ok = runGranagg("analyze " + run.string() + " --out " + (dir / "o2").string() +
+                              window + " -q --force");
+    INFO(ok.output);
+    CHECK(ok.status == 0);
+    CHECK_THAT(ok.output, !Catch::Contains("holds"));
+  }
+  // a dump of two frames (t = 0 and 10) cannot hold 3 in its last decade: said, not hidden
+  const Run two = runGranagg("analyze " + tinyDump(dir, false) + " --out " +
+                             (dir / "o3").string() + " -q");
+  CHECK(two.status == 0);
+  CHECK_THAT(two.output, Catch::Contains("the growth-exponent window (the last decade) [1, 10] "
+                                         "holds 1 frame"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("analyze says when a trajectory ends before its run.t_end", "[cli][analyze]") {
+  // A finished run of t_end = 1, then the same file with /parameters saying run.t_end = 2: what an
+  // interrupted run looks like (its frames stop before the configured end).
+  const fs::path dir = tempDir("unfinished");
+  const fs::path run = mdRun(dir, "run", 5);
+  const Run done = runGranagg("analyze " + run.string() + " --out " + (dir / "o1").string() +
+                              " -q");
+  INFO(done.output);
+  CHECK(done.status == 0);
+  CHECK_THAT(done.output, !Catch::Contains("run.t_end"));
+
+  const fs::path cut = dir / "cut";
+  fs::create_directories(cut);
+  fs::copy_file(run / "traj.h5", cut / "traj.h5");
+  {
+    namespace h5 = granagg::common::h5;
+    h5::Handle file(H5Fopen((cut / "traj.h5").c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    REQUIRE(file.valid());
+    h5::Handle par(H5Gopen2(file.get(), "parameters", H5P_DEFAULT));
+    REQUIRE(par.valid());
+    REQUIRE(H5Adelete(par.get(), "run.t_end") >= 0);
+    h5::writeAttribute(par.get(), "run.t_end", 2.0, "test");
+  }
+  const Run r = runGranagg("analyze " + cut.string() + " --out " + (dir / "o2").string() + " -q");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK_THAT(r.output,
+             Catch::Contains("analyze: warning: run 0 (" + cut.string() + ") ends at t = "));
+  CHECK_THAT(r.output, Catch::Contains("before its run.t_end = 2: an unfinished run"));
   fs::remove_all(dir);
 }
