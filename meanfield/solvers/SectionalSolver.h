@@ -29,8 +29,9 @@
 /// geometric pivots as the distribution spreads, so S is bounded by the section budget
 /// (4096 sections: a last pivot of 5e87 at r = 1.05; at most ~1e100 at any r), not by a size
 /// fixed in advance. Appending keeps every pivot and N_i, so no state is remapped; CVODE restarts
-/// from the current state (a few small steps). The grid grows (a) at an output time when the largest section holding mass, x_hi,
-/// has come within a factor GROW_TRIGGER = 100 of the last pivot, to GROW_TARGET = 1e6 x_hi;
+/// from the current state (a few small steps). The grid grows (a) at an output time when the
+/// largest section holding mass, x_hi, has come within a factor GROW_TRIGGER = 100 of the last
+/// pivot, to GROW_TARGET = 1e6 x_hi;
 /// (b) when mass escaped during the last output interval all the same (sparse output times,
 /// fast growth): the interval is integrated again from the previous output on the larger grid.
 /// A solve that never comes near the initial grid's end takes exactly the steps of a fixed grid.
