@@ -256,3 +256,13 @@ TEST_CASE("granagg-lammps rejects a key LAMMPS cannot honour: exit 2, the key na
   CHECK(r.status == 2);
   CHECK_THAT(r.output, Catch::Contains("--force"));
 }
+
+TEST_CASE("granagg-lammps stops at an overlap beyond run.max_overlap, naming the particles",
+          "[lammps][mpi]") {
+  const fs::path dir = test::tempDir("lammps_overlap");
+  const Run r = lammpsRun(2, "--preset quick --set system.N=500 --set run.t_end=1 "
+                             "--set run.max_overlap=0.01 -q --out " + (dir / "o").string());
+  CHECK(r.status == 1);
+  CHECK(std::regex_search(r.output, std::regex("step [0-9]+: overlap 0\\.01[0-9]* of particles "
+                                               "[0-9]+ and [0-9]+ beyond run.max_overlap = 0.01")));
+}
