@@ -144,6 +144,7 @@ TEST_CASE("granagg-lammps gives a two-body collision the restitution of granagg'
   const double e_lammps = (fin.rows[1][vx] - fin.rows[0][vx]) / v;
 
   const md::MdConfig mc = md::parseConfigFile(cfg);  // the same configuration, dt included
+  md::Engine::setThreads(1);  // two particles: threads would only add their synchronisation
   md::Engine engine(mc, md::readInitialState(state, TWO_BODY_L));
   engine.run(std::llround(t_end / dt));
   const md::Frame f = engine.frame();
