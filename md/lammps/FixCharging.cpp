@@ -163,7 +163,14 @@ void FixCharging::post_integrate() {
     for (int k = 0; k < 3; ++k) m_fprev[i][k] = f[i][k];
 }
 
-void FixCharging::pre_force(int /*vflag*/) {
+void FixCharging::setup_pre_force(int /*vflag*/) {
+  // the contact statistics of the state a run starts from (no step is taken: no collisions)
+  scanContacts(false);
+}
+
+void FixCharging::pre_force(int /*vflag*/) { scanContacts(true); }
+
+void FixCharging::scanContacts(bool step_taken) {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
   double** x = atom->x;
   double** v = atom->v;
@@ -173,7 +180,8 @@ void FixCharging::pre_force(int /*vflag*/) {
   const double dt = update->dt;
   const std::int64_t step = update->ntimestep;
 
-  if (m_exchange) {
+  const bool exchange = m_exchange && step_taken;
+  if (exchange) {
     // predicted full-step velocities v(t_n) = u + (dt/2) f(t_{n-1}) / m: the arithmetic of fix
     // nve/sphere's kick (dtf / rmass), which with m = 1 is the engine's u + (dt/2) f
     const double dtf = 0.5 * dt * force->ftm2v;
@@ -212,12 +220,12 @@ void FixCharging::pre_force(int /*vflag*/) {
       // a collision: the separation one step earlier (the drift undone) was not a contact
       const double px = rx - dt * (v[i][0] - v[j][0]), py = ry - dt * (v[i][1] - v[j][1]),
                    pz = rz - dt * (v[i][2] - v[j][2]);
-      if (!(px * px + py * py + pz * pz >= R * R)) continue;
+      if (!step_taken || !(px * px + py * py + pz * pz >= R * R)) continue;
       ++m_collisions_local;
       const auto id_i = static_cast<std::uint32_t>(tag[i] - 1),
                  id_j = static_cast<std::uint32_t>(tag[j] - 1);
       double dqi = 0.0, xi_dot = 0.0;
-      if (m_exchange) {
+      if (exchange) {
         const double inv_r = 1.0 / r;
         const double nx = rx * inv_r, ny = ry * inv_r, nz = rz * inv_r;  // from j to i
         const double gx = m_vpred[i][0] - m_vpred[j][0], gy = m_vpred[i][1] - m_vpred[j][1],
@@ -248,7 +256,7 @@ void FixCharging::pre_force(int /*vflag*/) {
     std::fprintf(stderr, "granagg-lammps: %s\n", msg.str().c_str());
     error->one(FLERR, msg.str());
   }
-  if (m_exchange) comm->reverse_comm_fix(this);  // ghosts' shares to their owners
+  if (exchange) comm->reverse_comm_fix(this);  // ghosts' shares to their owners
 }
 
 void FixCharging::end_of_step() {

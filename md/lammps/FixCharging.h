@@ -90,6 +90,7 @@ class FixCharging : public LAMMPS_NS::Fix {
   void init() override;
   void setup(int vflag) override;
   void post_integrate() override;
+  void setup_pre_force(int vflag) override;
   void pre_force(int vflag) override;
   void end_of_step() override;
 
@@ -142,7 +143,9 @@ class FixCharging : public LAMMPS_NS::Fix {
   std::int64_t m_contacts = 0, m_migrations = 0;
   double m_overlap_sum = 0.0, m_max_overlap_now = 0.0, m_sum_xi52 = 0.0, m_sum_xi2 = 0.0;
   std::vector<CollisionRecord> m_records;
-  int m_comm_stage = 0;  ///< what the forward communication carries (pre_force only)
+  /// The pass over the contacts: statistics and the overlap guard; with step_taken (pre_force
+  /// of a step, not a run's setup) also the collisions and their exchange.
+  void scanContacts(bool step_taken);
 };
 
 }  // namespace granagg::md::lammps
