@@ -267,3 +267,31 @@ TEST_CASE("granagg-lammps stops at an overlap beyond run.max_overlap, naming the
   CHECK(std::regex_search(r.output, std::regex("step [0-9]+: overlap 0\\.01[0-9]* of particles "
                                                "[0-9]+ and [0-9]+ beyond run.max_overlap = 0.01")));
 }
+
+TEST_CASE("granagg-lammps samples the contacts of its initial state as the engine does",
+          "[lammps][mpi]") {
+  const fs::path dir = test::tempDir("lammps_initial_contacts");
+  // a pair overlapping by 0.1 at rest, and a free particle
+  const std::string state =
+      writeFile(dir / "s.csv", "x,y,z,vx,vy,vz,q\n1,1,1,0,0,0,0\n1.9,1,1,0,0,0,0\n"
+                               "3.5,3.5,3.5,0.1,0,0,0\n");
+  const std::string cfg = writeFile(
+      dir / "c.toml", "[system]\nN = 3\nphi = 0.02\ninitial = \"" + state +
+                          "\"\n[integrator]\ndt = 0.001\n[run]\nt_end = 0.002\n"
+                          "[output]\nframes_per_decade = 0\ncheckpoint_wall_seconds = 0.0\n");
+  const Run r = lammpsRun(1, "--config " + cfg + " --out " + (dir / "o").string() + " -q");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const common::CsvTable obs = common::readCsv((dir / "o" / "observables.csv").string());
+  REQUIRE(!obs.rows.empty());
+  const auto& row0 = obs.rows[0];
+  const md::MdConfig mc = md::parseConfigFile(cfg);
+  md::Engine::setThreads(1);
+  const md::Engine engine(mc, md::readInitialState(state, md::boxLength(mc.system)), true);
+  const md::Observables o = engine.observables();
+  CHECK(o.contacts_per_particle == Approx(2.0 / 3.0));
+  CHECK(row0[obs.column("contacts_per_particle")] == Approx(o.contacts_per_particle));
+  CHECK(row0[obs.column("max_overlap")] == Approx(o.max_overlap).epsilon(1e-12));
+  CHECK(row0[obs.column("elastic_energy")] == Approx(o.elastic_energy).epsilon(1e-12));
+  CHECK(row0[obs.column("collisions")] == 0);
+}
