@@ -14,6 +14,7 @@
 
 #include "cli/CliContext.h"
 #include "common/Csv.h"
+#include "common/OutputPath.h"
 #include "md/config/ConfigParser.h"
 #include "md/engine/Engine.h"
 #include "md/run/RunLog.h"
@@ -87,7 +88,9 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
             : md::parseConfigFile(
                   a.config.empty() ? findPreset("presets", a.preset, "--preset") : a.config,
                   overrides);
-    sim.emplace(md::Simulation::start(cfg, a.out.empty() ? "md-out" : a.out, options));
+    const std::string out = a.out.empty() ? "md-out" : a.out;
+    common::checkOutputFolder(out);  // before the initial state and the engine are built
+    sim.emplace(md::Simulation::start(cfg, out, options));
   }
   if (sim->finished()) {  // --restart of a run at its run.t_end: say so, write nothing
     std::fprintf(stderr,

@@ -1,6 +1,7 @@
 /// granagg: one executable, subcommands over the md / analysis / meanfield libraries.
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -85,6 +86,12 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "granagg: error: %s\n", e.what());
     return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // Outputs are checked before the work (common/OutputPath.h); this is a write that failed
+    // later (a disk that filled, a folder removed meanwhile): the path and the system's reason.
+    std::fprintf(stderr, "granagg: failed: '%s': %s\n", e.path1().string().c_str(),
+                 e.code().message().c_str());
+    return 1;
   } catch (const cli::Interrupted& e) {
     std::fprintf(stderr, "granagg: stopped: %s\n", e.what());
     return e.status();

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/OutputPath.h"
 #include "common/Strings.h"
 #include "common/Version.h"
 
@@ -34,6 +35,12 @@ std::string commandLine(int argc, const char* const* argv) {
       line += a;
   }
   return line;
+}
+
+void CsvTarget::checkWritable() const {
+  if (path == "-") return;
+  checkOutputFile(path, "--out");  // a folder given as the file, a missing or read-only folder
+  refuseToOverwrite();
 }
 
 void refuseToOverwrite(const std::string& path, bool overwrite) {

@@ -82,6 +82,9 @@ struct CsvTarget {
   /// Throws std::invalid_argument if the table would replace a file without `force` (so that a
   /// command can refuse before it computes anything).
   void refuseToOverwrite() const { common::refuseToOverwrite(path == "-" ? "" : path, force); }
+  /// refuseToOverwrite(), and refuses a path whose folder is missing or takes no new file
+  /// (common::checkOutputFile, naming --out): what a command checks before it computes.
+  void checkWritable() const;
 };
 
 /// A CSV table read back: provenance comments, column names and rows.

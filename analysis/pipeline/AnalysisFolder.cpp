@@ -12,6 +12,7 @@
 #include "analysis/io/AnalysisFile.h"
 #include "analysis/stats/PowerLawFit.h"
 #include "common/FolderLock.h"
+#include "common/OutputPath.h"
 #include "common/Strings.h"
 
 namespace granagg::analysis {
@@ -40,6 +41,7 @@ void checkAnalysisFolderRequest(const AnalysisFolderRequest& request) {
   if (fs::exists(out) && !fs::is_directory(out))
     throw std::invalid_argument("--out '" + out.string() +
                                 "' is a file, not a folder; analyze writes a folder");
+  common::checkOutputFolder(out, "--out");  // read-only, or below a file: refused before reading
   common::FolderLock::checkAvailable(out, request.force);
   if (fs::exists(out) && !fs::is_empty(out) && !request.force)
     throw std::invalid_argument(

@@ -12,6 +12,7 @@
 
 #include "common/Csv.h"
 #include "common/FolderLock.h"
+#include "common/OutputPath.h"
 #include "common/Strings.h"
 #include "common/Version.h"
 
@@ -130,6 +131,7 @@ FitBetaFiles fitBetaFiles(const std::string& folder) {
 
 void checkFitBetaOutputs(const std::string& folder, bool curve_fit, bool force) {
   const FitBetaFiles f = fitBetaFiles(folder);
+  common::checkOutputFolder(folder, "--out");         // a file, read-only or not creatable
   common::FolderLock::checkAvailable(folder, force);  // another command writing there: refused
   common::refuseToOverwrite(f.csv, force);
   common::refuseToOverwrite(f.json, force);

@@ -83,7 +83,7 @@ std::vector<double> tableTimes(double t_min, double t_end, int points) {
 void writeTable(const RestitutionRequest& a, const CsvTarget& target) {
   const ContactParams p = contactParams(a.E, a.D, a.unclamped);
   const std::vector<double> speeds = impactSpeeds(a.speeds);
-  target.refuseToOverwrite();
+  target.checkWritable();
   const Restitution R(p);
 
   // The second-order series is printed only where it applies (b < 0.1, i.e. 1 - e below ~0.11);
@@ -129,7 +129,7 @@ void writeTable(const HaffRequest& a, const CsvTarget& target) {
   require(a.T0 > 0.0 && std::isfinite(a.T0),
           "--T0 must be positive and finite (got " + formatReal(a.T0) + ").");
   const auto times = tableTimes(a.t_min, a.t_end, a.points);
-  target.refuseToOverwrite();
+  target.checkWritable();
   const double inv_tau0 = haffInverseTau0(a.eps, a.phi, a.T0);
 
   common::Provenance prov(target.command_line);
@@ -156,7 +156,7 @@ void writeTable(const CoolingRequest& a, const CsvTarget& target) {
           "--D must be positive for viscoelastic cooling (got 0: the gas does not cool).");
   checkPhi(a.phi);
   const auto times = tableTimes(a.t_min, a.t_end, a.points);
-  target.refuseToOverwrite();
+  target.checkWritable();
 
   CoolingOptions o;
   o.phi = a.phi;
@@ -201,7 +201,7 @@ void writeTable(const EnskogRequest& a, const CsvTarget& target) {
   checkPhi(a.phi);
   require(a.T >= 0.0 && std::isfinite(a.T),
           "--T must be non-negative and finite (got " + formatReal(a.T) + ").");
-  target.refuseToOverwrite();
+  target.checkWritable();
   common::Provenance prov(target.command_line);
   prov.add("phi", a.phi);
   prov.add("T", a.T);
@@ -222,7 +222,7 @@ void writeTable(const ChargingRequest& c, const CsvTarget& target) {
   require(c.cooling_exponent > 0.0 && std::isfinite(c.cooling_exponent),
           "--cooling-exponent must be positive and finite (got " + formatReal(c.cooling_exponent) +
               ").");
-  target.refuseToOverwrite();
+  target.checkWritable();
   common::Provenance prov(target.command_line);
   prov.add("kappa", c.kappa);
   prov.add("cooling_exponent", c.cooling_exponent);

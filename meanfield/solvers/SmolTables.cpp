@@ -142,7 +142,7 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
     throw std::invalid_argument("--t-end must be below the gel time 1/K0 = " +
                                 common::formatReal(1.0 / a.K0) + " for the multiplicative kernel.");
   const auto times = outputTimes(a.t_min, a.t_end, a.per_decade);
-  target.refuseToOverwrite();
+  target.checkWritable();
 
   const auto wall0 = std::chrono::steady_clock::now();
   const SmolResult r =
@@ -219,7 +219,7 @@ void writeZbetaTable(const ZbetaRequest& a, const common::CsvTarget& target, con
   requireRange(a.s_end >= 1e3, "--s-end must be at least 1e3 for an asymptotic exponent.");
   requireRange(a.method == "sectional" || a.method == "discrete",
                "--method must be sectional or discrete for zbeta (got '" + a.method + "').");
-  target.refuseToOverwrite();
+  target.checkWritable();
 
   common::Provenance prov(target.command_line);
   prov.add("method", a.method);
