@@ -34,6 +34,7 @@ fs::path unwritableFolder(const fs::path& scratch) {
   fs::path dir;
   if (::geteuid() == 0) {
     dir = "/sys";
+    if (!fs::is_directory(dir)) return {};
   } else {
     dir = scratch / "read-only";
     fs::create_directories(dir);
