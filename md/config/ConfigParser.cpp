@@ -59,7 +59,9 @@ const std::vector<Section>& schema() {
       {"input", {Key{"version", +[](MdConfig& c) -> int& { return c.input_version; }}}},
       {"system",
        {GRANAGG_KEY(system, N), GRANAGG_KEY(system, phi), GRANAGG_KEY(system, seed),
-        GRANAGG_KEY(system, temperature), GRANAGG_KEY(system, initial)}},
+        GRANAGG_KEY(system, temperature), GRANAGG_KEY(system, initial),
+        Key{"initial_max_overlap",
+            +[](MdConfig& c) -> double& { return c.system.initial_max_overlap; }, true}}},
       {"contact",
        {GRANAGG_KEY(contact, model), GRANAGG_KEY(contact, E), GRANAGG_KEY(contact, D),
         GRANAGG_KEY(contact, clamp), GRANAGG_KEY(contact, stiffness),
@@ -534,6 +536,9 @@ void validateConfig(const MdConfig& c) {
     invalid("system.temperature", formatReal(s.temperature), "be > 0 and finite");
   if (s.initial.empty())
     invalid("system.initial", quote(s.initial), "be \"random\" or a file path");
+  if (!(s.initial_max_overlap >= 0.0 && s.initial_max_overlap < 1.0))  // 0: "auto"
+    invalid("system.initial_max_overlap", formatReal(s.initial_max_overlap),
+            "lie in (0, 1) or be \"auto\" (run.max_overlap)");
 
   const ContactConfig& k = c.contact;
   if (!isContactModel(k.model))

@@ -9,7 +9,8 @@
 ///
 /// All errors are std::invalid_argument (ConfigError), one line per problem, each starting with
 /// where the value came from: "run.toml:4:1: unknown key 'system.Nn' (known keys in [system]: N,
-/// phi, seed, temperature, initial)", or "--set system.N=1: system.N = 1 is invalid: must be >= 2".
+/// phi, seed, temperature, initial, initial_max_overlap)", or "--set system.N=1: system.N = 1 is
+/// invalid: must be >= 2".
 #include <stdexcept>
 #include <string>
 #include <utility>

@@ -8,7 +8,8 @@
 /// TOML layout (every key optional except where noted; unknown keys are errors):
 ///
 ///     [input]       version = 1
-///     [system]      N, phi, seed, temperature, initial ("random" or a CSV/H5MD file path)
+///     [system]      N, phi, seed, temperature, initial ("random" or a CSV, H5MD or LAMMPS data
+///                   file path), initial_max_overlap ("auto" or a number)
 ///     [contact]     model ("hertz" | "spring_dashpot"), E, D, clamp, stiffness, restitution
 ///     [integrator]  dt ("auto" or a number), steps_per_contact, impact_speed_max ("auto" or
 ///     number) [neighbor]    skin [charging]    mode ("exchange" | "fixed"), initial ("neutral" |
@@ -33,6 +34,13 @@ struct SystemConfig {
   std::uint64_t seed = 1;    ///< seeds positions, velocities (and charging, issue 4)
   double temperature = 1.0;  ///< initial granular temperature T_g(0) (= T0 = 1 in reduced units)
   std::string initial = "random";  ///< "random", or a CSV / H5MD file with positions, velocities
+  /// Deepest overlap 1 - r an initial file may hold (contacts of a running gas are physical);
+  /// 0 = "auto": run.max_overlap, the overlap no step of a run exceeds.
+  double initial_max_overlap = 0.0;
+  /// The tolerance in force: initial_max_overlap, or max_overlap for "auto".
+  double initialMaxOverlap(double max_overlap) const {
+    return initial_max_overlap > 0.0 ? initial_max_overlap : max_overlap;
+  }
 };
 
 struct ContactConfig {

@@ -22,6 +22,7 @@
 #include "common/H5mdReader.h"
 #include "common/Hdf5.h"
 #include "common/Strings.h"
+#include "md/config/ConfigParser.h"
 #include "md/rng/RngStreams.h"
 
 namespace granagg::md {
@@ -450,6 +451,81 @@ Frame readInitialState(const std::string& path, double box_if_csv) {
   if (is_h5 > 0) return readInitialStateH5md(path);
   if (isLammpsData(path)) return readInitialStateLammps(path);
   return readInitialStateCsv(path, box_if_csv);
+}
+
+OverlapPair deepestOverlap(const Frame& f) {
+  const std::size_t n = f.size();
+  const common::Box box{f.box};
+  OverlapPair worst;
+  auto consider = [&](std::size_t i, std::size_t j) {
+    const double rx = box.minimumImage(f.x[i] - f.x[j]), ry = box.minimumImage(f.y[i] - f.y[j]),
+                 rz = box.minimumImage(f.z[i] - f.z[j]);
+    const double overlap = 1.0 - std::sqrt(rx * rx + ry * ry + rz * rz);
+    if (overlap > worst.overlap) worst = {std::min(i, j), std::max(i, j), overlap};
+  };
+  // Cells of edge >= 1: two overlapping particles lie in the same or adjacent cells. At most
+  // about 2N cells, so that a large dilute box costs no more than its particles.
+  const long per_side = static_cast<long>(
+      std::min(std::floor(f.box), std::cbrt(2.0 * static_cast<double>(n)) + 1.0));
+  if (per_side < 3) {  // adjacent cells would repeat: compare every pair
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = i + 1; j < n; ++j) consider(i, j);
+    return worst;
+  }
+  const double cell = f.box / static_cast<double>(per_side);
+  auto cellOf = [&](double x) {
+    const long c = static_cast<long>(std::floor(x / cell)) % per_side;
+    return c < 0 ? c + per_side : c;
+  };
+  constexpr std::size_t NONE = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> head(static_cast<std::size_t>(per_side * per_side * per_side), NONE),
+      next(n, NONE);
+  std::vector<long> cx(n), cy(n), cz(n);
+  auto index = [per_side](long a, long b, long c) {
+    return static_cast<std::size_t>(((a + per_side) % per_side * per_side +
+                                     (b + per_side) % per_side) *
+                                        per_side +
+                                    (c + per_side) % per_side);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    cx[i] = cellOf(f.x[i]);
+    cy[i] = cellOf(f.y[i]);
+    cz[i] = cellOf(f.z[i]);
+    std::size_t& h = head[index(cx[i], cy[i], cz[i])];
+    next[i] = h;
+    h = i;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (long a = -1; a <= 1; ++a)
+      for (long b = -1; b <= 1; ++b)
+        for (long c = -1; c <= 1; ++c)
+          for (std::size_t j = head[index(cx[i] + a, cy[i] + b, cz[i] + c)]; j != NONE; j = next[j])
+            if (j > i) consider(i, j);
+  return worst;
+}
+
+Frame prepareInitialState(MdConfig& c) {
+  if (c.system.initial == "random") return randomInitialState(c);
+  const std::string& path = c.system.initial;
+  Frame f = readInitialState(path, boxLength(c.system));
+  if (static_cast<int>(f.size()) != c.system.N)
+    throw std::invalid_argument("system.initial '" + path + "' holds " + std::to_string(f.size()) +
+                                " particles but system.N = " + std::to_string(c.system.N));
+  f.step = 0;
+  f.time = 0.0;
+  const double tolerance = c.system.initialMaxOverlap(c.run.max_overlap);
+  const OverlapPair deepest = deepestOverlap(f);
+  if (deepest.overlap > tolerance)
+    throw std::invalid_argument(
+        "system.initial '" + path + "': particles " + std::to_string(deepest.i) + " and " +
+        std::to_string(deepest.j) + " overlap by " + common::formatReal(deepest.overlap) +
+        " (distance " + common::formatReal(1.0 - deepest.overlap) +
+        "), deeper than system.initial_max_overlap = " + common::formatReal(tolerance) +
+        (c.system.initial_max_overlap > 0.0 ? "" : " (auto: run.max_overlap)") +
+        "; contacts up to it are accepted, as in a running gas. To continue a granagg run bit "
+        "for bit, use granagg md --restart RUN (its folder) instead");
+  assignInitialCharges(c, f);
+  return f;
 }
 
 Frame randomInitialState(const MdConfig& c) {

@@ -69,6 +69,26 @@ bool isLammpsData(const std::string& path);
 Frame readInitialStateH5md(const std::string& path, long frame = -1,
                            const std::string& particle_group = "");
 
+/// The deepest overlap of a state: particles i < j at distance r = 1 - overlap (diameter 1), or
+/// overlap <= 0 (and i = j = 0) when no two particles overlap.
+struct OverlapPair {
+  std::size_t i = 0, j = 0;
+  double overlap = 0.0;  ///< 1 - r, in particle diameters
+};
+
+/// The pair of `state` whose overlap is deepest (minimum image in the cubic box state.box),
+/// found on a cell grid of edge >= 1 in O(N).
+OverlapPair deepestOverlap(const Frame& state);
+
+/// The initial state of a new run of `config`: randomInitialState for system.initial = "random",
+/// else the file (readInitialState), with the charges of charging.initial. A new run's clock
+/// starts at its initial state: step and time are 0 whatever frame the file held (run.t_end is
+/// the time run from it). A file may hold contacts, as any frame of a running gas does, up to
+/// system.initial_max_overlap ("auto": run.max_overlap, which no step of a run exceeds); a
+/// deeper overlap is refused naming the pair, the overlap and that key, and pointing to
+/// `granagg md --restart RUN`, which continues a run bit for bit. Throws std::invalid_argument.
+Frame prepareInitialState(MdConfig& config);
+
 /// Random non-overlapping positions at the configured phi (random sequential insertion),
 /// Maxwell velocities rescaled to T_g = temperature exactly with zero total momentum, and the
 /// charges of config.charging.initial (docs/model.md section 5). Deterministic in

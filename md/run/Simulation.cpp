@@ -84,18 +84,6 @@ std::vector<std::pair<std::string, std::string>> parameters(const MdConfig& cfg,
   return params;
 }
 
-/// The initial state of a new run: random, or from system.initial with its charges set.
-Frame initialState(const MdConfig& cfg) {
-  if (cfg.system.initial == "random") return randomInitialState(cfg);
-  Frame init = readInitialState(cfg.system.initial, boxLength(cfg.system));
-  if (static_cast<int>(init.size()) != cfg.system.N)
-    throw std::invalid_argument("system.initial '" + cfg.system.initial + "' holds " +
-                                std::to_string(init.size()) +
-                                " particles but system.N = " + std::to_string(cfg.system.N));
-  assignInitialCharges(cfg, init);
-  return init;
-}
-
 /// profile.csv: one row, seconds per phase of the loop (`other` = the loop's time in no phase:
 /// observables, output, checkpoints; column names are the phase names in snake case), then the
 /// list builds and slow Coulomb evaluations; the provenance holds box, dt, the end time and the
@@ -306,7 +294,9 @@ Simulation Simulation::start(const MdConfig& config, const fs::path& out,
                                 "' exists and is not empty; choose another --out or pass --force "
                                 "to overwrite it");
   // everything that can fail on the input fails before the folder is touched
-  d->setUp(std::make_unique<Engine>(d->cfg, initialState(d->cfg)));
+  // (a file's contacts within system.initial_max_overlap are accepted: InitialState.h)
+  const Frame init = prepareInitialState(d->cfg);
+  d->setUp(std::make_unique<Engine>(d->cfg, init, /*allow_contacts=*/true));
   d->lock = common::FolderLock::acquire(out, options.command_line, options.overwrite);
   try {
     // an overwritten run's checkpoint and profile are not this run's

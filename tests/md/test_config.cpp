@@ -44,6 +44,7 @@ void requireSame(const MdConfig& a, const MdConfig& b) {
   CHECK(a.system.seed == b.system.seed);
   CHECK(a.system.temperature == b.system.temperature);
   CHECK(a.system.initial == b.system.initial);
+  CHECK(a.system.initial_max_overlap == b.system.initial_max_overlap);
   CHECK(a.contact.model == b.contact.model);
   CHECK(a.contact.E == b.contact.E);
   CHECK(a.contact.D == b.contact.D);
@@ -144,6 +145,9 @@ TEST_CASE("bad configs are rejected with the key and the allowed range", "[md][c
        "system.temperature = inf is invalid: must be > 0 and finite"},
       {"system.initial", "\"\"", [](MdConfig& c) { c.system.initial = ""; },
        "system.initial = \"\" is invalid: must be \"random\" or a file path"},
+      {"system.initial_max_overlap", "1", [](MdConfig& c) { c.system.initial_max_overlap = 1; },
+       "system.initial_max_overlap = 1 is invalid: must lie in (0, 1) or be \"auto\" "
+       "(run.max_overlap)"},
       {"contact.model", "\"hooke\"", [](MdConfig& c) { c.contact.model = "hooke"; },
        "contact.model = \"hooke\" is invalid: must be one of \"hertz\", \"spring_dashpot\" "
        "(unknown contact "
@@ -266,7 +270,7 @@ TEST_CASE("unknown keys and sections are reported with file:line:col", "[md][con
       "Nn = 2\n";
   CHECK(errorOf([&] { parseConfigString(text, "run.toml"); }) ==
         "run.toml:6:1: unknown key 'system.Nn' (known keys in [system]: N, phi, seed, temperature, "
-        "initial); "
+        "initial, initial_max_overlap); "
         "did you mean 'system.N'?");
 
   CHECK(
@@ -344,7 +348,7 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
       {"system.Nn=2",
        "--set system.Nn=2: unknown key 'system.Nn' (known keys in [system]: N, phi, seed, "
        "temperature, "
-       "initial); "
+       "initial, initial_max_overlap); "
        "did you mean 'system.N'?"},
       {"sytem.N=2",
        "--set sytem.N=2: unknown section 'sytem' (known sections: input, system, contact, "
@@ -410,6 +414,7 @@ TEST_CASE("toToml round-trips exactly through parseConfigString", "[md][config]"
     c.system.seed = std::numeric_limits<std::uint64_t>::max();  // beyond TOML's int64
     c.system.temperature = 1.0 / 3.0;
     c.system.initial = "dir with space/\"quoted\"\\x\ttab\u00e9.csv";
+    c.system.initial_max_overlap = 0.1 + 0.2;
     c.contact.model = "spring_dashpot";
     c.contact.E = 1e-300;
     c.contact.D = 0.0;
@@ -441,18 +446,19 @@ TEST_CASE("flatten lists every key with round-trip numbers", "[md][config]") {
   MdConfig c;
   c.system.phi = 0.1 + 0.2;
   const auto f = flatten(c);
-  REQUIRE(f.size() == 43);
+  REQUIRE(f.size() == 44);
   CHECK(f.front() == std::make_pair(std::string("input.version"), std::string("1")));
   CHECK(f[1] == std::make_pair(std::string("system.N"), std::string("1000")));
   CHECK(f[2] == std::make_pair(std::string("system.phi"), std::string("0.30000000000000004")));
   CHECK(f[5] == std::make_pair(std::string("system.initial"), std::string("random")));
-  CHECK(f[9] == std::make_pair(std::string("contact.clamp"), std::string("true")));
-  CHECK(f[12] == std::make_pair(std::string("integrator.dt"), std::string("auto")));
-  CHECK(f[13] == std::make_pair(std::string("integrator.steps_per_contact"), std::string("50")));
-  CHECK(f[16] == std::make_pair(std::string("charging.mode"), std::string("exchange")));
-  CHECK(f[24] == std::make_pair(std::string("coulomb.K"), std::string("0")));
-  CHECK(f[27] == std::make_pair(std::string("coulomb.r_cut"), std::string("auto")));
-  CHECK(f[28] == std::make_pair(std::string("coulomb.mesh"), std::string("auto")));
+  CHECK(f[6] == std::make_pair(std::string("system.initial_max_overlap"), std::string("auto")));
+  CHECK(f[10] == std::make_pair(std::string("contact.clamp"), std::string("true")));
+  CHECK(f[13] == std::make_pair(std::string("integrator.dt"), std::string("auto")));
+  CHECK(f[14] == std::make_pair(std::string("integrator.steps_per_contact"), std::string("50")));
+  CHECK(f[17] == std::make_pair(std::string("charging.mode"), std::string("exchange")));
+  CHECK(f[25] == std::make_pair(std::string("coulomb.K"), std::string("0")));
+  CHECK(f[28] == std::make_pair(std::string("coulomb.r_cut"), std::string("auto")));
+  CHECK(f[29] == std::make_pair(std::string("coulomb.mesh"), std::string("auto")));
   // toToml has exactly these keys in this order.
   const std::string text = toToml(c);
   std::size_t pos = 0;

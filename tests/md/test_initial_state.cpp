@@ -1,6 +1,8 @@
 // User-given initial states: CSV (columns, comments, wrapping into the caller's box, errors
 // naming the line and particle), H5MD (last frame of a trajectory) and LAMMPS data files (the
-// same state as a CSV to the bit; styles, ids, image flags, errors), plus coordinate wrapping.
+// same state as a CSV to the bit; styles, ids, image flags, errors), plus coordinate wrapping;
+// what a new run takes from them (prepareInitialState): the contacts of a frame of granagg's own
+// run are accepted up to system.initial_max_overlap, deeper overlaps refused.
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
@@ -12,8 +14,10 @@
 #include <limits>
 #include <string>
 
+#include "common/H5mdReader.h"
 #include "md/io/H5mdWriter.h"
 #include "md/io/InitialState.h"
+#include "md/run/Simulation.h"
 
 #include "TestUtil.h"
 
@@ -27,6 +31,33 @@ std::string writeText(const std::string& name, const std::string& text) {
   const std::string p = tempPath(name);
   std::ofstream(p) << text;
   return p;
+}
+
+/// The deepest overlap by comparing every pair (the reference for deepestOverlap's cell grid).
+double deepestOverlapAllPairs(const Frame& f) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (std::size_t j = i + 1; j < f.size(); ++j) {
+      double r2 = 0.0;
+      for (const auto* c : {&f.x, &f.y, &f.z}) {
+        double d = std::fabs((*c)[i] - (*c)[j]);
+        d = std::min(d, f.box - d);
+        r2 += d * d;
+      }
+      worst = std::max(worst, 1.0 - std::sqrt(r2));
+    }
+  return worst;
+}
+
+/// A neutral Hertz gas of 500 particles at phi = 0.2: by t = 10 it has cooled to T_g ~ 0.03 and
+/// ~0.3 contacts per particle, so every frame from then on holds overlapping pairs.
+MdConfig denseGas(double t_end) {
+  MdConfig c;
+  c.system.N = 500;
+  c.system.phi = 0.2;
+  c.run.t_end = t_end;
+  c.output.checkpoint_wall_seconds = 0.0;
+  return c;
 }
 
 }  // namespace
@@ -297,4 +328,97 @@ TEST_CASE("LAMMPS data initial state errors name the file, line and atom", "[md]
     CHECK_THROWS_WITH(readInitialState(p, 1.0), Catch::Contains(c.expected));
     std::remove(p.c_str());
   }
+}
+
+TEST_CASE("deepestOverlap finds the deepest pair, across periodic faces, as all pairs do",
+          "[md][io]") {
+  Frame f;
+  f.box = 12.0;
+  f.x = {0.1, 11.9, 5.0, 6.0, 3.0};
+  f.y = {6.0, 6.0, 5.0, 5.0, 9.0};
+  f.z = {6.0, 6.0, 5.0, 5.0, 0.0};
+  const OverlapPair p = deepestOverlap(f);  // 0 and 1 at distance 0.2 through the x face
+  CHECK(p.i == 0);
+  CHECK(p.j == 1);
+  CHECK(p.overlap == Approx(0.8).epsilon(1e-12));
+  f.x[1] = 4.0;  // now only 2 and 3 touch (distance 1: no overlap)
+  CHECK(deepestOverlap(f).overlap <= 0.0);
+  // a random dense state, against every pair
+  MdConfig c;
+  c.system.N = 400;
+  c.system.phi = 0.3;
+  Frame g = randomInitialState(c);
+  for (std::size_t k = 0; k < g.size(); k += 7) g.x[k] = std::fmod(g.x[k] + 0.37, g.box);
+  const double all = deepestOverlapAllPairs(g);
+  REQUIRE(all > 0.0);
+  CHECK(deepestOverlap(g).overlap == all);
+}
+
+TEST_CASE("a frame of granagg's own run starts a new run: its contacts are accepted",
+          "[md][io][run]") {
+  const std::filesystem::path dir = granagg::test::tempDir("start_from_frame");
+  RunOptions opt;
+  Simulation::start(denseGas(10.0), dir / "cooled", opt).run();
+  const std::string traj = (dir / "cooled" / "traj.h5").string();
+  const Frame last = readInitialState(traj, 1.0);
+  // the frame a user would start from holds contacts: real overlaps, as a cooled gas has
+  const double deepest = deepestOverlapAllPairs(last);
+  INFO("deepest overlap of the last frame " << deepest);
+  REQUIRE(deepest > 0.0);
+  REQUIRE(deepest < 0.6);
+  CHECK(last.step > 0);
+
+  MdConfig next = denseGas(1.0);
+  next.system.initial = traj;
+  Simulation sim = Simulation::start(next, dir / "next", opt);
+  sim.run();
+  const granagg::common::H5mdReader r((dir / "next" / "traj.h5").string());
+  REQUIRE(r.frames() > 2);
+  // the new run's clock starts at the state: frame 0 is the file's last frame at t = 0, and the
+  // run reaches its own run.t_end
+  const Frame first = engineFrame(r.readFrame(0));
+  CHECK(first.step == 0);
+  CHECK(first.time == 0.0);
+  CHECK(first.x == last.x);
+  CHECK(first.vz == last.vz);
+  CHECK(r.readFrame(r.frames() - 1).time == Approx(1.0).margin(0.004));
+  if (std::getenv("GRANAGG_KEEP_TEST_FILES") == nullptr) std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("an initial state deeper than system.initial_max_overlap is refused, naming the pair",
+          "[md][io]") {
+  // 4 particles in the box of N = 4, phi = 0.01 (L = 5.9); 1 and 2 at distance 0.3
+  const std::string p = writeText("deep.csv",
+                                  "x,y,z,vx,vy,vz\n"
+                                  "1,1,1,0,0,0\n"
+                                  "3,3,3,0,0,0\n"
+                                  "3.3,3,3,0,0,0\n"
+                                  "5,1,4.5,0,0,0\n");
+  MdConfig c;
+  c.system.N = 4;
+  c.system.phi = 0.01;
+  c.system.initial = p;
+  try {
+    MdConfig copy = c;
+    prepareInitialState(copy);
+    FAIL("a deep overlap was accepted");
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    CHECK_THAT(m, Catch::Contains("particles 1 and 2 overlap by 0.7"));
+    CHECK_THAT(m, Catch::Contains("system.initial_max_overlap = 0.6 (auto: run.max_overlap)"));
+    CHECK_THAT(m, Catch::Contains("granagg md --restart"));
+  }
+  // the tolerance is the key's: above the overlap the state is taken as it is
+  c.system.initial_max_overlap = 0.75;
+  MdConfig accepted = c;
+  const Frame f = prepareInitialState(accepted);
+  CHECK(f.x[2] == 3.3);
+  // and a small contact beyond a tight tolerance is refused naming that tolerance
+  c.system.initial_max_overlap = 0.005;
+  std::ofstream(p) << "x,y,z,vx,vy,vz\n1,1,1,0,0,0\n1.99,1,1,0,0,0\n";
+  c.system.N = 2;
+  CHECK_THROWS_WITH(prepareInitialState(c),
+                    Catch::Contains("particles 0 and 1 overlap by 0.01") &&
+                        Catch::Contains("system.initial_max_overlap = 0.005;"));
+  std::remove(p.c_str());
 }
