@@ -2,6 +2,7 @@
 /// The analyze output folder (AnalysisFolder.h).
 #include "analysis/pipeline/AnalysisFolder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -188,11 +189,17 @@ std::vector<std::string> analysisReport(const AnalysisFolder& folder) {
     if (t.name == "fits" && !t.rows.empty()) {
       const auto& row = t.rows.front();
       auto c = [&](const char* name) { return row[t.column(name)]; };
+      // no exponent (too few frames, S constant: analysisWarnings says which) reads n/a
+      auto z = [&](const std::string& kind) {
+        const double v = c(("z_" + kind).c_str());
+        return std::isfinite(v) ? common::printfString("%.4g [%.4g, %.4g]", v,
+                                                       c(("z_" + kind + "_low").c_str()),
+                                                       c(("z_" + kind + "_high").c_str()))
+                                : std::string("n/a");
+      };
       lines.push_back(common::printfString(
-          "z (grid) = %.4g [%.4g, %.4g], z (particle) = %.4g [%.4g, %.4g] over t in "
-          "[%.4g, %.4g] (%s)",
-          c("z_grid"), c("z_grid_low"), c("z_grid_high"), c("z_particle"), c("z_particle_low"),
-          c("z_particle_high"), c("fit_t_min"), c("fit_t_max"),
+          "z (grid) = %s, z (particle) = %s over t in [%.4g, %.4g] (%s)", z("grid").c_str(),
+          z("particle").c_str(), c("fit_t_min"), c("fit_t_max"),
           folder.runs.size() > 1 ? "95% bootstrap over runs" : "95% Student t"));
       if (std::isfinite(c("charging_rate_exponent")))
         lines.push_back(common::printfString(
@@ -244,12 +251,37 @@ std::vector<std::string> analysisWarnings(const AnalysisFolder& folder,
     std::size_t inside = 0;
     for (double x : t)
       inside += x > 0 && x >= w0 * (1 - WINDOW_SLACK) && x <= w1 * (1 + WINDOW_SLACK);
+    const std::string window =
+        std::string(given ? "--fit-window" : "the growth-exponent window (the last decade)") +
+        common::printfString(" [%.4g, %.4g]", w0, w1);
     if (inside < 3)
-      lines.push_back(
-          std::string(given ? "--fit-window" : "the growth-exponent window (the last decade)") +
-          " [" + formatReal(w0) + ", " + formatReal(w1) + "] holds " + std::to_string(inside) +
-          " frame" + (inside == 1 ? "" : "s") + " (a fit needs 3; the frames span t = " +
-          formatReal(t.front()) + " .. " + formatReal(t.back()) + "): z is NaN in fits.csv");
+      lines.push_back(window + " holds " + std::to_string(inside) + " frame" +
+                      (inside == 1 ? "" : "s") + " (a fit needs 3; the frames span t = " +
+                      common::printfString("%.4g .. %.4g", t.front(), t.back()) +
+                      "): z is NaN in fits.csv");
+    // S the same at every frame of the window: no growth to fit (PowerLawFitResult::constant)
+    auto has = [&](const std::string& name) {
+      return std::find(st->columns.begin(), st->columns.end(), name) != st->columns.end();
+    };
+    for (const std::string kind : {"grid", "particle"}) {
+      const std::string col = has("S_" + kind + "_mean") ? "S_" + kind + "_mean" : "S_" + kind;
+      if (inside < 3 || !has(col)) continue;
+      const std::vector<double> S = st->values(col);
+      double lo = INFINITY, hi = -INFINITY;
+      std::size_t used = 0;
+      for (std::size_t k = 0; k < t.size(); ++k)
+        if (t[k] > 0 && t[k] >= w0 * (1 - WINDOW_SLACK) && t[k] <= w1 * (1 + WINDOW_SLACK) &&
+            S[k] > 0 && std::isfinite(S[k])) {
+          lo = std::min(lo, std::log(S[k]));
+          hi = std::max(hi, std::log(S[k]));
+          ++used;
+        }
+      if (used >= 3 && hi - lo <= 1e-12)
+        lines.push_back(col + " is " + common::printfString("%.4g", std::exp(lo)) +
+                        " at every frame of " +
+                        window + ": S does not grow there, so z (" + kind +
+                        ") is n/a (NaN in fits.csv)");
+    }
   }
   return lines;
 }

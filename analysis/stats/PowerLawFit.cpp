@@ -26,6 +26,11 @@ PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<do
   PowerLawFitResult r;
   r.points = lx.size();
   if (r.points < 3) return r;
+  const auto [lo, hi] = std::minmax_element(ly.begin(), ly.end());
+  if (*hi - *lo <= 1e-12) {  // ln y equal to round-off
+    r.constant = true;
+    return r;
+  }
   const common::stats::LineFit f = common::stats::fitLine(lx, ly);
   r.exponent = f.slope;
   r.amplitude = std::exp(f.intercept);

@@ -20,10 +20,14 @@ struct PowerLawFitResult {
   double low = 0.0;        ///< lower end of the confidence interval of z
   double high = 0.0;       ///< upper end
   std::size_t points = 0;  ///< points used (t in [t_min, t_max], t > 0, y > 0, finite)
+  /// y is the same at every point used: it does not grow, and a fit would give z = 0 with a
+  /// zero-width interval, a certainty the data do not carry. No exponent then (valid false).
+  bool constant = false;
 };
 
 /// Ordinary least squares of ln y on ln t over t_min <= t <= t_max; the interval is
-/// z +- t_{n-2, (1+confidence)/2} * stderr (GSL's Student-t quantile). Needs 3 points.
+/// z +- t_{n-2, (1+confidence)/2} * stderr (GSL's Student-t quantile). Needs 3 points whose y
+/// differ (a constant y: `constant`, no exponent).
 /// Throws std::invalid_argument when t and y differ in length or confidence is not in (0, 1).
 PowerLawFitResult fitPowerLaw(const std::vector<double>& t, const std::vector<double>& y,
                               double t_min, double t_max, double confidence = 0.95);

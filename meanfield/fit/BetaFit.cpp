@@ -283,6 +283,19 @@ ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window,
     y.push_back(std::log(data.S[i]));
   }
   ZFit f;
+  const auto [y_lo, y_hi] = std::minmax_element(y.begin(), y.end());
+  if (*y_hi - *y_lo <= 1e-12) {
+    f.z = f.z_low = f.z_high = NaN;
+    f.S0 = f.S1 = f.prefactor = std::exp(*y_lo);
+    f.t0 = data.t[idx.front()];
+    f.t1 = data.t[idx.back()];
+    f.points = static_cast<int>(idx.size());
+    f.confidence = o.confidence;
+    f.interval_method = "none";
+    f.note = "S is " + rounded(f.S0) + " at every sample of the window [" + rounded(f.t0) +
+             ", " + rounded(f.t1) + "]: it does not grow, no growth exponent.";
+    return f;
+  }
   double c0, se;
   ols(x, y, f.z, c0, se);
   f.prefactor = std::exp(c0);

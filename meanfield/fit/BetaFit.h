@@ -105,9 +105,14 @@ struct ZFit {
   /// errors where Student's t needs 2.78).
   std::string interval_method;
   int replicates = 0;
+  /// Why there is no z (empty when there is one): S the same at every sample of the window.
+  std::string note;
 };
 /// Fits z over the window. The interval half-width is never below 1e-12 (the round-off of a
 /// least-squares slope in double precision, so that an exact power law is inside its interval).
+/// S the same at every sample of the window (ln S equal to 1e-12) has no growth exponent: a fit
+/// would give z = 0 with a zero-width interval, a certainty the data do not carry; z, z_low and
+/// z_high are NaN then, S0 = S1 = that S, and `note` says so.
 ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window,
                        const BootstrapOptions& options = {});
 

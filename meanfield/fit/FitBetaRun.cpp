@@ -60,7 +60,7 @@ FitBetaResult runFitBeta(GrowthInput input, const FitBetaRequest& request) {
     throw std::invalid_argument("--window needs two times T0 T1.");
   FitBetaResult r;
   r.request = request;
-  dropUnusableRows(input);
+  const std::string dropped = dropUnusableRows(input);
   r.input = std::move(input);
   const GrowthInput& L = r.input;
   try {
@@ -71,9 +71,10 @@ FitBetaResult runFitBeta(GrowthInput input, const FitBetaRequest& request) {
   }
   const int minPoints = request.min_points;
   if (r.data.t.size() < static_cast<std::size_t>(minPoints))
-    throw std::invalid_argument("INPUT " + L.source + ": too few points (" +
-                                std::to_string(r.data.t.size()) + " samples with t > 0, at least " +
-                                std::to_string(minPoints) + " needed).");
+    throw std::invalid_argument(
+        "INPUT " + L.source + ": too few points (" + std::to_string(r.data.t.size()) +
+        " usable samples, at least " + std::to_string(minPoints) + " needed" +
+        (dropped.empty() ? std::string() : "; " + dropped) + ").");
 
   // 1. z over the window.
   WindowOptions wo;
@@ -158,6 +159,7 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
            r.z.interval_method +
                (r.z.replicates ? " (" + std::to_string(r.z.replicates) + " replicates)" : ""));
   prov.add("confidence", r.bootstrap.confidence);
+  if (!r.z.note.empty()) prov.add("z_note", r.z.note);
   prov.add("bootstrap_seed", static_cast<long long>(r.bootstrap.seed));
   prov.add("beta_min", r.request.beta_min);
   prov.add("beta_max", r.request.beta_max);
@@ -284,6 +286,7 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
     j["z_low"] = num(r.z.z_low);
     j["z_high"] = num(r.z.z_high);
     j["z_interval_method"] = r.z.interval_method;
+    j["z_note"] = r.z.note;
     j["t0"] = num(r.z.t0);
     j["t1"] = num(r.z.t1);
     j["n_points"] = r.z.points;
@@ -348,6 +351,7 @@ std::vector<std::string> fitBetaReport(const FitBetaResult& r, const common::Pap
       "z = %s (95 %%, %s)   paper: %.2f +- %.2f neutral, %.2f +- %.3f charged",
       interval(r.z.z, r.z.z_low, r.z.z_high).c_str(), r.z.interval_method.c_str(), paper.z_neutral,
       paper.z_neutral_pm, paper.z_charged, paper.z_charged_pm));
+  if (!r.z.note.empty()) lines.push_back(common::printfString("  note: %s", r.z.note.c_str()));
   lines.push_back(common::printfString(
       "beta from z = %s (full Smoluchowski z(beta) over S = %.4g..%.4g, where it gives z "
       "= %.4f at "

@@ -10,6 +10,7 @@
 
 #include "common/Csv.h"
 #include "common/Hdf5.h"
+#include "common/Strings.h"
 
 namespace granagg::meanfield {
 namespace fs = std::filesystem;
@@ -272,13 +273,13 @@ GrowthInput readGrowthInput(const std::string& input, const std::string& columnA
   return loadCsv(input, columnArg);
 }
 
-/// Drops the rows with t = 0 (fits are in log t) and the rows where S is NaN in the series or in
-/// any run (`granagg analyze` writes NaN where a frame has no cluster); rejects negative or
-/// non-finite t. Infinite or non-positive S stays, for validateGrowthData to reject.
-void dropUnusableRows(GrowthInput& L) {
+std::string dropUnusableRows(GrowthInput& L) {
   std::size_t zero = 0, missing = 0;
   std::vector<double> t;
   std::vector<std::vector<double>> runs(L.runs.size());
+  // per run: how many rows have S = NaN, and the first and last such time
+  std::vector<std::size_t> nan_rows(L.runs.size(), 0);
+  std::vector<double> nan_first(L.runs.size(), 0.0), nan_last(L.runs.size(), 0.0);
   for (std::size_t i = 0; i < L.t.size(); ++i) {
     if (!std::isfinite(L.t[i]) || L.t[i] < 0.0)
       throw std::invalid_argument(
@@ -289,7 +290,12 @@ void dropUnusableRows(GrowthInput& L) {
       continue;
     }
     bool nan = false;
-    for (const auto& r : L.runs) nan = nan || std::isnan(r[i]);
+    for (std::size_t r = 0; r < L.runs.size(); ++r)
+      if (std::isnan(L.runs[r][i])) {
+        nan = true;
+        if (nan_rows[r]++ == 0) nan_first[r] = L.t[i];
+        nan_last[r] = L.t[i];
+      }
     if (nan) {
       ++missing;
       continue;
@@ -297,14 +303,33 @@ void dropUnusableRows(GrowthInput& L) {
     t.push_back(L.t[i]);
     for (std::size_t r = 0; r < runs.size(); ++r) runs[r].push_back(L.runs[r][i]);
   }
-  if (zero)
-    L.notes.push_back(std::to_string(zero) + " row(s) at t = 0 left out (fits are in log t)");
-  if (missing)
-    L.notes.push_back(std::to_string(missing) + " row(s) with S = NaN (no cluster" +
-                      (L.runs.size() > 1 ? std::string(" in some run") : std::string()) +
-                      ") left out");
+  std::vector<std::string> added;
+  if (zero) added.push_back(std::to_string(zero) + " row(s) at t = 0 left out (fits are in log t)");
+  if (missing) {
+    // which runs and times: NaN is what analyze writes for a frame without a cluster (for
+    // S_grid: no grid cell reached the occupation threshold)
+    std::string where;
+    for (std::size_t r = 0; r < L.runs.size(); ++r) {
+      if (nan_rows[r] == 0) continue;
+      where += (where.empty() ? "" : "; ") +
+               (L.runs.size() > 1 ? "run " + std::to_string(r) : std::string("the series")) +
+               " at " + std::to_string(nan_rows[r]) + " time(s), t = " +
+               common::printfString("%.4g", nan_first[r]) +
+               (nan_rows[r] > 1 ? common::printfString(" .. %.4g", nan_last[r]) : std::string());
+    }
+    // the runs' own column: S_grid for the ensemble's S_grid_mean
+    std::string column = L.column;
+    const std::string mean = "_mean";
+    if (L.runs.size() > 1 && column.size() > mean.size() &&
+        column.compare(column.size() - mean.size(), mean.size(), mean) == 0)
+      column.resize(column.size() - mean.size());
+    added.push_back(std::to_string(missing) + " row(s) with " + column + " = NaN left out (" +
+                    where + "): frames without a cluster, e.g. no occupied grid cell");
+  }
+  L.notes.insert(L.notes.end(), added.begin(), added.end());
   L.t = t;
   L.runs = runs;
+  return common::join(added, "; ");
 }
 
 }  // namespace granagg::meanfield

@@ -28,9 +28,10 @@ struct GrowthInput {
 GrowthInput readGrowthInput(const std::string& input, const std::string& column);
 
 /// Drops the rows with t = 0 (fits are in log t) and the rows where S is NaN in the series or in
-/// any run (`granagg analyze` writes NaN where a frame has no cluster), with a note for each;
-/// throws std::invalid_argument for a negative or non-finite t. Infinite or non-positive S stays,
-/// for validateGrowthData to reject.
-void dropUnusableRows(GrowthInput& input);
+/// any run (`granagg analyze` writes NaN where a frame has no cluster), with a note for each that
+/// names the runs and times; throws std::invalid_argument for a negative or non-finite t.
+/// Infinite or non-positive S stays, for validateGrowthData to reject. Returns the notes added
+/// ("; "-joined, "" when nothing was dropped): why rows are missing, for a too-few-rows error.
+std::string dropUnusableRows(GrowthInput& input);
 
 }  // namespace granagg::meanfield

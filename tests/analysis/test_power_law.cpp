@@ -129,6 +129,25 @@ TEST_CASE("power-law fit of an exact power law returns its exponent with a zero-
   CHECK(f.points == 27);  // t_k = 10^(-1 + 3k/40) lies in [1, 100] for k = 14..40
 }
 
+TEST_CASE("a series that does not change has no growth exponent, not z = 0 +- 0",
+          "[analysis][fit]") {
+  // S_grid = 1 at every frame (no aggregation) used to give z = 0 [0, 0]: an interval of zero
+  // width from zero residuals, a certainty the data do not carry.
+  const std::vector<double> t{1, 2, 3, 4, 5, 6}, one(6, 1.0);
+  const PowerLawFitResult f = fitPowerLaw(t, one, 0, 10);
+  CHECK_FALSE(f.valid);
+  CHECK(f.constant);
+  CHECK(f.points == 6);
+  const PowerLawFitResult b = bootstrapPowerLaw(t, {one, one, one}, 0, 10, 100, 1);
+  CHECK_FALSE(b.valid);
+  CHECK(b.constant);
+  // a change anywhere in the window is a series to fit
+  std::vector<double> step = one;
+  step.back() = 1.5;
+  CHECK(fitPowerLaw(t, step, 0, 10).valid);
+  CHECK_FALSE(fitPowerLaw(t, step, 0, 10).constant);
+}
+
 TEST_CASE("the fit's 95 % interval uses the Student t quantile", "[analysis][fit]") {
   // y = t^1 * exp(e) with residuals e = +-0.1 alternating: slope 1 exactly in expectation
   std::vector<double> t{1, 2, 3, 4, 5}, y;

@@ -209,6 +209,34 @@ TEST_CASE("analyze warns when the growth-exponent window holds too few frames",
   fs::remove_all(dir);
 }
 
+TEST_CASE("analyze reports no growth exponent where S does not change", "[cli][analyze]") {
+  // Four frames of one configuration: four touching particles fill one grid cell (local filling
+  // fraction 4 (pi/6) / 8 = 0.26 >= 0.25) and form one particle cluster, so S_grid and
+  // S_particle are the same at every frame. The fit used to print z = 0 [0, 0].
+  const fs::path dir = tempDir("flat");
+  const fs::path dump = dir / "still.dump";
+  {
+    std::ofstream out(dump);
+    for (int k = 1; k <= 4; ++k)
+      out << "ITEM: TIMESTEP\n"
+          << k << "\nITEM: NUMBER OF ATOMS\n4\nITEM: BOX BOUNDS pp pp pp\n0 6\n0 6\n0 6\n"
+          << "ITEM: ATOMS id x y z\n"
+          << "1 0.5 0.5 0.5\n2 1.5 0.5 0.5\n3 0.5 1.5 0.5\n4 0.5 0.5 1.5\n";
+  }
+  const Run r = runGranagg("analyze " + dump.string() + " --out " + (dir / "o").string());
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK_THAT(r.output, Catch::Contains("z (grid) = n/a, z (particle) = n/a"));
+  CHECK_THAT(r.output, Catch::Contains("analyze: warning: S_grid_mean is 1 at every frame of the "
+                                       "growth-exponent window (the last decade) [0.4, 4]"));
+  CHECK_THAT(r.output, Catch::Contains("analyze: warning: S_particle_mean is 4 at every frame"));
+  const auto fits = granagg::common::readCsv((dir / "o" / "fits.csv").string());
+  REQUIRE(fits.rows.size() == 1);
+  for (const char* c : {"z_grid", "z_grid_low", "z_grid_high", "z_particle", "z_particle_low"})
+    CHECK(std::isnan(fits.rows[0][fits.column(c)]));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("analyze says when a trajectory ends before its run.t_end", "[cli][analyze]") {
   // A finished run of t_end = 1, then the same file with /parameters saying run.t_end = 2: what an
   // interrupted run looks like (its frames stop before the configured end).

@@ -218,6 +218,56 @@ TEST_CASE("fit-beta writes no number for a beta_fit at a bound of the search ran
   }
 }
 
+TEST_CASE("fit-beta names the runs and times whose S is NaN when too few samples are left",
+          "[cli][fitbeta]") {
+  // What `pair --preset tiny` meets at K = 5: S_grid is NaN (no occupied grid cell) in run 0 at
+  // most frames and in run 1 at some. The message said "0 samples with t > 0", not why.
+  const fs::path dir = tempDir("nan-runs");
+  std::vector<std::vector<double>> rows;
+  const double nan = std::nan("");
+  for (int run = 0; run < 2; ++run)
+    for (int k = 0; k <= 8; ++k) {
+      const double t = 0.1 * k;
+      const bool missing = run == 0 ? (k >= 1 && k <= 7) : (k == 5 || k == 6 || k == 8);
+      rows.push_back({static_cast<double>(run), t, missing ? nan : 1.0 + t});
+    }
+  writeCsv(dir / "S.csv", "run,t,S_grid", rows);
+  const Run r = runGranagg("fit-beta " + (dir / "S.csv").string() + " -q --no-curve-fit --out " +
+                           (dir / "o").string());
+  INFO(r.output);
+  CHECK(r.status == 2);
+  // rows at t = 0.1 .. 0.8 all miss S in one run or the other: none is left
+  CHECK_THAT(r.output, Catch::Contains("too few points (0 usable samples, at least 5 needed"));
+  CHECK_THAT(r.output, Catch::Contains("1 row(s) at t = 0 left out"));
+  CHECK_THAT(r.output, Catch::Contains("8 row(s) with S_grid = NaN left out (run 0 at 7 time(s), "
+                                       "t = 0.1 .. 0.7; run 1 at 3 time(s), t = 0.5 .. 0.8)"));
+  CHECK_THAT(r.output, Catch::Contains("no occupied grid cell"));
+  CHECK_FALSE(fs::exists(dir / "o"));
+}
+
+TEST_CASE("fit-beta reports no z, not a zero-width interval, for an S that does not grow",
+          "[cli][fitbeta]") {
+  // pair --preset tiny at K = 0: S_grid = 1 at every frame gave "z = 0 [-1e-12, 1e-12]".
+  const fs::path dir = tempDir("flat");
+  std::vector<std::vector<double>> rows;
+  for (int k = 1; k <= 10; ++k) rows.push_back({0.5 * k, 1.0});
+  writeCsv(dir / "S.csv", "t,S", rows);
+  const Run r = runGranagg("fit-beta " + (dir / "S.csv").string() + " --no-curve-fit --out " +
+                           (dir / "o").string());
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK_THAT(r.output, Catch::Contains("fit-beta: z = n/a"));
+  CHECK_THAT(r.output, Catch::Contains("S is 1 at every sample of the window [0.5, 5]: it does "
+                                       "not grow, no growth exponent"));
+  const auto row = readRow(dir / "o" / "fit_beta.csv");
+  CHECK(std::isnan(row.at("z")));
+  CHECK(std::isnan(row.at("z_low")));
+  CHECK(std::isnan(row.at("z_high")));
+  const std::string json = slurp(dir / "o" / "fit_beta.json");
+  CHECK_THAT(json, Catch::Contains("\"z\": null"));
+  CHECK_THAT(json, Catch::Contains("\"z_note\": \"S is 1 at every sample"));
+}
+
 TEST_CASE("fit-beta recovers beta = 2.5 from noisy mean-field S(t) given as CSV",
           "[cli][fitbeta]") {
   // S = S_c S_MF(t / tau_c; 2.5) exp(0.03 eps), S_c = 1.4, tau_c = 6: the curve fit's interval

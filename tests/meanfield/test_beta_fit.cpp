@@ -122,6 +122,26 @@ TEST_CASE("fit-beta z of an exact power law is exact and inside its interval",
   CHECK(z <= h.z_high);
 }
 
+TEST_CASE("fit-beta gives no z for an S that does not change, not z = 0 +- 0",
+          "[meanfield][fitbeta]") {
+  // S = 1 at every sample (no aggregation): least squares would say z = 0 with a zero-width
+  // interval (1e-12) or, over runs, a bootstrap of identical zeros. Neither is a measurement.
+  const std::vector<double> t{1, 2, 3, 4, 5, 6, 7, 8};
+  const GrowthData d = growthFromSeries(t, std::vector<double>(t.size(), 1.0));
+  const ZFit f = fitGrowthExponent(d, explicitWindow(d, 1.0, 8.0));
+  CHECK(std::isnan(f.z));
+  CHECK(std::isnan(f.z_low));
+  CHECK(std::isnan(f.z_high));
+  CHECK(f.S0 == 1.0);
+  CHECK(f.S1 == 1.0);
+  CHECK(f.points == 8);
+  CHECK_THAT(f.note, Catch::Contains("S is 1 at every sample of the window [1, 8]"));
+  GrowthData runs = growthFromRuns(t, {std::vector<double>(8, 2.0), std::vector<double>(8, 2.0)});
+  const ZFit g = fitGrowthExponent(runs, explicitWindow(runs, 1.0, 8.0));
+  CHECK(std::isnan(g.z));
+  CHECK_FALSE(g.note.empty());
+}
+
 TEST_CASE("fit-beta automatic window finds the late plateau of the local slope",
           "[meanfield][fitbeta]") {
   // S = 1 + (t/10)^{1.2} (1 + 0.02 eps): z(t) rises from 0 to 1.2; the late plateau is flat within
