@@ -473,6 +473,7 @@ MdConfig parseImpl(const std::string& text, const std::string& source_name,
     if (it == origin.end()) throw;
     throw ConfigError(it->second + ": " + e.what(), e.key());
   }
+  config.origin = std::move(origin);
   return config;
 }
 

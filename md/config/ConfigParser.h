@@ -44,6 +44,7 @@ class ConfigError : public std::invalid_argument {
 MdConfig parseConfigFile(const std::string& path, const std::vector<std::string>& overrides = {});
 
 /// Same as parseConfigFile for TOML `text`; `source_name` is the file name used in messages.
+/// Both record in MdConfig::origin where each key given in the text or an override was set.
 ///
 /// Rules:
 /// - Every section and key is optional (defaults of MdConfig.h); unknown ones are errors that list

@@ -22,6 +22,7 @@
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
 ///                   checkpoint_wall_seconds, write_velocities, write_forces
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include "md/neighbor/Skin.h"
@@ -141,6 +142,11 @@ struct MdConfig {
   CoulombConfig coulomb;
   RunConfig run;
   OutputConfig output;
+  /// Where each key the user gave was set: "section.key" -> "run.toml:3:1" or "--set
+  /// system.N=4" (the parser fills it; keys left at their defaults are absent). Not a key itself:
+  /// toToml and flatten leave it out. A file-given initial state refuses a system.N or system.phi
+  /// set here that contradicts the file, and replaces them where they are defaults.
+  std::map<std::string, std::string> origin;
 };
 
 }  // namespace granagg::md

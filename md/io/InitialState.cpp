@@ -81,11 +81,10 @@ void checkMinimumSize(std::size_t n, const std::string& path) {
 
 }  // namespace
 
-Frame readInitialStateCsv(const std::string& path, double box) {
-  if (!(box > 0.0) || !std::isfinite(box))
-    throw std::invalid_argument("initial state '" + path +
-                                "': the box edge must be positive and finite, got " +
-                                common::formatReal(box));
+namespace {
+
+/// The particles of a CSV initial state as written (box 0, positions not wrapped).
+Frame readCsvParticles(const std::string& path) {
   const common::CsvTable t = common::readCsv(path);  // names file:line for malformed numbers
   static const char* REQUIRED[] = {"x", "y", "z", "vx", "vy", "vz"};
   for (std::size_t k = 0; k < t.columns.size(); ++k) {
@@ -116,7 +115,6 @@ Frame readInitialStateCsv(const std::string& path, double box) {
   };
 
   Frame f;
-  f.box = box;
   for (auto* v : {&f.x, &f.y, &f.z, &f.vx, &f.vy, &f.vz, &f.charge}) v->resize(n);
   std::vector<double>* dst[6] = {&f.x, &f.y, &f.z, &f.vx, &f.vy, &f.vz};
   for (std::size_t i = 0; i < n; ++i) {
@@ -135,11 +133,28 @@ Frame readInitialStateCsv(const std::string& path, double box) {
                                   ": q = " + common::formatReal(q) + " is not finite");
     f.charge[i] = q;
   }
+  return f;
+}
+
+/// Puts a file's particles in a box of edge `box` (wrapIntoBox), naming the file in errors.
+void placeInBox(Frame& f, double box, const std::string& path) {
+  f.box = box;
   try {
     wrapIntoBox(f);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(path + ": " + e.what());
   }
+}
+
+}  // namespace
+
+Frame readInitialStateCsv(const std::string& path, double box) {
+  if (!(box > 0.0) || !std::isfinite(box))
+    throw std::invalid_argument("initial state '" + path +
+                                "': the box edge must be positive and finite, got " +
+                                common::formatReal(box));
+  Frame f = readCsvParticles(path);
+  placeInBox(f, box, path);
   return f;
 }
 
@@ -439,7 +454,12 @@ Frame readInitialStateH5md(const std::string& path, long frame, const std::strin
   return f;
 }
 
-Frame readInitialState(const std::string& path, double box_if_csv) {
+namespace {
+
+enum class StateFormat { H5md, LammpsData, Csv };
+
+/// The format of an initial state file, told by its content (readInitialState).
+StateFormat stateFormat(const std::string& path) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0)
     throw std::invalid_argument("initial state file '" + path + "' does not exist");
@@ -448,8 +468,21 @@ Frame readInitialState(const std::string& path, double box_if_csv) {
   h5::silenceErrors();
   const htri_t is_h5 = H5Fis_hdf5(path.c_str());
   h5::lastError();  // clear whatever H5Fis_hdf5 left on the stack
-  if (is_h5 > 0) return readInitialStateH5md(path);
-  if (isLammpsData(path)) return readInitialStateLammps(path);
+  if (is_h5 > 0) return StateFormat::H5md;
+  return isLammpsData(path) ? StateFormat::LammpsData : StateFormat::Csv;
+}
+
+}  // namespace
+
+Frame readInitialState(const std::string& path, double box_if_csv) {
+  switch (stateFormat(path)) {
+    case StateFormat::H5md:
+      return readInitialStateH5md(path);
+    case StateFormat::LammpsData:
+      return readInitialStateLammps(path);
+    case StateFormat::Csv:
+      break;
+  }
   return readInitialStateCsv(path, box_if_csv);
 }
 
@@ -504,13 +537,59 @@ OverlapPair deepestOverlap(const Frame& f) {
   return worst;
 }
 
+namespace {
+
+/// " (run.toml:3:1)": where the configuration set `key`, for messages.
+std::string setAt(const MdConfig& c, const std::string& key) {
+  const auto it = c.origin.find(key);
+  return it == c.origin.end() ? std::string() : " (" + it->second + ")";
+}
+
+/// A filling fraction read from a file agrees with a given one to this relative difference: a
+/// box written with 4 significant digits (L = 23.97 for N = 2000 at phi = 0.076) still agrees.
+constexpr double PHI_AGREEMENT = 1e-3;
+
+}  // namespace
+
 Frame prepareInitialState(MdConfig& c) {
   if (c.system.initial == "random") return randomInitialState(c);
   const std::string& path = c.system.initial;
-  Frame f = readInitialState(path, boxLength(c.system));
-  if (static_cast<int>(f.size()) != c.system.N)
-    throw std::invalid_argument("system.initial '" + path + "' holds " + std::to_string(f.size()) +
-                                " particles but system.N = " + std::to_string(c.system.N));
+  const StateFormat format = stateFormat(path);
+  Frame f = format == StateFormat::H5md         ? readInitialStateH5md(path)
+            : format == StateFormat::LammpsData ? readInitialStateLammps(path)
+                                                : readCsvParticles(path);
+  // N is the file's: a system.N the user gave must agree with it
+  const std::size_t n = f.size();
+  if (n > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw std::invalid_argument("system.initial '" + path + "' holds " + std::to_string(n) +
+                                " particles, more than system.N can count");
+  if (static_cast<int>(n) != c.system.N && c.origin.count("system.N"))
+    throw std::invalid_argument(
+        "system.N = " + std::to_string(c.system.N) + setAt(c, "system.N") +
+        " contradicts system.initial '" + path + "', which holds " + std::to_string(n) +
+        " particles: N (and the box of an H5MD or LAMMPS data file) come from the file; leave "
+        "system.N out or set it to " + std::to_string(n));
+  c.system.N = static_cast<int>(n);
+  if (format == StateFormat::Csv) {
+    placeInBox(f, boxLength(c.system), path);  // a CSV has no box: system.phi sets it
+  } else {
+    // the box is the file's: phi = N pi / (6 L^3) is the one the run has
+    const double phi = static_cast<double>(n) * M_PI / (6.0 * f.box * f.box * f.box);
+    if (c.origin.count("system.phi") &&
+        !(std::fabs(phi - c.system.phi) <= PHI_AGREEMENT * c.system.phi))
+      throw std::invalid_argument(
+          "system.phi = " + common::formatReal(c.system.phi) + setAt(c, "system.phi") +
+          " contradicts system.initial '" + path + "': " + std::to_string(n) +
+          " particles in its box L = " + common::formatReal(f.box) +
+          " are phi = " + common::formatReal(phi) + "; leave system.phi out (the file's box is "
+          "used) or set it to that value");
+    if (!(phi > 0.0 && phi < 0.6))
+      throw std::invalid_argument("system.initial '" + path + "': " + std::to_string(n) +
+                                  " particles in its box L = " + common::formatReal(f.box) +
+                                  " are phi = " + common::formatReal(phi) +
+                                  ", outside the (0, 0.6) of system.phi");
+    c.system.phi = phi;
+  }
   f.step = 0;
   f.time = 0.0;
   const double tolerance = c.system.initialMaxOverlap(c.run.max_overlap);

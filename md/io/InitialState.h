@@ -81,7 +81,12 @@ struct OverlapPair {
 OverlapPair deepestOverlap(const Frame& state);
 
 /// The initial state of a new run of `config`: randomInitialState for system.initial = "random",
-/// else the file (readInitialState), with the charges of charging.initial. A new run's clock
+/// else the file (readInitialState's formats), with the charges of charging.initial, and `config`
+/// made to say what the run has. N is the file's particle count. The box of an H5MD or LAMMPS
+/// data file is the file's, and system.phi becomes N pi / (6 L^3); a CSV has no box: system.phi
+/// and N set it, L = (N pi / (6 phi))^(1/3). A system.N or system.phi the user gave
+/// (config.origin) that contradicts the file is refused naming both values (phi agrees within
+/// a relative 1e-3, so a box written to 4 digits does); defaults are replaced. A new run's clock
 /// starts at its initial state: step and time are 0 whatever frame the file held (run.t_end is
 /// the time run from it). A file may hold contacts, as any frame of a running gas does, up to
 /// system.initial_max_overlap ("auto": run.max_overlap, which no step of a run exceeds); a

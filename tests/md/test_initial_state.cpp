@@ -2,7 +2,8 @@
 // naming the line and particle), H5MD (last frame of a trajectory) and LAMMPS data files (the
 // same state as a CSV to the bit; styles, ids, image flags, errors), plus coordinate wrapping;
 // what a new run takes from them (prepareInitialState): the contacts of a frame of granagg's own
-// run are accepted up to system.initial_max_overlap, deeper overlaps refused.
+// run are accepted up to system.initial_max_overlap, deeper overlaps refused; N and the box come
+// from the file, and a given system.N or system.phi that contradicts it is refused.
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
@@ -12,11 +13,16 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <string>
+#include <vector>
 
+#include "common/Csv.h"
 #include "common/H5mdReader.h"
+#include "md/config/ConfigParser.h"
 #include "md/io/H5mdWriter.h"
 #include "md/io/InitialState.h"
+#include "md/run/RunLog.h"
 #include "md/run/Simulation.h"
 
 #include "TestUtil.h"
@@ -47,6 +53,24 @@ double deepestOverlapAllPairs(const Frame& f) {
       worst = std::max(worst, 1.0 - std::sqrt(r2));
     }
   return worst;
+}
+
+/// Four atoms in a LAMMPS data file's box of edge 10 (atom style atomic): phi = 4 pi / 6000.
+const char* FOUR_ATOMS =
+    "LAMMPS data file: 4 atoms\n\n4 atoms\n1 atom types\n\n"
+    "0 10 xlo xhi\n0 10 ylo yhi\n0 10 zlo zhi\n\nMasses\n\n1 1.0\n\nAtoms # atomic\n\n"
+    "1 1 1.0 1.0 1.0\n2 1 3.0 1.0 1.0\n3 1 5.0 5.0 5.0\n4 1 8.0 2.0 7.0\n\n"
+    "Velocities\n\n1 0.5 0 0\n2 -0.5 0 0\n3 0 0.3 0\n4 0 0 -0.3\n";
+
+/// The message of the std::invalid_argument that f throws ("" if none).
+template <class F>
+std::string messageOf(F f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
 }
 
 /// A neutral Hertz gas of 500 particles at phi = 0.2: by t = 10 it has cooled to T_g ~ 0.03 and
@@ -421,4 +445,93 @@ TEST_CASE("an initial state deeper than system.initial_max_overlap is refused, n
                     Catch::Contains("particles 0 and 1 overlap by 0.01") &&
                         Catch::Contains("system.initial_max_overlap = 0.005;"));
   std::remove(p.c_str());
+}
+
+TEST_CASE("a LAMMPS data state sets N and phi, and the run records the phi it has",
+          "[md][io][run]") {
+  const std::string p = writeText("four.data", FOUR_ATOMS);
+  const double phi = 4.0 * M_PI / (6.0 * 1000.0);  // N pi / (6 L^3), L = 10
+  const std::string config = "[system]\ninitial = \"" + p + "\"\n[run]\nt_end = 0.05\n";
+  MdConfig c = parseConfigString(config, "run.toml");
+  CHECK(c.system.N == 1000);  // the defaults, until the file is read
+  const Frame f = prepareInitialState(c);
+  CHECK(f.box == 10.0);
+  CHECK(c.system.N == 4);
+  CHECK(c.system.phi == Approx(phi).epsilon(1e-15));
+  // the run logs and stores the phi it has
+  const std::filesystem::path dir = granagg::test::tempDir("lammps_phi");
+  Simulation sim = Simulation::start(parseConfigString(config, "run.toml"), dir / "run", {});
+  CHECK(sim.config().system.phi == Approx(phi).epsilon(1e-15));
+  std::string log;
+  for (const auto& line : runStartLines(sim)) log += line + "\n";
+  CHECK_THAT(log, Catch::Contains("N = 4, phi = 0.0020944, box L = 10,"));
+  sim.run();
+  const granagg::common::H5mdReader r((dir / "run" / "traj.h5").string());
+  std::map<std::string, std::string> params;
+  for (const auto& [k, v] : r.parameters()) params[k] = v;
+  CHECK(std::stod(params.at("system.phi")) == Approx(phi).epsilon(1e-15));
+  CHECK(params.at("system.N") == "4");
+  CHECK_THAT(r.configToml(), Catch::Contains("N = 4\n"));
+  std::filesystem::remove_all(dir);
+  std::remove(p.c_str());
+}
+
+TEST_CASE("a system.N or system.phi that contradicts the initial file is refused, naming both",
+          "[md][io]") {
+  const std::string p = writeText("four_given.data", FOUR_ATOMS);
+  const std::string config = "[system]\ninitial = \"" + p + "\"\n";
+  auto prepared = [&](const std::string& extra, const std::vector<std::string>& set) {
+    MdConfig c = parseConfigString(config + extra, "run.toml", set);
+    prepareInitialState(c);
+    return c;
+  };
+  const std::string n = messageOf([&] { prepared("N = 1000\n", {}); });
+  CHECK_THAT(n, Catch::Contains("system.N = 1000 (run.toml:3:5)") &&
+                    Catch::Contains("holds 4 particles"));
+  const std::string phi = messageOf([&] { prepared("", {"system.phi=0.076"}); });
+  CHECK_THAT(phi, Catch::Contains("system.phi = 0.076 (--set system.phi=0.076)") &&
+                      Catch::Contains("phi = 0.0020943951"));
+  // values that agree (phi to a relative 1e-3: a box written to a few digits) are taken, and the
+  // run has the file's phi
+  const MdConfig agreed = prepared("N = 4\nphi = 0.002094\n", {});
+  CHECK(agreed.system.N == 4);
+  CHECK(agreed.system.phi == Approx(4.0 * M_PI / 6000.0).epsilon(1e-15));
+  std::remove(p.c_str());
+}
+
+TEST_CASE("an H5MD state sets N and phi from its frame; a CSV takes its box from N and phi",
+          "[md][io]") {
+  const std::string h5 = tempPath("three.h5");
+  std::remove(h5.c_str());
+  {
+    H5mdWriter w(h5, 3, {}, "", true);
+    Frame f;
+    f.box = 6.0;
+    f.x = {0.5, 2.5, 4.5};
+    f.y = f.z = {1.0, 3.0, 5.0};
+    f.vx = f.vy = f.vz = {0.1, -0.2, 0.1};
+    f.charge = {0, 0, 0};
+    f.ix = f.iy = f.iz = {0, 0, 0};
+    w.writeFrame(f);
+  }
+  MdConfig c = parseConfigString("[system]\ninitial = \"" + h5 + "\"\n", "run.toml");
+  CHECK(prepareInitialState(c).box == 6.0);
+  CHECK(c.system.N == 3);
+  CHECK(c.system.phi == Approx(3.0 * M_PI / (6.0 * 216.0)).epsilon(1e-15));
+  std::remove(h5.c_str());
+  std::remove(H5mdWriter::xdmfPathFor(h5).c_str());
+
+  // CSV: N is the number of rows, the box that of N and system.phi
+  const std::string csv = writeText("three.csv",
+                                    "x,y,z,vx,vy,vz\n0.5,1,1,0,0,0\n2.5,3,3,0,0,0\n4.5,5,5,0,0,0\n");
+  MdConfig d = parseConfigString("[system]\nphi = 0.01\ninitial = \"" + csv + "\"\n", "r.toml");
+  CHECK(prepareInitialState(d).box == Approx(std::cbrt(3.0 * M_PI / 0.06)).epsilon(1e-15));
+  CHECK(d.system.N == 3);
+  CHECK(d.system.phi == 0.01);
+  MdConfig e = parseConfigString("[system]\ninitial = \"" + csv + "\"\n", "r.toml",
+                                 {"system.N=1000"});
+  CHECK_THAT(messageOf([&] { prepareInitialState(e); }),
+             Catch::Contains("system.N = 1000 (--set system.N=1000)") &&
+                 Catch::Contains("holds 3 particles"));
+  std::remove(csv.c_str());
 }
