@@ -131,8 +131,8 @@ TEST_CASE("power-law fit of an exact power law returns its exponent with a zero-
 
 TEST_CASE("a series that does not change has no growth exponent, not z = 0 +- 0",
           "[analysis][fit]") {
-  // S_grid = 1 at every frame (no aggregation) used to give z = 0 [0, 0]: an interval of zero
-  // width from zero residuals, a certainty the data do not carry.
+  // S_grid = 1 at every frame (no aggregation): least squares would give z = 0 [0, 0], an
+  // interval of zero width from zero residuals, a certainty the data do not carry.
   const std::vector<double> t{1, 2, 3, 4, 5, 6}, one(6, 1.0);
   const PowerLawFitResult f = fitPowerLaw(t, one, 0, 10);
   CHECK_FALSE(f.valid);

@@ -179,8 +179,8 @@ TEST_CASE("analyze of an md ensemble writes ensemble and per-run tables and anal
 
 TEST_CASE("analyze warns when the growth-exponent window holds too few frames",
           "[cli][analyze]") {
-  // The run's frames lie in t = 0 .. 1; a window over [100, 200] holds none, so z is NaN. That
-  // used to pass in silence with exit status 0.
+  // The run's frames lie in t = 0 .. 1; a window over [100, 200] holds none, so z is NaN: said on
+  // stderr, with the tables written and exit status 0.
   const fs::path dir = tempDir("window");
   const fs::path run = mdRun(dir, "run", 4);
   const Run r = runGranagg("analyze " + run.string() + " --out " + (dir / "o").string() +
@@ -212,7 +212,7 @@ TEST_CASE("analyze warns when the growth-exponent window holds too few frames",
 TEST_CASE("analyze reports no growth exponent where S does not change", "[cli][analyze]") {
   // Four frames of one configuration: four touching particles fill one grid cell (local filling
   // fraction 4 (pi/6) / 8 = 0.26 >= 0.25) and form one particle cluster, so S_grid and
-  // S_particle are the same at every frame. The fit used to print z = 0 [0, 0].
+  // S_particle are the same at every frame: no exponent, not z = 0 [0, 0].
   const fs::path dir = tempDir("flat");
   const fs::path dump = dir / "still.dump";
   {

@@ -126,8 +126,8 @@ bool smolOptionServes(const std::string& option, const std::string& method) {
 }  // namespace
 
 TEST_CASE("the README's sectional smol example reaches its t_end", "[cli][smol]") {
-  // README, CLI tour: "$G smol --beta 3 --method sectional --t-end 1e7 --out S.csv". It used to
-  // stop at t = 5.6e6 ("raise the largest size, --M", an option the sectional method ignores).
+  // README, CLI tour: "$G smol --beta 3 --method sectional --t-end 1e7 --out S.csv". S reaches
+  // 2e11 there, beyond the sectional grid's first last pivot (1e12 holds S up to ~7e10).
   const std::string readme = granagg::test::slurp(std::string(GRANAGG_SOURCE_DIR) + "/README.md");
   const std::string example = "$G smol --beta 3 --method sectional --t-end 1e7 --out S.csv";
   REQUIRE_THAT(readme, Catch::Contains(example));

@@ -185,8 +185,8 @@ TEST_CASE("fit-beta recovers z of an exact power law exactly", "[cli][fitbeta]")
 TEST_CASE("fit-beta writes no number for a beta_fit at a bound of the search range",
           "[cli][fitbeta]") {
   // S = t^2.6 grows faster than every mean-field curve in [1.5, 6] (z = 3 beta / (beta + 3) <= 2):
-  // the curve fit ends at beta = 6, which is the search bound, not a result. It used to be
-  // written as beta_fit = 6 in fit_beta.csv and fit_beta.json.
+  // the curve fit ends at beta = 6, which is the search bound, not a result: no number for it in
+  // fit_beta.csv and fit_beta.json.
   const fs::path dir = tempDir("bound");
   std::vector<std::vector<double>> rows;
   for (int i = 0; i < 30; ++i) {
@@ -221,7 +221,7 @@ TEST_CASE("fit-beta writes no number for a beta_fit at a bound of the search ran
 TEST_CASE("fit-beta names the runs and times whose S is NaN when too few samples are left",
           "[cli][fitbeta]") {
   // What `pair --preset tiny` meets at K = 5: S_grid is NaN (no occupied grid cell) in run 0 at
-  // most frames and in run 1 at some. The message said "0 samples with t > 0", not why.
+  // most frames and in run 1 at some. The error says which rows went and why.
   const fs::path dir = tempDir("nan-runs");
   std::vector<std::vector<double>> rows;
   const double nan = std::nan("");
@@ -247,7 +247,7 @@ TEST_CASE("fit-beta names the runs and times whose S is NaN when too few samples
 
 TEST_CASE("fit-beta reports no z, not a zero-width interval, for an S that does not grow",
           "[cli][fitbeta]") {
-  // pair --preset tiny at K = 0: S_grid = 1 at every frame gave "z = 0 [-1e-12, 1e-12]".
+  // pair --preset tiny at K = 0: S_grid = 1 at every frame; a fit would say z = 0 [-1e-12, 1e-12].
   const fs::path dir = tempDir("flat");
   std::vector<std::vector<double>> rows;
   for (int k = 1; k <= 10; ++k) rows.push_back({0.5 * k, 1.0});

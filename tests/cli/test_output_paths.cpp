@@ -1,6 +1,6 @@
 // Outputs that cannot be written are refused before any work, in one line of one style naming
 // --out, with exit status 2 (common/OutputPath.h): smol, smol zbeta, kinetic, fit-beta, analyze
-// and md. A missing or read-only folder used to show after the solve or fit, or as raw
+// and md: a missing or read-only folder shows before the solve or fit, never as raw
 // "filesystem error" text.
 #include <catch2/catch.hpp>
 
