@@ -48,6 +48,7 @@ TEST_CASE("bad input gives one line naming the option and exit status 2", "[cli]
        {Case{"smol --beta -1", "--beta"}, Case{"smol --beta 0", "--beta"},
         Case{"smol --t-min -1", "--t-min"}, Case{"smol --t-end -5", "--t-end"},
         Case{"smol --method discrete --M 1", "--M"},
+        Case{"smol --method discrete --M 4000000000", "--M must lie in [2, 2147483647]"},
         Case{"smol --kernel gaussian", "unknown kernel"}, Case{"smol --method euler", "--method"},
         Case{"smol --ratio 1", "--ratio"},
         Case{"smol --kernel multiplicative --t-end 2", "gel time"},
@@ -150,6 +151,10 @@ TEST_CASE("the README's sectional smol example reaches its t_end", "[cli][smol]"
   CHECK(std::stod(cells[5]) == Approx(1.5).margin(1e-4));
   CHECK(cells[7] == "1");
   std::remove(out.c_str());
+  // --M, the discrete method's bound, is said to be unused here, whatever its value
+  const Run m = runGranagg("smol --beta 3 --method sectional --t-end 10 --M 4000000000 --out -");
+  CHECK(m.status == 0);
+  CHECK_THAT(m.output, Catch::Contains("--M applies to --method discrete only"));
 }
 
 TEST_CASE("a smol that stops early advises options of its own method", "[cli][smol]") {
