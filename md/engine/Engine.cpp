@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -590,7 +591,13 @@ struct Engine::Impl {
       msg << ", or an attractive Coulomb pair beyond what the Hertz contact can hold (K |q_i q_j| "
              "> 0.0916 E = "
           << hold << " has no equilibrium overlap; here K q^2 = " << cfg.coulomb.K * worst_qq
-          << " for the largest flagged charge): lower coulomb.K or charging.Q";
+          << " for the largest flagged charge): lower charging.Q (here " << cfg.charging.Q
+          << "; recommended: 0.05 at K = 5, docs/validation.md";
+      char q[32];  // two digits: a value to type
+      std::snprintf(q, sizeof q, "%.2g", recommendedChargeScale(cfg.coulomb.K));
+      if (cfg.coulomb.K != 5.0)  // the gas depends on K Q^2 only
+        msg << ", so " << q << " at K = " << cfg.coulomb.K << ", the same K Q^2";
+      msg << ": --set charging.Q=" << q << ") or coulomb.K";
     }
     throw RunAborted(msg.str());
   }
@@ -757,6 +764,16 @@ Engine::Engine(const MdConfig& config, const Checkpoint& ck)
   extra.ints = c.int_scalars;
   extra.reals = c.real_scalars;
   restore(ck.state, f, collisions == c.int_scalars.end() ? 0 : collisions->second, extra);
+}
+
+void Engine::saveCheckpoint(const std::filesystem::path& folder,
+                            const CheckpointExtra& run_fields) {
+  Checkpoint ck = checkpoint();
+  ck.extra.config_toml = run_fields.config_toml;
+  ck.extra.seed = run_fields.seed;
+  ck.extra.frames_written = run_fields.frames_written;
+  ck.extra.next_frame_index = run_fields.next_frame_index;
+  writeCheckpoint(checkpointPath(folder).string(), ck.state, ck.extra);
 }
 
 Checkpoint Engine::checkpoint() const {
@@ -1010,5 +1027,7 @@ std::string Engine::backendDescription() {
   return "Thrust OpenMP backend, " + std::to_string(omp_get_max_threads()) + " thread(s)";
 #endif
 }
+
+std::string Engine::description() const { return backendDescription(); }
 
 }  // namespace granagg::md

@@ -47,46 +47,11 @@
 
 #include "md/config/MdConfig.h"
 #include "md/coulomb/CoulombDesign.h"
+#include "md/engine/RunEngine.h"
 #include "md/io/Checkpoint.h"
 #include "md/io/Frame.h"
 
 namespace granagg::md {
-
-/// Observables at one step (docs/model.md section 10, "Per frame"). Energies are totals (not per
-/// particle).
-struct Observables {
-  std::int64_t step = 0;
-  double time = 0.0;
-  double temperature = 0.0;        ///< T_g = (1/3N) sum (v - <v>)^2
-  double kinetic_energy = 0.0;     ///< (1/2) sum v^2
-  double elastic_energy = 0.0;     ///< sum over contacts of the elastic energy
-  double momentum[3] = {0, 0, 0};  ///< sum v
-  double momentum_abs_sum = 0.0;   ///< sum |v| (scale for momentum conservation)
-  double contacts_per_particle = 0.0;
-  std::int64_t collisions = 0;  ///< new contacts since the start of the run
-  double mean_overlap = 0.0;    ///< over pairs in contact (0 if none)
-  double max_overlap = 0.0;
-  double total_charge = 0.0;     ///< sum q (conserved by the exchange rule)
-  double mean_abs_charge = 0.0;  ///< (1/N) sum |q|, the paper's q-bar
-  double max_abs_charge = 0.0;
-  double coulomb_energy =
-      0.0;  ///< Ewald total (real + mesh/reciprocal + self + background); 0 without Coulomb
-};
-
-/// The Coulomb method's parameters as chosen for a run (docs/coulomb.md), logged and stored.
-
-/// Which velocities and forces a host copy holds. They differ only with Coulomb forces on a
-/// multiple-time-step schedule (coulomb.every = k > 1; see Engine), and there only between
-/// Coulomb evaluations.
-enum class StateKind {
-  /// The integrator's state: what a checkpoint stores. Velocities v(t) = u + (dt/2) f(t); forces
-  /// f(t) = contact + w Coulomb with the impulse weight w (k at an evaluation step, 0 between).
-  Integrator,
-  /// For output and observables: the velocities of the smooth trajectory that the impulses
-  /// approximate, v - (k/2 - j) dt F_C at j = 1..k-1 steps after an evaluation, and forces
-  /// contact + F_C (F_C from the last evaluation).
-  Physical,
-};
 
 /// Engine state besides particles and forces that a bit-for-bit restart needs (checkpoint
 /// datasets and scalars; see CheckpointExtra).
@@ -96,14 +61,9 @@ struct EngineExtra {
   std::map<std::string, double> reals;
 };
 
-/// Thrown when a run must stop (NaN, overlap beyond the bound); the message names the step and the
-/// particles (and, for a Coulomb collapse, the criterion). The last checkpoint is the good state.
-class RunAborted : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-class Engine {
+/// granagg's engine behind md::RunEngine (md/engine/RunEngine.h), on one process (OpenMP or
+/// CUDA): writesFiles() and anyRank() keep their defaults.
+class Engine : public RunEngine {
  public:
   /// Builds the engine from a validated configuration and an initial state (box L in initial.box).
   /// Throws std::invalid_argument for overlapping particles (naming the pair; a fresh initial state
@@ -116,55 +76,60 @@ class Engine {
   /// configuration, as stored with the checkpoint; run.t_end may differ). Throws
   /// std::invalid_argument if the checkpoint does not fit the configuration.
   Engine(const MdConfig& config, const Checkpoint& checkpoint);
-  ~Engine();
+  ~Engine() override;
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
 
   /// Advances `steps` velocity-Verlet steps. Throws RunAborted when a step fails its checks; the
   /// engine is then mid-step and must not be advanced further (a run restarts from its last
   /// checkpoint, as `granagg md` does).
-  void run(std::int64_t steps);
+  void run(std::int64_t steps) override;
 
   /// Host copy of the current state (wrapped positions, images, velocities, charges).
-  Frame frame(StateKind kind = StateKind::Integrator) const;
+  Frame frame(StateKind kind = StateKind::Integrator) const override;
   /// Forces of the current state, fx, fy, fz concatenated: the integrator's (a bit-for-bit restart
   /// needs them) or the physical ones (output).
-  std::vector<double> forces(StateKind kind = StateKind::Integrator) const;
+  std::vector<double> forces(StateKind kind = StateKind::Integrator) const override;
   /// Everything the engine needs to continue bit for bit (Engine(config, checkpoint)): the
   /// integrator's state and forces, dt, the collision counter, the Coulomb parameters' design
   /// and the multiple-time-step state. The run's own fields (config_toml, seed, frame counters)
   /// are left for the caller (md/run/Simulation).
   Checkpoint checkpoint() const;
+  /// checkpoint() with the run's fields of `run_fields` (config_toml, seed, frames_written,
+  /// next_frame_index), written atomically to checkpointPath(folder) = folder/checkpoint.h5
+  /// (md::writeCheckpoint).
+  void saveCheckpoint(const std::filesystem::path& folder,
+                      const CheckpointExtra& run_fields) override;
   /// What else a bit-for-bit restart needs (the Coulomb force of the last evaluation).
   EngineExtra extraState() const;
   /// Restores a checkpointed state with its forces, collision counter and extraState() (same N).
   void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions,
                const EngineExtra& extra = {});
 
-  Observables observables() const;
-  double dt() const;
-  std::int64_t step() const;
-  double time() const;
-  double box() const;
-  std::size_t size() const;
+  Observables observables() const override;
+  double dt() const override;
+  std::int64_t step() const override;
+  double time() const override;
+  double box() const override;
+  std::size_t size() const override;
   /// Number of neighbour-list builds so far (diagnostics).
-  std::int64_t neighborBuilds() const;
+  std::int64_t neighborBuilds() const override;
   /// Skins of the current contact list and Coulomb (PPPM real-space) list, 0 for none; they
   /// follow the gas where neighbor.skin and coulomb.skin are "auto" (md/neighbor/Skin.h).
   double contactListSkin() const;
   double coulombListSkin() const;
   /// Times the phases of every following step (md/engine/PhaseTimer.h; `granagg md --profile`).
   /// Changes no result; on the CUDA backend each phase then waits for the device.
-  void enableProfile(bool on);
+  void enableProfile(bool on) override;
   /// Wall seconds per phase since profiling was enabled, in PhaseTimer's order (zeros if never).
-  std::vector<std::pair<std::string, double>> phaseSeconds() const;
+  std::vector<std::pair<std::string, double>> phaseSeconds() const override;
   /// The Coulomb parameters in use, or null when coulomb.K = 0.
-  const CoulombSetup* coulombSetup() const;
+  const CoulombSetup* coulombSetup() const override;
   /// Steps from the last evaluation of the slow Coulomb part to the next (the interval in force;
   /// it changes only with coulomb.every_max); 0 without Coulomb.
-  int slowInterval() const;
+  int slowInterval() const override;
   /// Evaluations of the slow Coulomb part so far in this process (0 without Coulomb).
-  std::int64_t slowEvaluations() const;
+  std::int64_t slowEvaluations() const override;
   /// Re-chooses the Coulomb parameters for sum_q2_design (a restart passes the stored value, so
   /// that it continues with the same parameters as the uninterrupted run). No-op without Coulomb.
   void useCoulombDesign(double sum_q2_design);
@@ -173,6 +138,8 @@ class Engine {
   static void setThreads(int n);
   /// "OpenMP (2 threads)" or "CUDA (device name)": printed at start-up and stored in outputs.
   static std::string backendDescription();
+  /// backendDescription().
+  std::string description() const override;
   /// Steps between evaluations of the slow Coulomb part for a configuration and time step
   /// (coulomb.every, or "auto": every 0.016 time units; 1 for plain Ewald).
   static int coulombEvery(const MdConfig& config, double dt);

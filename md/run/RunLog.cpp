@@ -13,17 +13,19 @@ namespace granagg::md {
 using common::printfString;
 
 std::vector<std::string> runStartLines(const Simulation& sim) {
-  const Engine& e = sim.engine();
+  const RunEngine& e = sim.engine();
   const MdConfig& cfg = sim.config();
   std::vector<std::string> out;
   out.push_back("md: " + common::versionString());
-  // the hint belongs in the log, not in the outputs that store the description
+  // the hint belongs in the log, not in the outputs that store the description; it is about
+  // granagg's own engine on the CPU (LAMMPS's ranks are mpirun's -np)
 #ifdef GRANAGG_CUDA
   const char* hint = "";
 #else
-  const char* hint = " (set OMP_NUM_THREADS or --threads to change)";
+  const char* hint =
+      dynamic_cast<const Engine*>(&e) ? " (set OMP_NUM_THREADS or --threads to change)" : "";
 #endif
-  out.push_back("md: backend: " + Engine::backendDescription() + hint);
+  out.push_back("md: backend: " + e.description() + hint);
   out.push_back(printfString("md: N = %d, phi = %g, box L = %.6g, contact model %s, seed %llu",
                              cfg.system.N, cfg.system.phi, e.box(), cfg.contact.model.c_str(),
                              static_cast<unsigned long long>(cfg.system.seed)));
@@ -61,8 +63,8 @@ std::vector<std::string> runStartLines(const Simulation& sim) {
 }
 
 std::vector<std::string> runSummaryLines(const Simulation& sim, const RunSummary& s) {
-  const Engine& e = sim.engine();
-  const Observables o = e.observables();
+  const RunEngine& e = sim.engine();
+  const Observables& o = s.observables;  // (the engine's observables() may be collective)
   std::vector<std::string> out;
   out.push_back(printfString(
       "md: %lld steps in %.4g s (%.3g particle-steps/s incl. output); neighbour list rebuilt %lld "
@@ -89,7 +91,7 @@ std::vector<std::string> runSummaryLines(const Simulation& sim, const RunSummary
   return out;
 }
 
-std::vector<std::string> profileLines(const Engine& engine, std::int64_t steps,
+std::vector<std::string> profileLines(const RunEngine& engine, std::int64_t steps,
                                       double loop_seconds) {
   std::vector<std::string> out;
   out.push_back(printfString("md: time by phase (--profile), %lld steps, loop %.4g s:",
@@ -125,7 +127,7 @@ ProgressReporter::ProgressReporter(const Simulation& sim)
 
 void ProgressReporter::report(const Simulation& sim) {
   if (!m_line.due()) return;
-  const Engine& e = sim.engine();
+  const RunEngine& e = sim.engine();
   const double el = std::chrono::duration<double>(Clock::now() - m_start).count();
   const double rate = static_cast<double>(e.step() - m_first_step) / std::max(el, 1e-9);
   const double done = (e.time() - m_t_start) / std::max(m_t_end - m_t_start, 1e-300);

@@ -16,10 +16,11 @@ namespace granagg::md {
 /// Version, backend, N / phi / L / contact model / seed, dt and its reason, the Coulomb set-up
 /// and multiple time stepping, and where a resumed run restarts.
 std::vector<std::string> runStartLines(const Simulation& sim);
-/// Steps, wall time and rate, the final state, slow Coulomb evaluations, the files written.
+/// Steps, wall time and rate, the final state (summary.observables), slow Coulomb evaluations,
+/// the files written.
 std::vector<std::string> runSummaryLines(const Simulation& sim, const RunSummary& summary);
 /// `--profile`: the loop's wall time by phase (profile.csv holds the same numbers).
-std::vector<std::string> profileLines(const Engine& engine, std::int64_t steps,
+std::vector<std::string> profileLines(const RunEngine& engine, std::int64_t steps,
                                       double loop_seconds);
 
 /// The progress line (common/ProgressLine.h): time, T_g, rate and the time left; in place on a

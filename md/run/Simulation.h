@@ -1,25 +1,37 @@
 #pragma once
 /// \file Simulation.h
-/// A restartable MD run: an Engine plus its output folder (docs/ARCHITECTURE.md), the frame and
-/// observable schedule and the checkpoints. `granagg md` is option wiring around this class; so is
-/// any other driver (a test, a study). Modelled on OpenMM's Simulation: the run owns the engine and
-/// its outputs, and reporters look at it between chunks of steps.
+/// A restartable MD run: an engine plus its output folder (docs/ARCHITECTURE.md), the frame and
+/// observable schedule and the checkpoints. `granagg md` is option wiring around this class; so are
+/// `granagg-lammps` and any other driver (a test, a study). Modelled on OpenMM's Simulation: the
+/// run owns the engine and its outputs, and reporters look at it between chunks of steps. The
+/// engine is anything behind md::RunEngine (md/engine/RunEngine.h): granagg's md::Engine, which
+/// start() and resume() build, or one the caller builds (LAMMPS across MPI ranks,
+/// md/lammps/LammpsEngine.h).
+///
+/// Ranks. Under MPI every rank runs the same Simulation and makes the engine's collective calls in
+/// the same order; only the rank where RunEngine::writesFiles() holds the folder lock, the
+/// trajectory and the profile, and checks the trajectory between chunks. Checks that only the
+/// writing rank can make (the folder) are agreed on through RunEngine::anyRank, so that every rank
+/// throws the same kind of error; RunOptions::stop is OR-ed over the ranks.
 ///
 /// Output folder:
 ///     traj.h5        H5MD trajectory: frames (log- and/or linearly spaced), observables every
 ///                    output.observable_interval steps and at the end, /parameters (provenance)
 ///     checkpoint.h5  the state to continue from bit for bit (md/io/Checkpoint.h), written every
 ///                    output.checkpoint_interval steps and/or output.checkpoint_wall_seconds, and
-///                    at the end of run()
+///                    at the end of run() (another engine writes its own checkpoint files:
+///                    RunEngine::saveCheckpoint, checkpointPath)
 ///     profile.csv    with RunOptions::profile: wall seconds per phase of the loop
 ///     .granagg.lock  while start() or resume() writes the folder (common/FolderLock.h): a second
 ///                    command into the same folder is refused, naming this one
 ///
-/// Determinism: a run resumed from any of its checkpoints writes the same frames, observables and
-/// final state, to the bit, as the uninterrupted run (same build; any thread count).
+/// Determinism: a run of md::Engine resumed from any of its checkpoints writes the same frames,
+/// observables and final state, to the bit, as the uninterrupted run (same build; any thread
+/// count). Another engine's restart may be close without being exact (LAMMPS: docs/lammps.md).
 #include <csignal>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -28,6 +40,7 @@
 
 #include "md/config/MdConfig.h"
 #include "md/engine/Engine.h"
+#include "md/engine/RunEngine.h"
 
 namespace granagg::md {
 
@@ -58,7 +71,8 @@ struct RunOptions {
   bool overwrite = false;
   bool profile = false;      ///< time the loop by phase and write profile.csv (no result changes)
   /// When it points at a nonzero value (a signal handler sets it), run() stops after the chunk of
-  /// steps in progress, writes a checkpoint and returns with RunSummary::stopped.
+  /// steps in progress, writes a checkpoint and returns with RunSummary::stopped. Under MPI a
+  /// signal caught by any rank stops every rank at the same chunk boundary.
   const volatile std::sig_atomic_t* stop = nullptr;
 };
 
@@ -69,7 +83,11 @@ struct RunSummary {
   std::int64_t neighbor_builds = 0;   ///< contact-list builds in this run()
   std::int64_t slow_evaluations = 0;  ///< evaluations of the slow Coulomb part in this run()
   bool stopped = false;  ///< ended early by RunOptions::stop (checkpoint written; resume() goes on)
+  Observables observables;  ///< of the state run() ended in (the same on every rank)
 };
+
+/// Builds the engine that continues a checkpoint under the run's configuration (resume()).
+using EngineFromCheckpoint = std::function<std::unique_ptr<RunEngine>(const MdConfig&)>;
 
 class Simulation {
  public:
@@ -81,6 +99,12 @@ class Simulation {
   /// observables at t = 0; a failure there removes a folder it created.
   static Simulation start(const MdConfig& config, const std::filesystem::path& out,
                           const RunOptions& options);
+  /// As above with an engine the caller built from `config` and its initial state (collectively,
+  /// on every rank: LAMMPS). The folder is checked and locked on the writing rank; then
+  /// RunEngine::begin(out) lets the engine write its own files, and the frame and observables at
+  /// its first step are written.
+  static Simulation start(const MdConfig& config, std::unique_ptr<RunEngine> engine,
+                          const std::filesystem::path& out, const RunOptions& options);
   /// Continues the run in `out` from its checkpoint.h5, with the configuration stored there.
   /// `overrides` ("key=value", as --set) may only set run.t_end, to run further; the trajectory
   /// then records the continuation (/granagg/restarts, H5mdWriter::recordRestart). Throws
@@ -90,6 +114,14 @@ class Simulation {
   /// any other locks the folder as start() does.
   static Simulation resume(const std::filesystem::path& out,
                            const std::vector<std::string>& overrides, const RunOptions& options);
+  /// As above for a checkpoint of another engine, which the caller has read: `run_fields` holds
+  /// the run's fields stored with it (config_toml, frames_written; `config_source` names it in
+  /// messages) and `continue_engine` builds the engine from it under the run's configuration
+  /// (collectively, on every rank). After the folder is locked, RunEngine::begin(out).
+  static Simulation resume(const std::filesystem::path& out,
+                           const std::vector<std::string>& overrides, const RunOptions& options,
+                           const CheckpointExtra& run_fields, const std::string& config_source,
+                           const EngineFromCheckpoint& continue_engine);
 
   Simulation(Simulation&&) noexcept;
   Simulation& operator=(Simulation&&) noexcept;
@@ -107,10 +139,10 @@ class Simulation {
   /// chunks, or unreadable after closing): such a run never ends as a success.
   RunSummary run();
 
-  /// Writes checkpoint.h5 now (atomically; the trajectory is flushed first).
+  /// Writes checkpoint.h5 now (atomically; the trajectory is flushed first). Collective.
   void writeCheckpoint();
 
-  const Engine& engine() const;
+  const RunEngine& engine() const;
   const MdConfig& config() const;
   const std::filesystem::path& folder() const;
   std::filesystem::path trajectoryPath() const;
@@ -139,6 +171,13 @@ class Simulation {
  private:
   struct Impl;
   explicit Simulation(std::unique_ptr<Impl> impl);
+  /// start()'s second half, once the engine is set up: lock, begin(), the header and t = 0.
+  static Simulation startWriting(std::unique_ptr<Impl> d);
+  /// resume()'s common part; `folder_checked`: FolderLock::checkAvailable was called already.
+  static Simulation resumeWith(const std::filesystem::path& out,
+                               const std::vector<std::string>& overrides, const RunOptions& options,
+                               const CheckpointExtra& run_fields, const std::string& config_source,
+                               const EngineFromCheckpoint& continue_engine, bool folder_checked);
   std::unique_ptr<Impl> m_impl;
 };
 
