@@ -21,6 +21,7 @@
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
 ///                   checkpoint_wall_seconds, write_velocities, write_forces
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -81,14 +82,22 @@ struct ChargingConfig {
   /// initial charges: "neutral" (all 0), "monopolar" (all +q0), "bipolar" (+q0 or -q0 at random,
   /// zero net charge for even N), "file" (from system.initial)
   std::string initial = "neutral";
-  double q0 = 1.0;        ///< charge magnitude of monopolar / bipolar initial states
-  double Q = 1.0;         ///< charge scale of the exchange rule
+  double q0 = 1.0;  ///< charge magnitude of monopolar / bipolar initial states
+  /// charge scale of the exchange rule; the default suits K = 0 (charges exert no force there),
+  /// with Coulomb forces see recommendedChargeScale
+  double Q = 1.0;
   double kappa = 0.83;    ///< exponent (Poppe et al. 2000, silica)
   double psi1_min = 0.1;  ///< Psi1 range: U[0.1, 3.1623], mean 1.63
   double psi1_max = 3.1623;
   double psi2_fraction =
       0.05;  ///< Psi2 ~ U[-0.05 kappa, +0.05 kappa] (mean 0; docs/model.md section 9)
 };
+
+/// The charge scale Q recommended at Coulomb constant K > 0: 0.05 at K = 5, the largest value of
+/// the validation study's Q scan at which K = 5 runs (Q = 0.1 collapses: docs/validation.md).
+/// The gas depends on K and Q only through K Q^2 (docs/validation.md), so Q = 0.05 sqrt(5 / K)
+/// at other K.
+inline double recommendedChargeScale(double K) { return 0.05 * std::sqrt(5.0 / K); }
 
 /// Coulomb interaction K q_i q_k / r^2 with all periodic images (Ewald, tinfoil boundary).
 struct CoulombConfig {

@@ -68,7 +68,7 @@ TEST_CASE("pair configuration: the resolved TOML reads back as the same configur
   PairConfig c = parsePairConfig(TINY);
   CHECK(c.name == "tiny");
   CHECK(c.md_preset == "quick");
-  CHECK(c.charged_Q == 0.1);
+  CHECK(c.charged_Q == 0.05);
   c.K = {0.0, 2.5, 5.0};
   c.fit_window = {10.0, 1000.0};
   c.fit_column = "S_particle_mean";
