@@ -522,8 +522,8 @@ TEST_CASE("an H5MD state sets N and phi from its frame; a CSV takes its box from
   std::remove(H5mdWriter::xdmfPathFor(h5).c_str());
 
   // CSV: N is the number of rows, the box that of N and system.phi
-  const std::string csv = writeText("three.csv",
-                                    "x,y,z,vx,vy,vz\n0.5,1,1,0,0,0\n2.5,3,3,0,0,0\n4.5,5,5,0,0,0\n");
+  const std::string csv = writeText(
+      "three.csv", "x,y,z,vx,vy,vz\n0.5,1,1,0,0,0\n2.5,3,3,0,0,0\n4.5,5,5,0,0,0\n");
   MdConfig d = parseConfigString("[system]\nphi = 0.01\ninitial = \"" + csv + "\"\n", "r.toml");
   CHECK(prepareInitialState(d).box == Approx(std::cbrt(3.0 * M_PI / 0.06)).epsilon(1e-15));
   CHECK(d.system.N == 3);
