@@ -46,6 +46,10 @@
 /// granular damping with the full-step velocity v(t_n) where the uninterrupted run used
 /// u(t_n - dt/2); with the stored forces the continued run takes the same first kick as the
 /// uninterrupted one. The cumulative collision count is stored as global restart data.
+/// The write_restart command moves atoms between ranks before it writes (pbc, exchange), and
+/// atom->f does not move with them: init(), which it calls first, keeps the forces in the
+/// per-atom array that migrates, and the next run's setup puts them back in the writing process
+/// too (that run must not be `pre no`: the neighbour lists are stale after the move).
 ///
 /// Requirements checked at init: atom_style with q, radius and rmass; unit spheres of unit mass
 /// (granagg's particles: the charging rule's m_eff = 1/2); newton_pair on; comm_modify vel yes;

@@ -8,7 +8,6 @@
 #include "common/Csv.h"
 #include "md/config/ConfigParser.h"
 #include "md/engine/Engine.h"
-#include "md/io/InitialState.h"
 #include "md/potentials/SpringDashpot.h"
 
 namespace granagg::md::lammps {
@@ -51,18 +50,6 @@ void checkLammpsCanRun(const MdConfig& c) {
   }
 }
 
-Frame initialStateOf(const MdConfig& cfg) {
-  // the rule of md::Simulation for a new run
-  if (cfg.system.initial == "random") return randomInitialState(cfg);
-  Frame init = readInitialState(cfg.system.initial, boxLength(cfg.system));
-  if (static_cast<int>(init.size()) != cfg.system.N)
-    throw std::invalid_argument("system.initial '" + cfg.system.initial + "' holds " +
-                                std::to_string(init.size()) +
-                                " particles but system.N = " + std::to_string(cfg.system.N));
-  assignInitialCharges(cfg, init);
-  return init;
-}
-
 std::string LammpsInput::text(const std::string& header) const {
   std::string t = header;
   if (!t.empty() && t.back() != '\n') t += '\n';
@@ -71,23 +58,28 @@ std::string LammpsInput::text(const std::string& header) const {
   return t;
 }
 
-LammpsInput translateConfig(const MdConfig& c, const Frame& state, const std::string& data_file,
-                            bool record_collisions) {
+namespace {
+
+/// translateConfig and translateRestart: the particles come from `file` (a data file, or with
+/// `restart` a restart file, whose settings are then left out).
+LammpsInput translate(const MdConfig& c, std::size_t N, double L, double sum_q2_design,
+                      const std::string& file, bool restart, bool record_collisions) {
   checkLammpsCanRun(c);
-  if (data_file.find_first_of(" \t\n\"'") != std::string::npos)
+  if (file.find_first_of(" \t\n\"'") != std::string::npos)
     throw std::invalid_argument("--out: the output folder's path must not contain blanks or "
-                                "quotes (LAMMPS reads it as a word): " + data_file);
+                                "quotes (LAMMPS reads it as a word): " + file);
   LammpsInput in;
   auto& cmd = in.commands;
-  const double L = state.box;
   const double skin = c.neighbor.skinCap();
 
-  cmd.push_back("units lj");
-  cmd.push_back("atom_style hybrid sphere charge");
-  cmd.push_back("boundary p p p");
+  if (!restart) {
+    cmd.push_back("units lj");
+    cmd.push_back("atom_style hybrid sphere charge");
+    cmd.push_back("boundary p p p");
+  }
   cmd.push_back("newton on");
   cmd.push_back("comm_modify vel yes");
-  cmd.push_back("read_data " + data_file);
+  cmd.push_back((restart ? "read_restart " : "read_data ") + file);
   cmd.push_back("set group all mass 1.0");
 
   // contact model
@@ -109,11 +101,7 @@ LammpsInput translateConfig(const MdConfig& c, const Frame& state, const std::st
 
   in.coulomb = c.coulomb.K > 0.0;
   if (in.coulomb) {
-    double sum_q2 = 0.0;
-    for (double q : state.charge) sum_q2 += q * q;
-    const CoulombDesign d =
-        designCoulomb(c.coulomb, state.size(), L, skin, 1, 1,
-                      std::max(sum_q2, static_cast<double>(state.size())));
+    const CoulombDesign d = designCoulomb(c.coulomb, N, L, skin, 1, 1, sum_q2_design);
     in.coulomb_setup = d.setup;
     cmd.push_back("pair_style hybrid/overlay " + gran + " coul/long " + formatReal(d.pppm.r_cut));
     cmd.push_back("pair_coeff * * " + in.pair_style);
@@ -158,16 +146,23 @@ LammpsInput translateConfig(const MdConfig& c, const Frame& state, const std::st
   cmd.push_back("thermo_modify norm no");
   cmd.push_back("thermo " + std::to_string(std::max(1, c.output.observable_interval)));
 
-  const OutputConfig& o = c.output;
-  if (o.frames_per_decade > 0 || o.frame_interval > 0.0)
-    in.notes.push_back(
-        "output: granagg-lammps writes no trajectory yet (output.frames_per_decade, "
-        "output.frame_interval): observables.csv and final_state.csv only");
-  if (o.checkpoint_interval > 0 || o.checkpoint_wall_seconds > 0.0)
-    in.notes.push_back(
-        "output: granagg-lammps writes no checkpoint yet (output.checkpoint_interval, "
-        "output.checkpoint_wall_seconds)");
   return in;
+}
+
+}  // namespace
+
+LammpsInput translateConfig(const MdConfig& c, const Frame& state, const std::string& data_file,
+                            bool record_collisions) {
+  // as the engine: sum q^2 of the initial state, at least N (a gas that starts neutral charges)
+  double sum_q2 = 0.0;
+  for (double q : state.charge) sum_q2 += q * q;
+  return translate(c, state.size(), state.box, std::max(sum_q2, static_cast<double>(state.size())),
+                   data_file, /*restart=*/false, record_collisions);
+}
+
+LammpsInput translateRestart(const MdConfig& c, std::size_t N, double box, double sum_q2_design,
+                             const std::string& restart_file, bool record_collisions) {
+  return translate(c, N, box, sum_q2_design, restart_file, /*restart=*/true, record_collisions);
 }
 
 std::string lammpsDataText(const Frame& s) {

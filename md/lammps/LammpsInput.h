@@ -6,8 +6,8 @@
 ///
 /// The model, key by key (docs/lammps.md has the table):
 /// - Particles: unit spheres of unit mass, `atom_style hybrid sphere charge`, ids = granagg's
-///   particle index + 1, read from a data file written from the initial state (random as
-///   `granagg md` draws it, or system.initial with its charges), then `set group all mass 1.0`
+///   particle index + 1, read from a data file written from the initial state (as `granagg md`
+///   builds it: md::prepareInitialState), then `set group all mass 1.0`
 ///   (the density 6/pi gives 1 only up to rounding). Periodic cube [0, L)^3 from the state.
 /// - contact.model = "hertz": `pair_style gran/hertz/history kn 0 gamma_n 0 0 0 [limit_damping]`
 ///   with kn = 2E, gamma_n = 4D. LAMMPS's normal force is sqrt(xi R_i R_j/(R_i + R_j)) [kn xi +
@@ -49,7 +49,7 @@ struct LammpsInput {
   std::string pair_style;    ///< the granular pair style (FixCharging's `pair`)
   bool coulomb = false;      ///< coulomb.K > 0
   CoulombSetup coulomb_setup;  ///< coulomb: what granagg's design chose
-  /// How keys were resolved for LAMMPS, and what granagg-lammps does not write yet (log lines).
+  /// How keys were resolved for LAMMPS (log lines).
   std::vector<std::string> notes;
 
   /// The complete input: `header` (comment lines), the commands, `run steps`.
@@ -61,15 +61,20 @@ struct LammpsInput {
 /// coulomb.r_fast, coulomb.skin other than the neighbour skin, coulomb.method = "ewald".
 void checkLammpsCanRun(const MdConfig& config);
 
-/// The initial state of a new run, as `granagg md` builds it: randomInitialState, or
-/// system.initial (CSV, LAMMPS data, H5MD) with N checked and the charges of charging.initial.
-Frame initialStateOf(const MdConfig& config);
-
-/// The input for `config` from `state` (as initialStateOf gives it), stored as the data file
-/// `data_file`. record_collisions: the fix keeps every collision (FixCharging `record yes`).
+/// The input for `config` from `state` (as md::prepareInitialState gives it), stored as the data
+/// file `data_file`. record_collisions: the fix keeps every collision (FixCharging `record yes`).
 /// Throws std::invalid_argument like checkLammpsCanRun (which it calls).
 LammpsInput translateConfig(const MdConfig& config, const Frame& state,
                             const std::string& data_file, bool record_collisions = false);
+
+/// The input that continues a run of `config` from the LAMMPS restart file `restart_file`: the
+/// commands of translateConfig for that run, with `read_restart` for `read_data` and without
+/// what the restart file sets (units, atom_style, boundary). The run had N particles in a box of
+/// edge `box`, and its Coulomb parameters were designed for `sum_q2_design`
+/// (CoulombSetup::sum_q2_design; unused without Coulomb), so that they come out the same.
+LammpsInput translateRestart(const MdConfig& config, std::size_t N, double box,
+                             double sum_q2_design, const std::string& restart_file,
+                             bool record_collisions);
 
 /// The LAMMPS data file of `state` (atom_style hybrid sphere charge): box [0, L)^3, atom i has
 /// id i + 1, type 1, diameter 1, density 6/pi, charge, image flags; velocities (angular 0).

@@ -82,11 +82,11 @@ TEST_CASE("fix granagg/charging continues a run from a LAMMPS restart file as if
   const int rc = inChildProcess([&] {
     MPI_Init(nullptr, nullptr);
     // a charged gas with exchange and Coulomb forces, dense enough for many contacts
-    const md::MdConfig c = md::parseConfigString(
+    md::MdConfig c = md::parseConfigString(
         "", "(test)",
         {"system.N=300", "system.phi=0.2", "system.seed=7", "charging.initial=bipolar",
          "charging.q0=0.3", "charging.Q=0.1", "coulomb.K=1", "integrator.dt=0.003"});
-    const md::Frame s = md::lammps::initialStateOf(c);
+    const md::Frame s = md::prepareInitialState(c);
     test::spit(dir + "/state.data", md::lammps::lammpsDataText(s));
     const auto in = md::lammps::translateConfig(c, s, dir + "/state.data");
     std::vector<double> whole, continued;

@@ -1,6 +1,7 @@
 // granagg-lammps under mpirun: the charge exchanged at a collision (to the bit), the restitution
 // of a collision against granagg's engine, a charged gas on 2 ranks (charge conservation, every
-// collision charging exactly once, the same collisions as on 1 rank) and bad input.
+// collision charging exactly once, the same collisions as on 1 rank; its H5MD trajectory read by
+// granagg analyze and scripts/check_h5md.py), SIGTERM and --restart, a folder in use, bad input.
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
@@ -19,6 +20,7 @@
 
 #include "cli/RunCommand.h"
 #include "common/Csv.h"
+#include "common/H5mdReader.h"
 #include "md/config/ConfigParser.h"
 #include "md/engine/Engine.h"
 #include "md/io/InitialState.h"
@@ -43,6 +45,17 @@ Run lammpsRun(int ranks, const std::string& args) {
 std::string writeFile(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
   return p.string();
+}
+
+/// The last frame of a run's traj.h5, as the engine's Frame (id order).
+md::Frame lastFrame(const fs::path& run) {
+  const common::H5mdReader r((run / "traj.h5").string());
+  return md::engineFrame(r.readFrame(r.frames() - 1));
+}
+
+/// One of a run's /granagg/observables.
+common::ObservableSeries observable(const fs::path& run, const std::string& name) {
+  return common::H5mdReader((run / "traj.h5").string()).readObservable(name);
 }
 
 /// Two particles on the x axis at y = z = 2.5 in a box of edge 5, approaching head-on at
@@ -108,11 +121,12 @@ TEST_CASE("granagg-lammps exchanges at a collision exactly the charge of ChargeE
   CHECK(test::sameBits(c[coll.column("xi_dot")], xi_dot));
   CHECK(test::sameBits(c[coll.column("dq_lo")], dq0));
   CHECK(dq0 != 0.0);
-  // the charges at the end: the exchange and nothing else, to the bit
-  const common::CsvTable fin = common::readCsv((dir / "o" / "final_state.csv").string());
-  REQUIRE(fin.rows.size() == 2);
-  CHECK(test::sameBits(fin.rows[0][fin.column("q")], dq0));
-  CHECK(test::sameBits(fin.rows[1][fin.column("q")], -dq0));
+  // the charges at the end (the trajectory's last frame): the exchange and nothing else, to the bit
+  const md::Frame fin = lastFrame(dir / "o");
+  REQUIRE(fin.size() == 2);
+  CHECK(fin.step == std::llround(0.05 / dt));
+  CHECK(test::sameBits(fin.charge[0], dq0));
+  CHECK(test::sameBits(fin.charge[1], -dq0));
 
   // granagg's engine from the same state gives the same charges at the same step
   const md::MdConfig mc = md::parseConfigFile(cfg);
@@ -138,10 +152,9 @@ TEST_CASE("granagg-lammps gives a two-body collision the restitution of granagg'
   const Run r = lammpsRun(1, "--config " + cfg + " --out " + (dir / "o").string() + " -q");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  const common::CsvTable fin = common::readCsv((dir / "o" / "final_state.csv").string());
-  REQUIRE(fin.rows.size() == 2);
-  const std::size_t vx = fin.column("vx");
-  const double e_lammps = (fin.rows[1][vx] - fin.rows[0][vx]) / v;
+  const md::Frame fin = lastFrame(dir / "o");
+  REQUIRE(fin.size() == 2);
+  const double e_lammps = (fin.vx[1] - fin.vx[0]) / v;
 
   const md::MdConfig mc = md::parseConfigFile(cfg);  // the same configuration, dt included
   md::Engine::setThreads(1);  // two particles: threads would only add their synchronisation
@@ -155,7 +168,8 @@ TEST_CASE("granagg-lammps gives a two-body collision the restitution of granagg'
   CHECK(engine.observables().elastic_energy == 0.0);  // the contact is over in both
 }
 
-TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collision",
+TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collision, and granagg "
+          "analyze reads its trajectory",
           "[lammps][mpi]") {
   const fs::path dir = test::tempDir("lammps_gas");
   const int N = 1000;
@@ -166,7 +180,7 @@ TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collis
                          "\nseed = 42\n[charging]\ninitial = \"bipolar\"\nq0 = 0.05\nQ = 0.05\n"
                          "[coulomb]\nK = 5\n[integrator]\ndt = 0.003\n[run]\nt_end = " +
                          common::formatReal(steps * dt) +
-                         "\n[output]\nobservable_interval = 25\nframes_per_decade = 0\n"
+                         "\n[output]\nobservable_interval = 25\nframes_per_decade = 10\n"
                          "checkpoint_wall_seconds = 0.0\n");
   };
   const Run two = lammpsRun(2, "--config " + config("long.toml", 500) + " --out " +
@@ -185,15 +199,18 @@ TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collis
 
   // the total charge at every sample, to 1e-12 N max|q| (the exchange rule conserves it exactly;
   // what remains is the rounding of the per-particle sums)
-  const common::CsvTable obs = common::readCsv((dir / "two" / "observables.csv").string());
-  REQUIRE(obs.rows.size() == 21);  // steps 0, 25, ..., 500
+  const auto total_q = observable(dir / "two", "total_charge"),
+             max_q_obs = observable(dir / "two", "max_abs_charge"),
+             mean_q_obs = observable(dir / "two", "mean_abs_charge"),
+             collisions = observable(dir / "two", "collisions");
+  REQUIRE(total_q.value.size() == 21);  // steps 0, 25, ..., 500
+  CHECK(total_q.step.back() == 500);
   const md::Frame init = md::readInitialStateLammps((dir / "two" / "initial.data").string());
   double q_init = 0.0;
   for (double q : init.charge) q_init += q;
-  for (const auto& row : obs.rows)
-    CHECK(std::fabs(row[obs.column("total_charge")] - q_init) <=
-          1e-12 * N * row[obs.column("max_abs_charge")]);
-  CHECK(obs.rows.back()[obs.column("mean_abs_charge")] > 0.06);  // charges grew
+  for (std::size_t k = 0; k < total_q.value.size(); ++k)
+    CHECK(std::fabs(total_q.value[k] - q_init) <= 1e-12 * N * max_q_obs.value[k]);
+  CHECK(mean_q_obs.value.back() > 0.06);  // charges grew
 
   // every collision charged each partner exactly once: the final charges are the initial ones plus
   // the sum of the logged exchanges, within the rounding of the per-step sums
@@ -208,15 +225,47 @@ TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collis
     q[static_cast<std::size_t>(row[clo])] += row[cdq];
     q[static_cast<std::size_t>(row[chi])] -= row[cdq];
   }
-  const common::CsvTable fin = common::readCsv((dir / "two" / "final_state.csv").string());
-  REQUIRE(fin.rows.size() == static_cast<std::size_t>(N));
+  const md::Frame fin = lastFrame(dir / "two");
+  REQUIRE(fin.size() == static_cast<std::size_t>(N));
+  CHECK(fin.step == 500);
   for (double x : q) max_q = std::max(max_q, std::fabs(x));
   int wrong = 0;
-  for (int i = 0; i < N; ++i)
-    wrong += !(std::fabs(fin.rows[i][fin.column("q")] - q[i]) <= 1e-12 * max_q);
+  for (int i = 0; i < N; ++i) wrong += !(std::fabs(fin.charge[i] - q[i]) <= 1e-12 * max_q);
   CHECK(wrong == 0);
   CHECK(coll.rows.back()[cs] > 400);
-  CHECK(static_cast<double>(coll.rows.size()) == obs.rows.back()[obs.column("collisions")]);
+  CHECK(static_cast<double>(coll.rows.size()) == collisions.value.back());
+
+  // the trajectory is granagg's H5MD (scripts/check_h5md.py), and granagg analyze reads it: the
+  // run's N, frames and box, and its charges (<|q|> of the last frame, against the frame itself)
+  const common::H5mdReader traj((dir / "two" / "traj.h5").string());
+  const std::size_t frames = traj.frames();
+  CHECK(frames >= 10);
+  CHECK(traj.box(0) == init.box);
+  CHECK(traj.configToml().find("K = 5") != std::string::npos);
+  const Run check = sh("/usr/bin/python3 " + std::string(GRANAGG_SOURCE_DIR) +
+                       "/scripts/check_h5md.py " + (dir / "two" / "traj.h5").string());
+  INFO(check.output);
+  CHECK(check.status == 0);
+  CHECK_THAT(check.output, Catch::Contains("layout OK"));
+  const Run ana = sh(std::string(GRANAGG_BINARY) + " analyze " + (dir / "two").string() +
+                     " --out " + (dir / "ana").string());
+  INFO(ana.output);
+  REQUIRE(ana.status == 0);
+  REQUIRE(fs::exists(dir / "ana" / "S_t.csv"));
+  const common::CsvTable thermo = common::readCsv((dir / "ana" / "thermo.csv").string());
+  std::string run0;
+  for (const auto& [k, v] : thermo.meta)
+    if (k == "run.0") run0 = v;
+  INFO(run0);
+  CHECK_THAT(run0, Catch::Contains(std::to_string(frames) + " frames, N = " + std::to_string(N)));
+  std::smatch grid;
+  REQUIRE(std::regex_search(run0, grid, std::regex("grid ([0-9]+)\\^3 cells of h = ([0-9.e+-]+)")));
+  CHECK(std::stod(grid[1]) * std::stod(grid[2]) == Approx(init.box).epsilon(1e-12));
+  REQUIRE(thermo.rows.size() == frames);
+  double mean_abs_q = 0.0;
+  for (double x : fin.charge) mean_abs_q += std::fabs(x) / N;
+  CHECK(thermo.rows.back()[thermo.column("mean_abs_q_mean")] == Approx(mean_abs_q).epsilon(1e-12));
+  CHECK(thermo.rows.back()[thermo.column("t")] == Approx(500 * dt).epsilon(1e-12));
 
   // the same collisions as on 1 rank over the first 50 steps (the trajectories agree to rounding
   // there), with the same exchanges up to that rounding
@@ -282,16 +331,19 @@ TEST_CASE("granagg-lammps samples the contacts of its initial state as the engin
   const Run r = lammpsRun(1, "--config " + cfg + " --out " + (dir / "o").string() + " -q");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  const common::CsvTable obs = common::readCsv((dir / "o" / "observables.csv").string());
-  REQUIRE(!obs.rows.empty());
-  const auto& row0 = obs.rows[0];
+  auto at0 = [&](const std::string& name) {
+    const auto series = observable(dir / "o", name);
+    REQUIRE(!series.value.empty());
+    CHECK(series.step[0] == 0);
+    return series.value[0];
+  };
   const md::MdConfig mc = md::parseConfigFile(cfg);
   md::Engine::setThreads(1);
   const md::Engine engine(mc, md::readInitialState(state, md::boxLength(mc.system)), true);
   const md::Observables o = engine.observables();
   CHECK(o.contacts_per_particle == Approx(2.0 / 3.0));
-  CHECK(row0[obs.column("contacts_per_particle")] == Approx(o.contacts_per_particle));
-  CHECK(row0[obs.column("max_overlap")] == Approx(o.max_overlap).epsilon(1e-12));
-  CHECK(row0[obs.column("elastic_energy")] == Approx(o.elastic_energy).epsilon(1e-12));
-  CHECK(row0[obs.column("collisions")] == 0);
+  CHECK(at0("contacts_per_particle") == Approx(o.contacts_per_particle));
+  CHECK(at0("max_overlap") == Approx(o.max_overlap).epsilon(1e-12));
+  CHECK(at0("elastic_energy") == Approx(o.elastic_energy).epsilon(1e-12));
+  CHECK(at0("collisions") == 0);
 }
