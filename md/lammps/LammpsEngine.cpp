@@ -521,7 +521,8 @@ LammpsCheckpoint readLammpsCheckpoint(const fs::path& folder, MPI_Comm comm) {
     }
     auto need = [&](const char* key) -> const toml::node& {
       const toml::node* n = t.get(key);
-      if (!n) throw std::runtime_error(where + ": not a granagg-lammps checkpoint (no " + key + ")");
+      if (!n)
+        throw std::runtime_error(where + ": not a granagg-lammps checkpoint (no " + key + ")");
       return *n;
     };
     auto text_of = [&](const char* key) {
