@@ -97,7 +97,8 @@ std::invalid_argument stale(const fs::path& folder, const std::string& option,
                                FOLDER_LOCK_FILE + ") of " + h.describe() + ": " + why +
                                "; it ended without releasing the folder, which may hold a "
                                "partial output. " +
-                               (clear_hint.empty() ? "Pass --force to clear the lock" : clear_hint));
+                               (clear_hint.empty() ? std::string("Pass --force to clear the lock")
+                                                   : clear_hint));
 }
 
 /// The holder named by the lock file of `folder` and whether a process holds its flock now.

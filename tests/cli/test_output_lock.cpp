@@ -166,7 +166,8 @@ TEST_CASE("md --restart: a stale lock needs --force, a finished run has nothing 
   CHECK_FALSE(fs::exists(dir / "run" / granagg::common::FOLDER_LOCK_FILE));
 
   // at its run.t_end: nothing to do, nothing written, and the way to go further
-  const std::string traj = slurp(dir / "run" / "traj.h5"), ck = slurp(dir / "run" / "checkpoint.h5");
+  const std::string traj = slurp(dir / "run" / "traj.h5");
+  const std::string ck = slurp(dir / "run" / "checkpoint.h5");
   r = runGranagg("md --restart " + run);
   INFO(r.output);
   CHECK(r.status == 0);
