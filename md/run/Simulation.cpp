@@ -375,14 +375,21 @@ Simulation::Simulation(Simulation&&) noexcept = default;
 Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 Simulation::~Simulation() = default;
 
-Simulation Simulation::start(const MdConfig& config, const fs::path& out,
-                             const RunOptions& options) {
+std::unique_ptr<Simulation::Impl> Simulation::checkedRun(const MdConfig& config,
+                                                        const fs::path& out,
+                                                        const RunOptions& options) {
   auto d = std::make_unique<Impl>();
   d->cfg = config;
   d->out = out;
   d->options = options;
   validateConfig(d->cfg);
   checkSchedule(d->cfg);
+  return d;
+}
+
+Simulation Simulation::start(const MdConfig& config, const fs::path& out,
+                             const RunOptions& options) {
+  auto d = checkedRun(config, out, options);
   checkNewFolder(out, options);
   // everything that can fail on the input fails before the folder is touched
   // (a file's contacts within system.initial_max_overlap are accepted: InitialState.h)
@@ -393,12 +400,7 @@ Simulation Simulation::start(const MdConfig& config, const fs::path& out,
 
 Simulation Simulation::start(const MdConfig& config, std::unique_ptr<RunEngine> engine,
                              const fs::path& out, const RunOptions& options) {
-  auto d = std::make_unique<Impl>();
-  d->cfg = config;
-  d->out = out;
-  d->options = options;
-  validateConfig(d->cfg);
-  checkSchedule(d->cfg);
+  auto d = checkedRun(config, out, options);
   onWritingRank(*engine, [&] { checkNewFolder(out, options); });
   d->setUp(std::move(engine));
   return startWriting(std::move(d));

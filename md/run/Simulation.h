@@ -171,6 +171,10 @@ class Simulation {
  private:
   struct Impl;
   explicit Simulation(std::unique_ptr<Impl> impl);
+  /// start()'s first part: the configuration validated and its schedule checked, no engine yet.
+  static std::unique_ptr<Impl> checkedRun(const MdConfig& config,
+                                          const std::filesystem::path& out,
+                                          const RunOptions& options);
   /// start()'s second half, once the engine is set up: lock, begin(), the header and t = 0.
   static Simulation startWriting(std::unique_ptr<Impl> d);
   /// resume()'s common part; `folder_checked`: FolderLock::checkAvailable was called already.

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include "meanfield/solvers/SmolResult.h"
+
 namespace granagg::meanfield {
 
 /// Throw this from a right-hand side to ask CVODE to retry with a smaller step (the trampoline
@@ -129,5 +131,15 @@ class CvodeSolver {
   std::unique_ptr<Impl> m_impl;
   int m_n;
 };
+
+/// Adds the cost of one CVODE instance to a solve's totals (a solve may use several: the
+/// discrete solver after each resize, the sectional one after each grid growth).
+inline void addStats(SolveStats& acc, const CvodeSolver::Stats& s) {
+  acc.steps += s.steps;
+  acc.rhs_evaluations += s.rhs_evaluations;
+  acc.linear_iterations += s.linear_iterations;
+  acc.nonlinear_failures += s.nonlinear_failures;
+  acc.error_test_failures += s.error_test_failures;
+}
 
 }  // namespace granagg::meanfield

@@ -53,14 +53,6 @@ Moments moments(const double* n, int M) {
   return m;
 }
 
-void addStats(SolveStats& acc, const CvodeSolver::Stats& s) {
-  acc.steps += s.steps;
-  acc.rhs_evaluations += s.rhs_evaluations;
-  acc.linear_iterations += s.linear_iterations;
-  acc.nonlinear_failures += s.nonlinear_failures;
-  acc.error_test_failures += s.error_test_failures;
-}
-
 }  // namespace
 
 SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o,

@@ -200,15 +200,6 @@ void validate(const SectionalOptions& o) {
   CvodeSolver::parseMethod(o.integrator);  // throws for an unknown name
 }
 
-/// Adds the cost of one CVODE instance to the solve's totals.
-void addStats(SolveStats& acc, const CvodeSolver::Stats& s) {
-  acc.steps += s.steps;
-  acc.rhs_evaluations += s.rhs_evaluations;
-  acc.linear_iterations += s.linear_iterations;
-  acc.nonlinear_failures += s.nonlinear_failures;
-  acc.error_test_failures += s.error_test_failures;
-}
-
 /// The pivots of the file comment up to the first >= top, or up to `max_sections` pivots. Every
 /// grid of one ratio is a prefix of the grids with a larger top, so a grown grid keeps its pivots.
 SectionalGrid buildGrid(double ratio, double top, size_t max_sections) {
