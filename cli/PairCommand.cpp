@@ -109,11 +109,15 @@ void registerPairCommand(CLI::App& app, const CliContext& ctx) {
   c->add_option("--runs", a->runs, "Runs per K (1..10000; overrides pair.runs)")
       ->check(CLI::Range(1, MAX_RUNS));
   c->add_option("--jobs", a->request.jobs,
-                "MD runs at a time, 1..1024 (default: max(1, cores / 2))")
+                "MD runs at a time, 1..1024 (default: max(1, cores / 2); with md.engine = "
+                "\"lammps\": max(1, cores / lammps.ranks))")
       ->check(CLI::Range(1, 1024));
   c->add_option("--threads", a->request.threads,
-                "OpenMP threads per MD run, 1..4096 (default: max(1, cores / jobs))")
+                "OpenMP threads per granagg md run, 1..4096 (default: max(1, cores / jobs))")
       ->check(CLI::Range(1, 4096));
+  c->add_option("--launcher", a->request.launcher,
+                "How granagg-lammps runs start (md.engine = \"lammps\"; overrides "
+                "lammps.launcher), e.g. \"mpirun -np {ranks}\"");
   c->add_option("-o,--out", a->request.out,
                 "Output folder (default pair-<preset>); an existing study there is resumed");
   c->add_flag("--force", a->request.force,
@@ -130,6 +134,11 @@ void registerPairCommand(CLI::App& app, const CliContext& ctx) {
     if (c->count("--run-index") > 0 && a->request.run_index < 0)  // -1 would start the whole study
       throw std::invalid_argument("--run-index must be >= 0 (got " +
                                   std::to_string(a->request.run_index) + ")");
+    if (c->count("--launcher") > 0 &&
+        a->request.launcher.find_first_not_of(" \t") == std::string::npos)
+      throw std::invalid_argument(
+          "--launcher is empty: give the command that starts MPI ranks, e.g. \"mpirun -np "
+          "{ranks}\"");
     runPair(*a, ctx, root, c->count("--runs") > 0, c->count("--K") > 0);
   });
 }

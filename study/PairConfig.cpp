@@ -42,11 +42,12 @@ PairConfig parsePairConfig(const std::string& path) {
   const std::map<std::string, std::set<std::string>> known{
       {"input", {"version"}},
       {"pair", {"name", "K", "runs", "seed"}},
-      {"md", {"preset", "config", "set"}},
+      {"md", {"preset", "config", "set", "engine"}},
       {"charged", {"Q", "set"}},
       {"analysis", {"args"}},
       {"meanfield", {"beta", "t_end", "s_end", "zbeta_min", "zbeta_max", "zbeta_count"}},
-      {"fit", {"window", "column"}}};
+      {"fit", {"window", "column"}},
+      {"lammps", {"launcher", "ranks", "slurm_launcher", "nodes", "tasks_per_node"}}};
   auto fail = [&](const toml::node& n, const std::string& msg) -> void {
     throw std::invalid_argument(where(n.source(), path) + ": " + msg);
   };
@@ -117,7 +118,8 @@ PairConfig parsePairConfig(const std::string& path) {
         fail(e, std::string(sec) + "." + key + " must hold numbers only");
     }
   };
-  long long version = 1, runs = c.runs, zcount = c.zbeta_count;
+  long long version = 1, runs = c.runs, zcount = c.zbeta_count, ranks = c.lammps_ranks,
+            nodes = c.lammps_nodes, tasks_per_node = c.lammps_tasks_per_node;
   integer("input", "version", version);
   if (version != 1)
     throw std::invalid_argument(path + ": [input] version = " + std::to_string(version) +
@@ -129,6 +131,7 @@ PairConfig parsePairConfig(const std::string& path) {
   string("md", "preset", c.md_preset);
   string("md", "config", c.md_config);
   strings("md", "set", c.md_set);
+  string("md", "engine", c.md_engine);
   number("charged", "Q", c.charged_Q);
   strings("charged", "set", c.charged_set);
   strings("analysis", "args", c.analysis_args);
@@ -140,7 +143,23 @@ PairConfig parsePairConfig(const std::string& path) {
   integer("meanfield", "zbeta_count", zcount);
   numbers("fit", "window", c.fit_window);
   string("fit", "column", c.fit_column);
+  string("lammps", "launcher", c.lammps_launcher);
+  integer("lammps", "ranks", ranks);
+  string("lammps", "slurm_launcher", c.lammps_slurm_launcher);
+  integer("lammps", "nodes", nodes);
+  integer("lammps", "tasks_per_node", tasks_per_node);
   c.runs = static_cast<int>(std::clamp<long long>(runs, -1, MAX_RUNS + 1));
+  // a count beyond int is refused here, with its position; validate() checks those within int
+  const auto count = [&](const char* key, long long n) {
+    const toml::node* node = doc.at_path(std::string("lammps.") + key).node();
+    if (node && n != static_cast<int>(n))
+      fail(*node, std::string("lammps.") + key + " must lie in 1.." + std::to_string(MAX_RANKS) +
+                      " (got " + std::to_string(n) + ")");
+    return static_cast<int>(n);
+  };
+  c.lammps_ranks = count("ranks", ranks);
+  c.lammps_nodes = count("nodes", nodes);
+  c.lammps_tasks_per_node = count("tasks_per_node", tasks_per_node);
   c.zbeta_count = static_cast<int>(std::clamp<long long>(zcount, -1, 100000));
   if (c.md_preset.empty() == c.md_config.empty())
     throw std::invalid_argument(
@@ -162,7 +181,7 @@ toml::array tomlArray(const std::vector<T>& v) {
 }  // namespace
 
 std::string toToml(const PairConfig& c) {
-  toml::table md{{"set", tomlArray(c.md_set)}};
+  toml::table md{{"set", tomlArray(c.md_set)}, {"engine", c.md_engine}};
   if (c.md_preset.empty())
     md.insert("config", c.md_config);
   else
@@ -182,7 +201,12 @@ std::string toToml(const PairConfig& c) {
                                 {"zbeta_min", c.zbeta_min},
                                 {"zbeta_max", c.zbeta_max},
                                 {"zbeta_count", c.zbeta_count}}},
-      {"fit", toml::table{{"window", tomlArray(c.fit_window)}, {"column", c.fit_column}}}};
+      {"fit", toml::table{{"window", tomlArray(c.fit_window)}, {"column", c.fit_column}}},
+      {"lammps", toml::table{{"launcher", c.lammps_launcher},
+                             {"ranks", c.lammps_ranks},
+                             {"slurm_launcher", c.lammps_slurm_launcher},
+                             {"nodes", c.lammps_nodes},
+                             {"tasks_per_node", c.lammps_tasks_per_node}}}};
   std::ostringstream o;
   o << "# granagg pair configuration, resolved from " << c.source
     << " and the command line (docs/pair.md)\n"
@@ -240,6 +264,42 @@ void validate(const PairConfig& c) {
   if (!c.fit_window.empty() &&
       (c.fit_window.size() != 2 || !(c.fit_window[1] > c.fit_window[0]) || !(c.fit_window[0] >= 0)))
     throw std::invalid_argument(src + "fit.window must be [] or [T0, T1] with 0 <= T0 < T1");
+  if (std::find(std::begin(MD_ENGINES), std::end(MD_ENGINES), c.md_engine) == std::end(MD_ENGINES))
+    throw std::invalid_argument(src + "md.engine = \"" + c.md_engine +
+                                "\" is not known (allowed: \"granagg\", \"lammps\")");
+  const auto in_range = [&](const char* key, int n) {
+    if (n < 1 || n > MAX_RANKS)
+      throw std::invalid_argument(src + key + " must lie in 1.." + std::to_string(MAX_RANKS) +
+                                  " (got " + std::to_string(n) + ")");
+  };
+  in_range("lammps.ranks", c.lammps_ranks);
+  in_range("lammps.nodes", c.lammps_nodes);
+  in_range("lammps.tasks_per_node", c.lammps_tasks_per_node);
+  launcherWords(c.lammps_launcher, c.lammps_ranks, src + "lammps.launcher");
+  launcherWords(c.lammps_slurm_launcher, 1LL * c.lammps_nodes * c.lammps_tasks_per_node,
+                src + "lammps.slurm_launcher");
+}
+
+std::vector<std::string> launcherWords(const std::string& launcher, long long ranks,
+                                       const std::string& key) {
+  std::vector<std::string> words;
+  std::istringstream in(launcher);
+  for (std::string w; in >> w;) {
+    for (std::size_t at; (at = w.find("{ranks}")) != std::string::npos;)
+      w.replace(at, 7, std::to_string(ranks));
+    words.push_back(w);
+  }
+  if (words.empty())
+    throw std::invalid_argument(key +
+                                " is empty: give the command that starts MPI ranks, e.g. "
+                                "\"mpirun -np {ranks}\"");
+  for (const auto& w : words)
+    if (w.find_first_of("{}'\"\\$`;|&<>") != std::string::npos)
+      throw std::invalid_argument(key + " = \"" + launcher + "\": '" + w +
+                                  "' holds a character the launcher's words cannot (no shell "
+                                  "runs them: words are split at blanks, {ranks} is the one "
+                                  "placeholder)");
+  return words;
 }
 
 std::string kName(double K) { return "K" + formatReal(K); }

@@ -122,6 +122,7 @@ PairStudy::PairStudy(PairConfig config, StudyRequest request, StudyServices serv
   if (!m_a.emit_batch.empty() && m_a.emit_batch != "slurm")
     throw std::invalid_argument("--emit-batch supports only 'slurm' (got '" + m_a.emit_batch +
                                 "')");
+  setUpLaunch();
   // every ensemble's MD configuration, resolved before anything is written (exit 2 on a bad key)
   const std::string base =
       m_c.md_preset.empty() ? m_c.md_config : m_s.find_md_preset(m_c.md_preset);
@@ -151,8 +152,10 @@ PairStudy::PairStudy(PairConfig config, StudyRequest request, StudyServices serv
       j.dir = m_out / "runs" / name / ("run" + std::to_string(r));
       j.config = path;
       j.log = m_out / "logs" / ("md-" + name + "-run" + std::to_string(r) + ".log");
-      j.spec = "md_config_fnv1a=" + hash + " seed=" + std::to_string(j.seed);
-      j.legacy_spec = "md_config_fnv1a=" + legacy + " seed=" + std::to_string(j.seed);
+      // granagg md's runs keep the spec they always had; another engine's runs are other runs
+      const std::string engine = m_launch.lammps() ? " engine=" + m_launch.engine : "";
+      j.spec = "md_config_fnv1a=" + hash + " seed=" + std::to_string(j.seed) + engine;
+      j.legacy_spec = "md_config_fnv1a=" + legacy + " seed=" + std::to_string(j.seed) + engine;
       j.cost = static_cast<double>(plan.N) * plan.steps * (K > 0 ? 100.0 : 1.0);
       m_runs.push_back(j);
     }
@@ -161,6 +164,36 @@ PairStudy::PairStudy(PairConfig config, StudyRequest request, StudyServices serv
     throw std::invalid_argument("--run-index " + std::to_string(m_a.run_index) +
                                 " is out of range (the study has " + std::to_string(m_runs.size()) +
                                 " runs: 0.." + std::to_string(m_runs.size() - 1) + ")");
+}
+
+/// The programs that run the MD: `granagg md`, or granagg-lammps beside the granagg binary under
+/// the launcher (checked here, before anything is written: exit 2 with the key).
+void PairStudy::setUpLaunch() {
+  m_launch.engine = m_c.md_engine;
+  m_launch.granagg = m_s.exe;
+  if (!m_launch.lammps()) {
+    if (!m_a.launcher.empty())
+      throw std::invalid_argument("--launcher applies only to a study with md.engine = "
+                                  "\"lammps\" (this one runs granagg md)");
+    return;
+  }
+  m_launch.granagg_lammps = (fs::path(m_s.exe).parent_path() / "granagg-lammps").string();
+  if (!findProgram(m_launch.granagg_lammps))
+    throw std::invalid_argument(
+        "md.engine = \"lammps\" runs the MD with granagg-lammps, which is not beside granagg (" +
+        m_launch.granagg_lammps +
+        " not found): it is built when liblammps-dev and Open MPI are found (scripts/setup.sh, "
+        "docs/lammps.md)");
+  const bool given = !m_a.launcher.empty();
+  const std::string key = given ? "--launcher" : m_c.source + ": lammps.launcher";
+  m_launch.launcher =
+      launcherWords(given ? m_a.launcher : m_c.lammps_launcher, m_c.lammps_ranks, key);
+  // the launcher runs here unless the study is only written out for a cluster
+  if (m_a.emit_batch.empty() && !findProgram(m_launch.launcher[0]))
+    throw std::invalid_argument(key + ": '" + m_launch.launcher[0] +
+                                "' is not a program found in PATH (Open MPI's mpirun: "
+                                "scripts/setup.sh)");
+  m_s.backend = "LAMMPS through granagg-lammps, started as: " + joinCommand(m_launch.launcher);
 }
 
 std::string PairStudy::batchCommand() const {
@@ -176,6 +209,16 @@ void PairStudy::emitSlurm() {
   job.runs_per_K = m_c.runs;
   job.K = m_c.K;
   job.threads = m_a.threads > 0 ? m_a.threads : 4;
+  if (m_launch.lammps()) {  // every task holds the nodes of one granagg-lammps run
+    job.nodes = m_c.lammps_nodes;
+    job.tasks_per_node = m_c.lammps_tasks_per_node;
+    std::vector<std::string> srun = launcherWords(
+        m_c.lammps_slurm_launcher, 1LL * job.nodes * job.tasks_per_node, "lammps.slurm_launcher");
+    srun.push_back("--nodes=" + std::to_string(job.nodes));
+    srun.push_back("--ntasks-per-node=" + std::to_string(job.tasks_per_node));
+    job.launcher = joinCommand(srun);
+    job.task_options = "--launcher " + shellQuote(job.launcher);
+  }
   job.out = m_out;
   job.study_command = batchCommand();
   job.written_by = m_s.command_line;
@@ -207,7 +250,7 @@ void PairStudy::runMd(std::vector<RunJob> all) {
     if (const auto holder = common::FolderLock::liveHolder(j.dir))
       throw std::invalid_argument("run folder '" + j.dir.string() + "' is in use by " +
                                   holder->describe() + ": wait for it to finish or stop it");
-    j.restart = fs::exists(j.dir / "checkpoint.h5") && fs::exists(j.dir / "traj.h5") &&
+    j.restart = fs::exists(j.dir / checkpointFile(m_launch)) && fs::exists(j.dir / "traj.h5") &&
                 recordOf(j.dir / "run.json", j);
     todo.push_back(j);
   }
@@ -224,7 +267,9 @@ void PairStudy::runMd(std::vector<RunJob> all) {
   // Default: two OpenMP threads per run. The engine's one-thread path is currently several times
   // slower per core than its two-thread path (measured 2026-11-23: N = 500 neutral, 1.9e5 vs
   // 1.2e6 particle-steps/s), so one run per core loses on a 2-core machine.
-  const int default_jobs = std::max(1, m_cores / 2);
+  // A granagg-lammps run takes lammps.ranks cores.
+  const int default_jobs =
+      std::max(1, m_launch.lammps() ? m_cores / m_c.lammps_ranks : m_cores / 2);
   const int jobs = std::max(
       1, std::min<int>(m_a.jobs > 0 ? m_a.jobs : default_jobs, static_cast<int>(todo.size())));
   const int threads = m_a.threads > 0 ? m_a.threads : std::max(1, m_cores / jobs);
@@ -240,29 +285,25 @@ void PairStudy::runMd(std::vector<RunJob> all) {
   std::size_t finished = 0;
   auto progress = [&]() {
     if (!tty) return;
-    std::fprintf(stderr,
-                 "\rpair: md %zu/%zu runs done, %zu running (%d jobs x %d threads), %.0f s   ",
-                 finished, todo.size(), running.size(), jobs, threads,
+    std::fprintf(stderr, "\rpair: md %zu/%zu runs done, %zu running (%d jobs x %d %s), %.0f s   ",
+                 finished, todo.size(), running.size(), jobs,
+                 m_launch.lammps() ? m_c.lammps_ranks : threads,
+                 m_launch.lammps() ? "ranks" : "threads",
                  std::chrono::duration<double>(clock::now() - t0).count());
     std::fflush(stderr);
   };
   auto start = [&](RunJob j) {
     fs::create_directories(j.dir);
-    std::vector<std::string> argv{m_s.exe, "md"};
-    if (j.restart) {
-      // --force clears the stale lock of a run killed with the study (a live one is never taken)
-      argv.insert(argv.end(), {"--restart", j.dir.string(), "--force"});
-    } else {
+    if (!j.restart) {
       // A fresh start: clear what an interrupted attempt left behind.
-      for (const char* f : {"traj.h5", "traj.xdmf", "checkpoint.h5", "done.json"})
+      for (const char* f :
+           {"traj.h5", "traj.xdmf", "checkpoint.h5", "checkpoint.toml", "done.json"})
         fs::remove(j.dir / f);
       nlohmann::ordered_json rec = runRecord(j);
       rec["started"] = nowUtc();
       writeText(j.dir / "run.json", rec.dump(2) + "\n");
-      argv.insert(argv.end(), {"--config", j.config.string(), "--seed", std::to_string(j.seed),
-                               "--out", j.dir.string(), "--force"});
     }
-    argv.insert(argv.end(), {"--threads", std::to_string(threads), "-q"});
+    const std::vector<std::string> argv = mdCommand(m_launch, j, threads);
     appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
     appendText(j.log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
     say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": " +
@@ -285,14 +326,14 @@ void PairStudy::runMd(std::vector<RunJob> all) {
       // each run stops at the end of its chunk of steps with a checkpoint (granagg md handles
       // the signal); the next pair resumes it from there (RunJob::restart)
       const int sig = stopped();
-      for (auto& [p, r] : running) ::kill(p, SIGTERM);
+      for (auto& [p, r] : running) stopRun(p);
       if (tty) std::fprintf(stderr, "\n");
       for (auto& [p, r] : running) {
         int child = 0;
         while (::waitpid(p, &child, 0) < 0 && errno == EINTR) {
         }
         say("md " + kName(r.job.K) + " run " + std::to_string(r.job.r) + ": stopped (" +
-            lastLine(r.job.log) + ")");
+            runLastLine(r.job) + ")");
       }
       say("interrupted (signal " + std::to_string(sig) +
           "): finished runs are kept, stopped runs continue from their checkpoints; run the "
@@ -314,7 +355,10 @@ void PairStudy::runMd(std::vector<RunJob> all) {
     if (ok) {
       nlohmann::ordered_json rec = runRecord(r.job);
       rec["wall_seconds"] = wall;
-      rec["threads"] = threads;
+      if (m_launch.lammps())
+        rec["launcher"] = joinCommand(m_launch.launcher);
+      else
+        rec["threads"] = threads;
       rec["restarted"] = r.job.restart;
       rec["finished"] = nowUtc();
       rec["granagg"] = common::versionString();
@@ -326,7 +370,7 @@ void PairStudy::runMd(std::vector<RunJob> all) {
           (r.job.restart ? " (restarted)" : ""));
     } else if (r.job.restart) {
       // The checkpoint could not be continued (e.g. a trajectory cut by a kill): start afresh.
-      say("md " + name + ": restart failed (" + lastLine(r.job.log) + "); starting it afresh",
+      say("md " + name + ": restart failed (" + runLastLine(r.job) + "); starting it afresh",
           !tty);
       r.job.restart = false;
       pending.push_front(r.job);
@@ -336,7 +380,7 @@ void PairStudy::runMd(std::vector<RunJob> all) {
                                             : "killed by signal " + std::to_string(WTERMSIG(st));
       failed.push_back(name);
       if (tty) std::fprintf(stderr, "\r%100s\r", "");
-      say("md " + name + ": FAILED (" + why + "): " + lastLine(r.job.log) +
+      say("md " + name + ": FAILED (" + why + "): " + runLastLine(r.job) +
           " [log: " + r.job.log.string() + "]");
     }
   }
@@ -350,6 +394,24 @@ void PairStudy::runMd(std::vector<RunJob> all) {
         (m_out / "logs").string() +
         "); finished runs are kept: run the same command again to retry the others");
   }
+}
+
+/// What a run said last: granagg-lammps's last line, not the report mpirun appends after it.
+std::string PairStudy::runLastLine(const RunJob& j) const {
+  return m_launch.lammps() ? lastLine(j.log, "granagg-lammps: ") : lastLine(j.log);
+}
+
+/// Asks a running MD run to stop with a checkpoint: SIGTERM to `granagg md`; to a launched
+/// granagg-lammps run, SIGTERM to its ranks on this machine and not to the launcher, because
+/// Open MPI's mpirun answers SIGTERM by killing its ranks a second later
+/// (odls_base_sigkill_timeout), before a large run has written its checkpoint. The ranks agree
+/// on the stop, then exit, and mpirun with them. A launcher with no rank among its descendants
+/// (srun: Slurm's daemons start the ranks) gets the signal and forwards it.
+void PairStudy::stopRun(pid_t pid) {
+  const std::vector<pid_t> ranks =
+      m_launch.lammps() ? descendantsNamed(pid, "granagg-lammps") : std::vector<pid_t>{};
+  if (ranks.empty()) ::kill(pid, SIGTERM);
+  for (pid_t r : ranks) ::kill(r, SIGTERM);
 }
 
 /// Runs one post-processing command (blocking); returns its exit status (127: could not run).
@@ -583,7 +645,8 @@ void PairStudy::run() {
   }
   say("study '" + m_c.name + "' -> " + m_out.string() + " (" + common::versionString() +
       "; K = " + kList(m_c.K) + ", " + std::to_string(m_c.runs) + " runs each, " +
-      std::to_string(m_cores) + " cores)");
+      std::to_string(m_cores) + " cores)" +
+      (m_launch.lammps() ? "; MD by " + joinCommand(m_launch.launcher) + " granagg-lammps" : ""));
   runMd(m_runs);
   analyse();
   meanField();

@@ -9,6 +9,8 @@
 ///
 /// The library includes none of md/, analysis/ or meanfield/: what it needs of them comes in
 /// StudyServices, wired by the command line (cli/PairCommand.cpp).
+#include <sys/types.h>
+
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -21,6 +23,7 @@
 
 #include "common/FolderLock.h"
 #include "common/PaperValues.h"
+#include "study/MdLaunch.h"
 #include "study/PairConfig.h"
 
 namespace granagg::study {
@@ -41,7 +44,7 @@ struct GrowthSummary {
 
 /// What a study needs from the rest of granagg.
 struct StudyServices {
-  std::string exe;           ///< the granagg binary that runs every step
+  std::string exe;  ///< the granagg binary that runs every step (granagg-lammps lies beside it)
   std::string command_line;  ///< of this study's command, for provenance
   std::string backend;       ///< the MD backend's description, for summary.json
   /// The MD configuration file behind [md] preset = "name" (std::invalid_argument if unknown).
@@ -69,6 +72,7 @@ struct StudyRequest {
   int jobs = 0;            ///< MD runs at a time; 0: max(1, cores / 2)
   int threads = 0;         ///< threads per run; 0: max(1, cores / jobs)
   int run_index = -1;      ///< >= 0: run only this run (a batch array task)
+  std::string launcher;    ///< "" : lammps.launcher; else the launcher of granagg-lammps runs
   bool force = false, quiet = false, no_figures = false;
 };
 
@@ -79,7 +83,9 @@ struct RunJob {
   long long seed = 0;
   int index = 0;  ///< k * runs + r: the batch array index
   std::filesystem::path dir, config, log;
-  std::string spec;  ///< the resolved configuration's hash and the seed: what a record must match
+  /// the resolved configuration's hash, the seed and the engine unless granagg's own: what a
+  /// record must match
+  std::string spec;
   std::string
       legacy_spec;  ///< the same with the hash of records made before 2026-12-02 (Process.h)
   double cost = 0;  ///< particle-steps, x100 with Coulomb: longest first
@@ -105,7 +111,10 @@ class PairStudy {
   void say(const std::string& line, bool terminal = true);
   std::string batchCommand() const;
   void emitSlurm();
+  void setUpLaunch();
   void runMd(std::vector<RunJob> jobs);
+  void stopRun(pid_t pid);
+  std::string runLastLine(const RunJob& j) const;
   int runStep(const std::string& label, std::vector<std::string> argv, const std::string& logname,
               bool quiet_failure = false);
   void analyse();
@@ -129,6 +138,7 @@ class PairStudy {
   std::map<std::string, MdPlan> m_md;            ///< per K name
   std::map<std::string, std::string> m_md_text;  ///< path -> resolved MD TOML to write
   std::vector<RunJob> m_runs;                    ///< every run of the study
+  MdLaunch m_launch;                             ///< how the runs are started
   std::set<std::string> m_changed_k;             ///< K names with a run (re)done now
   std::map<std::string, double> m_timing;
   std::map<std::string, std::string> m_status;    ///< step -> done / skipped: ... / failed: ...

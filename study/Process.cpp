@@ -12,9 +12,11 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -76,6 +78,51 @@ std::string selfExe() {
   return ec ? std::string("granagg") : p.string();
 }
 
+bool findProgram(const std::string& program) {
+  if (program.empty()) return false;
+  if (program.find('/') != std::string::npos) return ::access(program.c_str(), X_OK) == 0;
+  const char* path = std::getenv("PATH");
+  std::istringstream dirs(path ? path : "/usr/bin:/bin");
+  for (std::string dir; std::getline(dirs, dir, ':');) {
+    const fs::path p = fs::path(dir.empty() ? "." : dir) / program;
+    if (fs::is_regular_file(p) && ::access(p.c_str(), X_OK) == 0) return true;
+  }
+  return false;
+}
+
+std::vector<pid_t> descendantsNamed(pid_t root, const std::string& name) {
+  // every process's parent and name from /proc/PID/stat: "pid (comm) state ppid ..."; comm may
+  // hold blanks and parentheses, so it ends at the last ')'
+  std::map<pid_t, std::vector<pid_t>> children;
+  std::map<pid_t, std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator("/proc", ec)) {
+    const std::string id = entry.path().filename().string();
+    if (id.empty() || id.find_first_not_of("0123456789") != std::string::npos) continue;
+    const std::string stat = readText(entry.path() / "stat");
+    const std::size_t open = stat.find('('), close = stat.rfind(')');
+    if (open == std::string::npos || close == std::string::npos || close < open) continue;
+    std::istringstream rest(stat.substr(close + 1));
+    std::string state;
+    long ppid = 0;
+    if (!(rest >> state >> ppid)) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(id));
+    children[static_cast<pid_t>(ppid)].push_back(pid);
+    names[pid] = stat.substr(open + 1, close - open - 1);
+  }
+  std::vector<pid_t> found, todo{root};
+  while (!todo.empty()) {
+    const pid_t p = todo.back();
+    todo.pop_back();
+    for (pid_t c : children[p]) {
+      if (names[c] == name.substr(0, 15)) found.push_back(c);
+      todo.push_back(c);
+    }
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
 std::string shellQuote(const std::string& a) {
   if (!a.empty() &&
       a.find_first_not_of(
@@ -103,6 +150,7 @@ pid_t spawn(const std::vector<std::string>& argv, const fs::path& log) {
   if (pid < 0) throw std::runtime_error("fork failed: " + std::string(std::strerror(errno)));
   if (pid == 0) {
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    ::setpgid(0, 0);
     ::signal(SIGINT, SIG_DFL);
     ::signal(SIGTERM, SIG_DFL);
     const int fd = ::open(logpath.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
@@ -129,6 +177,16 @@ std::string lastLine(const fs::path& log) {
                            end - (begin == std::string::npos ? 0 : begin + 1) + 1);
   if (const auto cr = l.find_last_of('\r'); cr != std::string::npos) l = l.substr(cr + 1);
   return l;
+}
+
+std::string lastLine(const fs::path& log, const std::string& prefix) {
+  std::istringstream in(readText(log));
+  std::string found;
+  for (std::string l; std::getline(in, l);) {
+    if (const auto cr = l.find_last_of('\r'); cr != std::string::npos) l = l.substr(cr + 1);
+    if (l.rfind(prefix, 0) == 0) found = l;
+  }
+  return found.empty() ? lastLine(log) : found;
 }
 
 }  // namespace granagg::study

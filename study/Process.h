@@ -14,7 +14,14 @@ namespace granagg::study {
 
 /// fork + exec of argv (argv[0] looked up in PATH) with stdout and stderr appended to `log` and
 /// stdin from /dev/null. The child gets SIGTERM when its parent dies. Status 127: could not run.
+/// The child leads a process group of its own, so that a terminal's Ctrl-C reaches the study
+/// alone, which stops its children in the way each needs (PairStudy): an MPI launcher that got
+/// the SIGINT itself would kill its ranks before they write their checkpoint.
 pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& log);
+
+/// The processes under `root` (its children, their children, ...) whose name is `name`
+/// (/proc/PID/comm: the executed file's name, cut at 15 characters), found in /proc (Linux).
+std::vector<pid_t> descendantsNamed(pid_t root, const std::string& name);
 
 /// `a` quoted for a POSIX shell where it needs to be ('...' with ' escaped).
 std::string shellQuote(const std::string& a);
@@ -23,9 +30,14 @@ std::string joinCommand(const std::vector<std::string>& argv);
 
 /// The last non-empty line of a log ("" if none), after its last carriage return (progress).
 std::string lastLine(const std::filesystem::path& log);
+/// The last line of a log that starts with `prefix` (after its last carriage return), else
+/// lastLine(log): what a program said last, where a launcher (mpirun) writes after it.
+std::string lastLine(const std::filesystem::path& log, const std::string& prefix);
 
 /// The path of the running executable (/proc/self/exe), "granagg" if unknown.
 std::string selfExe();
+/// Whether `program` can be executed: a path to an executable file, or a name found so in PATH.
+bool findProgram(const std::string& program);
 /// Cores this process may run on (its affinity mask).
 int availableCores();
 /// The current UTC time, ISO 8601 to the second.

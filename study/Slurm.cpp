@@ -29,11 +29,19 @@ std::string slurmScript(const SlurmJob& j) {
     << "# Adjust the #SBATCH lines (partition, account, time, GPUs: --gres=gpu:1 for a CUDA build) "
        "to your cluster.\n"
     << "#SBATCH --job-name=granagg-" << j.name << "\n"
-    << "#SBATCH --array=0-" << (j.tasks - 1) << "\n"
-    << "#SBATCH --cpus-per-task=" << j.threads << "\n"
-    << "#SBATCH --time=24:00:00\n"
+    << "#SBATCH --array=0-" << (j.tasks - 1) << "\n";
+  if (j.nodes > 0)
+    s << "# Each task runs granagg-lammps on " << j.nodes << " node(s) x " << j.tasks_per_node
+      << " MPI ranks, one CPU each, started with: " << j.launcher << "\n"
+      << "#SBATCH --nodes=" << j.nodes << "\n"
+      << "#SBATCH --ntasks-per-node=" << j.tasks_per_node << "\n"
+      << "#SBATCH --cpus-per-task=1\n";
+  else
+    s << "#SBATCH --cpus-per-task=" << j.threads << "\n";
+  s << "#SBATCH --time=24:00:00\n"
     << "# SIGTERM to the task 5 minutes before its time limit: the run stops with a checkpoint\n"
-    << "# (granagg md handles the signal), and resubmitting continues it from there.\n"
+    << "# (granagg pair passes the signal on to the run), and resubmitting continues it from "
+       "there.\n"
     << "#SBATCH --signal=B:TERM@300\n"
     << "#SBATCH --output=" << logs << "/slurm-%A_%a.out\n"
     << "set -euo pipefail\n"
@@ -41,14 +49,15 @@ std::string slurmScript(const SlurmJob& j) {
     << "  jid=$(sbatch --parsable \"$0\")\n"
     << "  sbatch --dependency=afterok:${jid%%;*} --job-name=granagg-" << j.name
     << "-post --cpus-per-task=" << j.threads << " --time=04:00:00 --output=" << logs
-    << "/slurm-post-%j.out --wrap=" << shellQuote(j.study_command) << "\n"
+    << "/slurm-post-%j.out --wrap="
+    << shellQuote(j.study_command + (j.task_options.empty() ? "" : " " + j.task_options)) << "\n"
     << "  echo \"submitted array job $jid and its follow-up\"\n"
     << "  exit 0\n"
     << "fi\n"
     << "# task index = k * " << j.runs_per_K << " + r for K index k (K = " << K << ") and run r\n"
-    << "exec " << j.study_command
-    << " --run-index \"$SLURM_ARRAY_TASK_ID\" --threads \"${SLURM_CPUS_PER_TASK:-" << j.threads
-    << "}\" -q\n";
+    << "exec " << j.study_command << " --run-index \"$SLURM_ARRAY_TASK_ID\""
+    << (j.task_options.empty() ? "" : " " + j.task_options)
+    << " --threads \"${SLURM_CPUS_PER_TASK:-" << (j.nodes > 0 ? 1 : j.threads) << "}\" -q\n";
   return s.str();
 }
 
