@@ -59,17 +59,11 @@ RC_SCAN=${RC_SCAN-"3 4 5 6"}
 LMP_RESPA=${LMP_RESPA-8}
 EVERY_ALSO=${EVERY_ALSO-1}  # also time granagg with these coulomb.every values (default: 1)
 E=278.6; D=27.7; PHI=0.076; SKIN=0.3
-calc() { awk "BEGIN {printf \"%.10g\", $1}"; }
+. scripts/bench_common.sh
 KN=$(calc "2 * $E"); GN=$(calc "4 * $D")
 LMP_ACC=${LMP_ACC:-$(calc "$ACC * $K")}
 
-if ! command -v lmp >/dev/null 2>&1; then
-  echo "bench_coulomb_lammps: installing Debian's lammps" >&2
-  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO=sudo
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get install -y lammps >/dev/null || { $SUDO apt-get update >/dev/null && $SUDO apt-get install -y lammps >/dev/null; }
-fi
-LMP=$(command -v lmp)
+bench_need_lmp bench_coulomb_lammps
 command -v mpirun >/dev/null 2>&1 || LMP_RANKS=1
 
 TMP=$(mktemp -d)
@@ -79,19 +73,10 @@ steps_for() {  # N -> "n1 n2"
   local var="STEPS_$1"
   if [ -n "${!var:-}" ]; then echo "${!var}"; elif [ "$1" -le 20000 ]; then echo "24 120"; else echo "8 48"; fi  # windows of whole multiples of coulomb.every = 8
 }
-now() { date +%s.%N; }
-mins() { printf '%s\n' "$@" | sort -g | head -n 1; }
-range() { printf '%s\n' "$@" | sort -g | awk '{a[NR] = $1} END {printf "%.3g-%.3g", a[1], a[NR]}'; }
-lmp_launch() {  # ranks -> launcher words
-  if [ "$1" -gt 1 ]; then
-    printf '%s\n' mpirun -np "$1" --bind-to core
-    [ "$(id -u)" -ne 0 ] || echo --allow-run-as-root
-  fi
-}
 
-echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(free -g | awk '/Mem:/ {print $2}') GiB"
+echo "Machine: $(bench_machine)"
 echo "granagg: $("$G" --version 2>&1 | head -n 1); $G"
-echo "LAMMPS:  $("$LMP" -h | grep -m1 'Large-scale' | sed 's/.*Simulator - //') (Debian $(dpkg-query -W -f='${Version}' lammps 2>/dev/null || echo '?')); $LMP"
+echo "LAMMPS:  $(bench_lmp_version); $LMP"
 echo "Load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "Settings: K = $K, granagg coulomb.accuracy = $ACC, LAMMPS kspace accuracy = $LMP_ACC (absolute, = ACC K), dt = $DT, skin = $SKIN"
 echo

@@ -48,16 +48,10 @@ E=278.6; D=27.7; PHI=0.076; SKIN=${SKIN:-0.3}   # SKIN: Verlet skin of both code
 # temperatures printed below); nve/sphere, the usual choice for granular runs, also integrates
 # the (zero) rotation. Both are timed; the ratio is taken against the faster.
 LMP_FIXES=${LMP_FIXES:-"nve nve/sphere"}
-calc() { awk "BEGIN {printf \"%.10g\", $1}"; }
+. scripts/bench_common.sh
 KN=$(calc "2 * $E"); GN=$(calc "4 * $D")
 
-if ! command -v lmp >/dev/null 2>&1; then
-  echo "bench_md_lammps: installing Debian's lammps" >&2
-  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO=sudo
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get install -y lammps >/dev/null || { $SUDO apt-get update >/dev/null && $SUDO apt-get install -y lammps >/dev/null; }
-fi
-LMP=$(command -v lmp)
+bench_need_lmp bench_md_lammps
 if ! command -v mpirun >/dev/null 2>&1; then  # Debian's lammps pulls in Open MPI; without it, serial only
   LMP_RANKS=1
 fi
@@ -72,9 +66,9 @@ steps_for() {  # N -> "n1 n2": STEPS_<N> if set, else 200 2000 up to N = 2e4 and
 
 # ---------------------------------------------------------------------------------------------
 # Machine
-echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(free -g | awk '/Mem:/ {print $2}') GiB"
+echo "Machine: $(bench_machine)"
 echo "granagg: $("$G" --version 2>&1 | head -n 1); $G"
-echo "LAMMPS:  $("$LMP" -h | grep -m1 'Large-scale' | sed 's/.*Simulator - //') (Debian $(dpkg-query -W -f='${Version}' lammps 2>/dev/null || echo '?')); $LMP"
+echo "LAMMPS:  $(bench_lmp_version); $LMP"
 echo "Load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
 
@@ -141,16 +135,7 @@ EOF
   OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" \
     --profile > "$TMP/g.log" 2>&1 || { cat "$TMP/g.log" >&2; exit 1; }
   # the loop time and step count from profile.csv (machine-readable; the log is for people)
-  /usr/bin/python3 - "$ROOT/scripts" "$TMP/gout/profile.csv" "$n" <<'PY' \
-    || { cat "$TMP/g.log" >&2; exit 1; }
-import sys
-sys.path.insert(0, sys.argv[1])
-import granagg_tables as gt
-r = gt.read(sys.argv[2])
-if r is None or int(r["steps"][0]) != int(sys.argv[3]):
-    sys.exit(f"granagg did not run {sys.argv[3]} steps ({sys.argv[2]})")
-print(repr(float(r["loop_s"][0])))
-PY
+  granagg_loop_seconds "$TMP/gout/profile.csv" "$n" || { cat "$TMP/g.log" >&2; exit 1; }
 }
 
 lammps_time() {  # N n1 n2 ranks fix -> loop seconds of steps n1..n2
@@ -171,22 +156,12 @@ thermo          1000000
 run             $n1
 run             $((n2 - n1))
 EOF
-  local launch=()
-  if [ "$np" -gt 1 ]; then
-    launch=(mpirun -np "$np" --bind-to core)
-    [ "$(id -u)" -ne 0 ] || launch+=(--allow-run-as-root)
-  fi
+  local launch
+  mapfile -t launch < <(lmp_launch "$np")
   (cd "$TMP" && OMP_NUM_THREADS=1 "${launch[@]}" "$LMP" -in bench.in -log none -nocite -echo none > lmp.log 2>&1) || { cat "$TMP/lmp.log" >&2; exit 1; }
   cp "$TMP/lmp.log" "$TMP/lmp_$np.log"
   cp "$TMP/lmp.log" "$TMP/lmp_${np}_${fix//\//_}.log"
   grep '^Loop time' "$TMP/lmp.log" | tail -n 1 | awk '{print $4}'
-}
-
-mins() {  # numbers... -> the smallest
-  printf '%s\n' "$@" | sort -g | head -n 1
-}
-range() {  # rates... -> "min-max"
-  printf '%s\n' "$@" | sort -g | awk '{a[NR] = $1} END {printf "%.3g-%.3g", a[1], a[NR]}'
 }
 
 ROWS=()
