@@ -31,7 +31,7 @@ const char* FOUR_ATOMS =
 
 }  // namespace
 
-TEST_CASE("md from a LAMMPS data file logs the file's N and phi; contradictions exit 2",
+TEST_CASE("md from a LAMMPS data file logs the file's N and phi, contradictions exit 2",
           "[cli][md]") {
   const fs::path dir = tempDir("md_inputs_lammps");
   const std::string data = (dir / "four.data").string();

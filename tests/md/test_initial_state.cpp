@@ -499,7 +499,7 @@ TEST_CASE("a system.N or system.phi that contradicts the initial file is refused
   std::remove(p.c_str());
 }
 
-TEST_CASE("an H5MD state sets N and phi from its frame; a CSV takes its box from N and phi",
+TEST_CASE("an H5MD state sets N and phi from its frame, a CSV takes its box from N and phi",
           "[md][io]") {
   const std::string h5 = tempPath("three.h5");
   std::remove(h5.c_str());
