@@ -84,8 +84,8 @@ constexpr double R_FAST_AUTO_BEFORE_RECORDED = 3.5;
 /// granagg resolves "auto" differently.
 MdConfig withRecordedSplit(MdConfig c, const Checkpoint& ck) {
   if (!(c.coulomb.K > 0.0)) return c;
-  const auto& reals = ck.extra.real_scalars;
-  const auto& ints = ck.extra.int_scalars;
+  const auto& reals = ck.engine.reals;
+  const auto& ints = ck.engine.ints;
   if (!(c.coulomb.r_fast > 0.0)) {
     const auto r = reals.find("coulomb_r_fast");
     c.coulomb.r_fast = r != reals.end() ? r->second : R_FAST_AUTO_BEFORE_RECORDED;
@@ -750,30 +750,21 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
 
 Engine::Engine(const MdConfig& config, const Checkpoint& ck)
     : Engine(withRecordedSplit(config, ck), ck.state, /*allow_contacts=*/true) {
-  const CheckpointExtra& c = ck.extra;
+  const EngineState& e = ck.engine;
   // the Coulomb parameters first: restore() sizes the multiple-time-step state for them
-  if (const auto design = c.real_scalars.find("coulomb_sum_q2_design");
-      design != c.real_scalars.end())
+  if (const auto design = e.reals.find("coulomb_sum_q2_design"); design != e.reals.end())
     useCoulombDesign(design->second);
-  std::vector<double> f = c.fx;
-  f.insert(f.end(), c.fy.begin(), c.fy.end());
-  f.insert(f.end(), c.fz.begin(), c.fz.end());
-  const auto collisions = c.int_scalars.find("collisions");
-  EngineExtra extra;
-  extra.arrays = c.arrays;
-  extra.ints = c.int_scalars;
-  extra.reals = c.real_scalars;
-  restore(ck.state, f, collisions == c.int_scalars.end() ? 0 : collisions->second, extra);
+  std::vector<double> f = ck.fx;
+  f.insert(f.end(), ck.fy.begin(), ck.fy.end());
+  f.insert(f.end(), ck.fz.begin(), ck.fz.end());
+  const auto collisions = e.ints.find("collisions");
+  restore(ck.state, f, collisions == e.ints.end() ? 0 : collisions->second, e);
 }
 
-void Engine::saveCheckpoint(const std::filesystem::path& folder,
-                            const CheckpointExtra& run_fields) {
+void Engine::saveCheckpoint(const std::filesystem::path& folder, const RunFields& run_fields) {
   Checkpoint ck = checkpoint();
-  ck.extra.config_toml = run_fields.config_toml;
-  ck.extra.seed = run_fields.seed;
-  ck.extra.frames_written = run_fields.frames_written;
-  ck.extra.next_frame_index = run_fields.next_frame_index;
-  writeCheckpoint(checkpointPath(folder).string(), ck.state, ck.extra);
+  ck.run = run_fields;
+  writeCheckpoint(checkpointPath(folder).string(), ck);
 }
 
 Checkpoint Engine::checkpoint() const {
@@ -781,18 +772,14 @@ Checkpoint Engine::checkpoint() const {
   ck.state = frame(StateKind::Integrator);
   const std::vector<double> f = forces(StateKind::Integrator);
   const std::size_t N = size();
-  CheckpointExtra& c = ck.extra;
-  c.fx.assign(f.begin(), f.begin() + N);
-  c.fy.assign(f.begin() + N, f.begin() + 2 * N);
-  c.fz.assign(f.begin() + 2 * N, f.end());
-  c.dt = dt();
-  c.int_scalars["collisions"] = m_impl->collisions;
+  ck.fx.assign(f.begin(), f.begin() + N);
+  ck.fy.assign(f.begin() + N, f.begin() + 2 * N);
+  ck.fz.assign(f.begin() + 2 * N, f.end());
+  ck.dt = dt();
+  ck.engine = engineState();
+  ck.engine.ints["collisions"] = m_impl->collisions;
   if (const CoulombSetup* cs = coulombSetup())
-    c.real_scalars["coulomb_sum_q2_design"] = cs->sum_q2_design;
-  EngineExtra extra = extraState();
-  c.arrays = std::move(extra.arrays);
-  c.int_scalars.insert(extra.ints.begin(), extra.ints.end());
-  c.real_scalars.insert(extra.reals.begin(), extra.reals.end());
+    ck.engine.reals["coulomb_sum_q2_design"] = cs->sum_q2_design;
   return ck;
 }
 
@@ -864,9 +851,9 @@ std::vector<double> Engine::forces(StateKind kind) const {
   return out;
 }
 
-EngineExtra Engine::extraState() const {
+EngineState Engine::engineState() const {
   const Impl& d = *m_impl;
-  EngineExtra e;
+  EngineState e;
   if (!d.coulomb) return e;
   e.arrays["coulomb_fx"] = toHostById(d.ext_fx, d.p.id);
   e.arrays["coulomb_fy"] = toHostById(d.ext_fy, d.p.id);
@@ -882,7 +869,7 @@ EngineExtra Engine::extraState() const {
 }
 
 void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions,
-                     const EngineExtra& extra) {
+                     const EngineState& extra) {
   Impl& d = *m_impl;
   const std::size_t N = d.p.size();
   if (s.size() != N || forces.size() != 3 * N || s.charge.size() != N || s.ix.size() != N)

@@ -53,14 +53,6 @@
 
 namespace granagg::md {
 
-/// Engine state besides particles and forces that a bit-for-bit restart needs (checkpoint
-/// datasets and scalars; see CheckpointExtra).
-struct EngineExtra {
-  std::map<std::string, std::vector<double>> arrays;  ///< per particle, in id order
-  std::map<std::string, std::int64_t> ints;
-  std::map<std::string, double> reals;
-};
-
 /// granagg's engine behind md::RunEngine (md/engine/RunEngine.h), on one process (OpenMP or
 /// CUDA): writesFiles() and anyRank() keep their defaults.
 class Engine : public RunEngine {
@@ -98,13 +90,13 @@ class Engine : public RunEngine {
   /// checkpoint() with the run's fields of `run_fields` (config_toml, seed, frames_written,
   /// next_frame_index), written atomically to checkpointPath(folder) = folder/checkpoint.h5
   /// (md::writeCheckpoint).
-  void saveCheckpoint(const std::filesystem::path& folder,
-                      const CheckpointExtra& run_fields) override;
-  /// What else a bit-for-bit restart needs (the Coulomb force of the last evaluation).
-  EngineExtra extraState() const;
-  /// Restores a checkpointed state with its forces, collision counter and extraState() (same N).
+  void saveCheckpoint(const std::filesystem::path& folder, const RunFields& run_fields) override;
+  /// What else a bit-for-bit restart needs: the multiple-time-step state (the Coulomb force of
+  /// the last evaluation, its step and energy, the slow interval) and the resolved split.
+  EngineState engineState() const;
+  /// Restores a checkpointed state with its forces, collision counter and engineState() (same N).
   void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions,
-               const EngineExtra& extra = {});
+               const EngineState& engine_state = {});
 
   Observables observables() const override;
   double dt() const override;

@@ -127,7 +127,7 @@ class RunEngine {
   /// is ignored). Collective; the files are written by the writing rank. Not const: LAMMPS's
   /// write_restart migrates atoms between ranks (the state's values do not change).
   virtual void saveCheckpoint(const std::filesystem::path& folder,
-                              const CheckpointExtra& run_fields) = 0;
+                              const RunFields& run_fields) = 0;
 };
 
 }  // namespace granagg::md

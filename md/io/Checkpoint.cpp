@@ -59,7 +59,8 @@ void writeU64(hid_t obj, const std::string& name, std::uint64_t v, const std::st
   h5::writeAttribute(obj, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &v, {}, ctx);
 }
 
-void writeFile(const std::string& file_path, const Frame& s, const CheckpointExtra& e) {
+void writeFile(const std::string& file_path, const Checkpoint& e) {
+  const Frame& s = e.state;
   const std::string c = "checkpoint '" + file_path + "'";
   h5::Handle file = h5::check(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
                               "cannot create " + c);
@@ -90,28 +91,29 @@ void writeFile(const std::string& file_path, const Frame& s, const CheckpointExt
   }
   {
     h5::Handle g = h5::createGroup(f, "run", c);
-    writeU64(g.get(), "seed", e.seed, c);
-    writeU64(g.get(), "frames_written", e.frames_written, c);
-    writeU64(g.get(), "next_frame_index", e.next_frame_index, c);
-    h5::writeStringDataset(g.get(), "config_toml", e.config_toml, c);
+    writeU64(g.get(), "seed", e.run.seed, c);
+    writeU64(g.get(), "frames_written", e.run.frames_written, c);
+    writeU64(g.get(), "next_frame_index", e.run.next_frame_index, c);
+    h5::writeStringDataset(g.get(), "config_toml", e.run.config_toml, c);
   }
   {
     h5::Handle gi = h5::createGroup(f, "scalars/int", c);
-    for (const auto& [k, v] : e.int_scalars)
+    for (const auto& [k, v] : e.engine.ints)
       h5::writeAttribute(gi.get(), k, static_cast<std::int64_t>(v), c + " /scalars/int");
     h5::Handle gr = h5::createGroup(f, "scalars/real", c);
-    for (const auto& [k, v] : e.real_scalars)
+    for (const auto& [k, v] : e.engine.reals)
       h5::writeAttribute(gr.get(), k, v, c + " /scalars/real");
   }
-  if (!e.arrays.empty()) {
+  if (!e.engine.arrays.empty()) {
     h5::Handle g = h5::createGroup(f, "arrays", c);
-    for (const auto& [k, v] : e.arrays)
+    for (const auto& [k, v] : e.engine.arrays)
       writeArray(g.get(), k, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v.data(), n, c);
   }
   if (!file.reset()) h5::fail("cannot close " + c + " (disk full?)");
 }
 
-void validate(const Frame& s, const CheckpointExtra& e) {
+void validate(const Checkpoint& e) {
+  const Frame& s = e.state;
   const std::size_t n = s.size();
   if (n == 0) throw std::invalid_argument("writeCheckpoint: the state has no particles.");
   auto need = [&](std::size_t size, const char* name) {
@@ -138,13 +140,13 @@ void validate(const Frame& s, const CheckpointExtra& e) {
   if (!(e.dt > 0.0) || !std::isfinite(e.dt))
     throw std::invalid_argument("writeCheckpoint: dt must be positive and finite, got " +
                                 common::formatReal(e.dt) + ".");
-  for (const auto& kv : e.int_scalars)
+  for (const auto& kv : e.engine.ints)
     if (kv.first.empty())
       throw std::invalid_argument("writeCheckpoint: an integer scalar has an empty name.");
-  for (const auto& kv : e.real_scalars)
+  for (const auto& kv : e.engine.reals)
     if (kv.first.empty())
       throw std::invalid_argument("writeCheckpoint: a real scalar has an empty name.");
-  for (const auto& kv : e.arrays) {
+  for (const auto& kv : e.engine.arrays) {
     if (kv.first.empty() || kv.first.find('/') != std::string::npos)
       throw std::invalid_argument("writeCheckpoint: an array name is empty or contains '/'.");
     need(kv.second.size(), kv.first.c_str());
@@ -153,13 +155,13 @@ void validate(const Frame& s, const CheckpointExtra& e) {
 
 }  // namespace
 
-void writeCheckpoint(const std::string& path, const Frame& state, const CheckpointExtra& extra) {
+void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint) {
   if (path.empty()) throw std::invalid_argument("writeCheckpoint requires a file name.");
-  validate(state, extra);
+  validate(checkpoint);
   h5::silenceErrors();
   const std::string tmp = path + ".tmp";
   try {
-    writeFile(tmp, state, extra);
+    writeFile(tmp, checkpoint);
     if (!syncPath(tmp, false))
       throw std::runtime_error("cannot fsync checkpoint '" + tmp + "': " + std::strerror(errno));
     if (std::rename(tmp.c_str(), path.c_str()) != 0)
@@ -218,7 +220,7 @@ Checkpoint readCheckpoint(const std::string& path) {
 
   Checkpoint cp;
   Frame& s = cp.state;
-  CheckpointExtra& e = cp.extra;
+  Checkpoint& e = cp;
   std::int64_t n = 0;
   {
     h5::Handle g = group("state");
@@ -265,14 +267,14 @@ Checkpoint readCheckpoint(const std::string& path) {
   }
   {
     h5::Handle g = group("run");
-    scalar(g.get(), "/run", "seed", H5T_NATIVE_UINT64, &e.seed);
-    scalar(g.get(), "/run", "frames_written", H5T_NATIVE_UINT64, &e.frames_written);
-    scalar(g.get(), "/run", "next_frame_index", H5T_NATIVE_UINT64, &e.next_frame_index);
+    scalar(g.get(), "/run", "seed", H5T_NATIVE_UINT64, &e.run.seed);
+    scalar(g.get(), "/run", "frames_written", H5T_NATIVE_UINT64, &e.run.frames_written);
+    scalar(g.get(), "/run", "next_frame_index", H5T_NATIVE_UINT64, &e.run.next_frame_index);
     if (h5::objectType(g.get(), "config_toml") != H5I_DATASET)
       throw std::runtime_error(c + " is missing dataset '/run/config_toml'");
     h5::Handle d =
         h5::check(H5Dopen2(g.get(), "config_toml", H5P_DEFAULT), c + ": /run/config_toml");
-    e.config_toml = h5::readString(d.get(), false, c + ": /run/config_toml");
+    e.run.config_toml = h5::readString(d.get(), false, c + ": /run/config_toml");
   }
   {
     h5::Handle gs = group("scalars");
@@ -286,11 +288,11 @@ Checkpoint readCheckpoint(const std::string& path) {
         if (integer) {
           std::int64_t v = 0;
           scalar(g.get(), gname, name.c_str(), H5T_NATIVE_INT64, &v);
-          e.int_scalars[name] = v;
+          e.engine.ints[name] = v;
         } else {
           double v = 0;
           scalar(g.get(), gname, name.c_str(), H5T_NATIVE_DOUBLE, &v);
-          e.real_scalars[name] = v;
+          e.engine.reals[name] = v;
         }
       }
     };
@@ -305,7 +307,7 @@ Checkpoint readCheckpoint(const std::string& path) {
       const auto dims = h5::datasetDims(d.get(), dc);
       if (dims.size() != 1 || dims[0] != static_cast<hsize_t>(n))
         throw std::runtime_error(dc + " does not hold N = " + std::to_string(n) + " entries");
-      std::vector<double>& out = e.arrays[name];
+      std::vector<double>& out = e.engine.arrays[name];
       out.resize(static_cast<std::size_t>(n));
       h5::checkStatus(
           H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),

@@ -12,10 +12,10 @@
 ///         ix iy iz                         int32[N]
 ///     /integrator       +-- dt (double)
 ///     /run              +-- seed (uint64), frames_written (uint64), next_frame_index (uint64)
-///         config_toml   string
-///     /scalars/int      +-- one int64 attribute per entry of CheckpointExtra::int_scalars
-///     /scalars/real     +-- one double attribute per entry of CheckpointExtra::real_scalars
-///     /arrays           one double[N] dataset per entry of CheckpointExtra::arrays (optional:
+///         config_toml   string                            (RunFields)
+///     /scalars/int      +-- one int64 attribute per entry of EngineState::ints
+///     /scalars/real     +-- one double attribute per entry of EngineState::reals
+///     /arrays           one double[N] dataset per entry of EngineState::arrays (optional:
 ///                       files without the group read back with no arrays)
 ///
 /// Arrays are chunked with HDF5's Fletcher-32 checksum filter, so silent corruption is detected
@@ -32,26 +32,33 @@
 
 namespace granagg::md {
 
-/// Engine state besides the particle Frame that a bit-for-bit restart needs.
-struct CheckpointExtra {
-  /// Forces at the saved state (computed at the end of the last step), one per particle, in
-  /// reduced units m d / t^2: velocity Verlet's first half-kick of the next step uses them.
-  std::vector<double> fx, fy, fz;
-  double dt = 0.0;                     ///< integrator time step (reduced time units), > 0
+/// The run's own fields (md::Simulation's, the same whatever the engine): the configuration, the
+/// seed and where the trajectory stands.
+struct RunFields {
   std::string config_toml;             ///< TOML text of the resolved configuration
   std::uint64_t seed = 0;              ///< RNG seed (Philox key; no RNG state is stored)
   std::uint64_t frames_written = 0;    ///< frames already in the trajectory file
   std::uint64_t next_frame_index = 0;  ///< index of the next scheduled frame in the output schedule
-  std::map<std::string, std::int64_t> int_scalars;  ///< engine-defined counters (e.g. rebuilds)
-  std::map<std::string, double> real_scalars;  ///< engine-defined reals (e.g. wall-clock timers)
-  std::map<std::string, std::vector<double>>
-      arrays;  ///< engine-defined per-particle arrays (N each)
 };
 
-/// What readCheckpoint returns.
+/// The state an engine defines for itself, beyond particles and forces: named integers (counters,
+/// the step of the last Coulomb evaluation), reals and per-particle arrays (N each, in id order).
+/// md::Engine stores its multiple-time-step state here (Engine::engineState).
+struct EngineState {
+  std::map<std::string, std::int64_t> ints;
+  std::map<std::string, double> reals;
+  std::map<std::string, std::vector<double>> arrays;
+};
+
+/// Everything a checkpoint holds: one typed state for reading, writing and restoring.
 struct Checkpoint {
   Frame state;  ///< full-precision particle state (positions wrapped, with images)
-  CheckpointExtra extra;
+  /// Forces at the saved state (computed at the end of the last step), one per particle, in
+  /// reduced units m d / t^2: velocity Verlet's first half-kick of the next step uses them.
+  std::vector<double> fx, fy, fz;
+  double dt = 0.0;     ///< integrator time step (reduced time units), > 0
+  RunFields run;       ///< /run
+  EngineState engine;  ///< /scalars/int, /scalars/real, /arrays
 };
 
 /// Writes a checkpoint atomically to `path` (via `path + ".tmp"`, see the file comment).
@@ -59,7 +66,7 @@ struct Checkpoint {
 /// dt > 0 and non-empty scalar names (std::invalid_argument otherwise). Throws
 /// std::runtime_error naming the file if writing or renaming fails; the previous file at `path`
 /// is then untouched and the temporary file removed.
-void writeCheckpoint(const std::string& path, const Frame& state, const CheckpointExtra& extra);
+void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint);
 
 /// Reads a checkpoint written by writeCheckpoint. Values come back bit for bit. Throws
 /// std::runtime_error naming the file (and dataset) if it is missing, not HDF5, truncated,

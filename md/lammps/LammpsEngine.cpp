@@ -460,7 +460,7 @@ fs::path LammpsEngine::checkpointPath(const fs::path& folder) const {
 }
 
 void LammpsEngine::saveCheckpoint(const fs::path& /*folder: the constructor's*/,
-                                  const CheckpointExtra& run) {
+                                  const RunFields& run) {
   const std::int64_t now = step();
   const std::string name = "checkpoint-" + std::to_string(now) + ".restart";
   const fs::path partial = m_folder / (name + ".partial");

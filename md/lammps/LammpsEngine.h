@@ -68,7 +68,7 @@ struct LammpsCheckpoint {
   double box = 0.0;            ///< edge L of the periodic cube
   double sum_q2_design = 0.0;  ///< CoulombSetup::sum_q2_design of the run (0 without Coulomb)
   bool record_collisions = false;  ///< the run logs its collisions (collisions.csv)
-  CheckpointExtra run_fields;      ///< config_toml, seed, frames_written, next_frame_index
+  RunFields run_fields;            ///< config_toml, seed, frames_written, next_frame_index
 };
 
 /// The name of the checkpoint file in a run's folder.
@@ -121,7 +121,7 @@ class LammpsEngine : public RunEngine {
   bool anyRank(bool local) const override;
   std::filesystem::path checkpointPath(const std::filesystem::path& folder) const override;
   void saveCheckpoint(const std::filesystem::path& folder,
-                      const CheckpointExtra& run_fields) override;
+                      const RunFields& run_fields) override;
 
   /// The generated input as lammps.in holds it (header comments, commands, the `run`).
   const std::string& inputText() const { return m_input_text; }

@@ -32,7 +32,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -41,27 +40,9 @@
 #include "md/config/MdConfig.h"
 #include "md/engine/Engine.h"
 #include "md/engine/RunEngine.h"
+#include "md/run/Reporter.h"
 
 namespace granagg::md {
-
-class Simulation;
-
-/// Looks at a run between chunks of steps (progress lines, user callbacks). A reporter never
-/// changes the run: the frames, observables and checkpoints are the Simulation's own.
-class Reporter {
- public:
-  virtual ~Reporter() = default;
-  /// The step at which this reporter next wants to be called; the run then stops there. The
-  /// default has no wish: report() is still called after every chunk (at most
-  /// output.observable_interval steps).
-  virtual std::int64_t nextStep(const Simulation&) const {
-    return std::numeric_limits<std::int64_t>::max();
-  }
-  /// Called after each chunk of steps, with the engine at the chunk's end.
-  virtual void report(const Simulation& sim) = 0;
-  /// Called once when run() ends (normally or not).
-  virtual void finish(const Simulation&) {}
-};
 
 /// How a run is started or resumed.
 struct RunOptions {
@@ -120,7 +101,7 @@ class Simulation {
   /// (collectively, on every rank). After the folder is locked, RunEngine::begin(out).
   static Simulation resume(const std::filesystem::path& out,
                            const std::vector<std::string>& overrides, const RunOptions& options,
-                           const CheckpointExtra& run_fields, const std::string& config_source,
+                           const RunFields& run_fields, const std::string& config_source,
                            const EngineFromCheckpoint& continue_engine);
 
   Simulation(Simulation&&) noexcept;
@@ -180,7 +161,7 @@ class Simulation {
   /// resume()'s common part; `folder_checked`: FolderLock::checkAvailable was called already.
   static Simulation resumeWith(const std::filesystem::path& out,
                                const std::vector<std::string>& overrides, const RunOptions& options,
-                               const CheckpointExtra& run_fields, const std::string& config_source,
+                               const RunFields& run_fields, const std::string& config_source,
                                const EngineFromCheckpoint& continue_engine, bool folder_checked);
   std::unique_ptr<Impl> m_impl;
 };

@@ -212,26 +212,28 @@ void checkAgainstReference(const std::string& name, const MdConfig& c, const Out
   const std::size_t n = o.end.size();
   if (std::getenv("GRANAGG_WRITE_BACKEND_REFERENCE")) {
     REQUIRE_FALSE(CUDA_BUILD);  // the reference is the CPU backend's by definition
-    CheckpointExtra x;
+    Checkpoint x;
+    x.state = o.end;
     x.fx = slice(o.f1, 0, n);
     x.fy = slice(o.f1, 1, n);
     x.fz = slice(o.f1, 2, n);
     x.dt = 1.0;  // unused by the comparison
-    x.seed = c.system.seed;
-    x.arrays = {{"f0x", slice(o.f0, 0, n)}, {"f0y", slice(o.f0, 1, n)}, {"f0z", slice(o.f0, 2, n)}};
-    writeCheckpoint(path, o.end, x);
+    x.run.seed = c.system.seed;
+    x.engine.arrays = {
+        {"f0x", slice(o.f0, 0, n)}, {"f0y", slice(o.f0, 1, n)}, {"f0z", slice(o.f0, 2, n)}};
+    writeCheckpoint(path, x);
     WARN("wrote the reference " << path);
     return;
   }
   const Checkpoint ref = readCheckpoint(path);
   REQUIRE(ref.state.size() == n);
   REQUIRE(ref.state.step == o.end.step);
-  std::vector<double> ref_f0 = ref.extra.arrays.at("f0x");
+  std::vector<double> ref_f0 = ref.engine.arrays.at("f0x");
   for (const char* k : {"f0y", "f0z"})
-    ref_f0.insert(ref_f0.end(), ref.extra.arrays.at(k).begin(), ref.extra.arrays.at(k).end());
-  std::vector<double> ref_f1 = ref.extra.fx;
-  ref_f1.insert(ref_f1.end(), ref.extra.fy.begin(), ref.extra.fy.end());
-  ref_f1.insert(ref_f1.end(), ref.extra.fz.begin(), ref.extra.fz.end());
+    ref_f0.insert(ref_f0.end(), ref.engine.arrays.at(k).begin(), ref.engine.arrays.at(k).end());
+  std::vector<double> ref_f1 = ref.fx;
+  ref_f1.insert(ref_f1.end(), ref.fy.begin(), ref.fy.end());
+  ref_f1.insert(ref_f1.end(), ref.fz.begin(), ref.fz.end());
 
   const double f0 = maxAbsDiff(o.f0, ref_f0) / maxAbs(ref_f0);
   const double f1 = maxAbsDiff(o.f1, ref_f1) / maxAbs(ref_f1);

@@ -37,7 +37,7 @@ Checkpoint makeCheckpoint(std::size_t n, unsigned seed) {
   s.step = 123456789012LL;
   s.time = 98.76543210987654;
   s.box = 12.0;
-  CheckpointExtra& e = c.extra;
+  Checkpoint& e = c;
   for (std::size_t i = 0; i < n; ++i) {
     s.x.push_back(u(rng));
     s.y.push_back(u(rng));
@@ -57,27 +57,28 @@ Checkpoint makeCheckpoint(std::size_t n, unsigned seed) {
   s.vy[0] = std::numeric_limits<double>::denorm_min();
   e.fz[0] = 1.7976931348623157e308;
   e.dt = 1.0 / 3000.0;
-  e.config_toml = "[input]\nversion = 1\n[system]\nN = " + std::to_string(n) + "\n";
-  e.seed = 0xFFFFFFFFFFFFFFF1ULL;  // needs all 64 unsigned bits
-  e.frames_written = 17;
-  e.next_frame_index = 19;
-  e.int_scalars = {{"neighbor_rebuilds", 4242}, {"min_step", -7}};
-  e.real_scalars = {{"wall_seconds", 1234.5}, {"max_displacement", 0.1 + 0.2}};
+  e.run.config_toml = "[input]\nversion = 1\n[system]\nN = " + std::to_string(n) + "\n";
+  e.run.seed = 0xFFFFFFFFFFFFFFF1ULL;  // needs all 64 unsigned bits
+  e.run.frames_written = 17;
+  e.run.next_frame_index = 19;
+  e.engine.ints = {{"neighbor_rebuilds", 4242}, {"min_step", -7}};
+  e.engine.reals = {{"wall_seconds", 1234.5}, {"max_displacement", 0.1 + 0.2}};
   return c;
 }
 
 bool sameCheckpoint(const Checkpoint& a, const Checkpoint& b) {
   const Frame &s = a.state, &t = b.state;
-  const CheckpointExtra &e = a.extra, &f = b.extra;
+  const Checkpoint &e = a, &f = b;
   return s.step == t.step && sameBits(s.time, t.time) && sameBits(s.box, t.box) &&
          sameBits(s.x, t.x) && sameBits(s.y, t.y) && sameBits(s.z, t.z) && sameBits(s.vx, t.vx) &&
          sameBits(s.vy, t.vy) && sameBits(s.vz, t.vz) && sameBits(s.charge, t.charge) &&
          sameBits(s.ix, t.ix) && sameBits(s.iy, t.iy) && sameBits(s.iz, t.iz) &&
          sameBits(e.fx, f.fx) && sameBits(e.fy, f.fy) && sameBits(e.fz, f.fz) &&
-         sameBits(e.dt, f.dt) && e.config_toml == f.config_toml && e.seed == f.seed &&
-         e.frames_written == f.frames_written && e.next_frame_index == f.next_frame_index &&
-         e.int_scalars == f.int_scalars && e.real_scalars.size() == f.real_scalars.size() &&
-         std::equal(e.real_scalars.begin(), e.real_scalars.end(), f.real_scalars.begin(),
+         sameBits(e.dt, f.dt) && e.run.config_toml == f.run.config_toml &&
+         e.run.seed == f.run.seed && e.run.frames_written == f.run.frames_written &&
+         e.run.next_frame_index == f.run.next_frame_index && e.engine.ints == f.engine.ints &&
+         e.engine.reals.size() == f.engine.reals.size() &&
+         std::equal(e.engine.reals.begin(), e.engine.reals.end(), f.engine.reals.begin(),
                     [](const auto& p, const auto& q) {
                       return p.first == q.first && sameBits(p.second, q.second);
                     });
@@ -93,16 +94,16 @@ bool fileExists(const std::string& p) {
 TEST_CASE("checkpoint round trip is bit-exact", "[md][io]") {
   const std::string path = tempPath("rt.h5");
   const Checkpoint c = makeCheckpoint(1000, 7);
-  writeCheckpoint(path, c.state, c.extra);
+  writeCheckpoint(path, c);
   CHECK_FALSE(fileExists(path + ".tmp"));  // renamed into place
   const Checkpoint r = readCheckpoint(path);
   CHECK(sameCheckpoint(c, r));
-  CHECK(r.extra.seed == 0xFFFFFFFFFFFFFFF1ULL);
-  CHECK(r.extra.int_scalars.at("min_step") == -7);
+  CHECK(r.run.seed == 0xFFFFFFFFFFFFFFF1ULL);
+  CHECK(r.engine.ints.at("min_step") == -7);
 
   // replacing it with a newer checkpoint
   const Checkpoint c2 = makeCheckpoint(1000, 8);
-  writeCheckpoint(path, c2.state, c2.extra);
+  writeCheckpoint(path, c2);
   CHECK(sameCheckpoint(readCheckpoint(path), c2));
   std::remove(path.c_str());
 }
@@ -110,18 +111,18 @@ TEST_CASE("checkpoint round trip is bit-exact", "[md][io]") {
 TEST_CASE("a failed checkpoint write keeps the previous checkpoint", "[md][io]") {
   const std::string path = tempPath("atomic.h5");
   const Checkpoint good = makeCheckpoint(50, 1);
-  writeCheckpoint(path, good.state, good.extra);
+  writeCheckpoint(path, good);
   // Simulate a failure while writing: the temporary file cannot be created because a directory
   // of that name is in the way.
   const std::string tmp = path + ".tmp";
   REQUIRE(::mkdir(tmp.c_str(), 0700) == 0);
   const Checkpoint next = makeCheckpoint(50, 2);
-  CHECK_THROWS_AS(writeCheckpoint(path, next.state, next.extra), std::runtime_error);
-  CHECK_THROWS_WITH(writeCheckpoint(path, next.state, next.extra), Catch::Contains(tmp));
+  CHECK_THROWS_AS(writeCheckpoint(path, next), std::runtime_error);
+  CHECK_THROWS_WITH(writeCheckpoint(path, next), Catch::Contains(tmp));
   CHECK(sameCheckpoint(readCheckpoint(path), good));  // the old one survives intact
   ::rmdir(tmp.c_str());
   // and once the obstacle is gone, writing works again
-  writeCheckpoint(path, next.state, next.extra);
+  writeCheckpoint(path, next);
   CHECK(sameCheckpoint(readCheckpoint(path), next));
   std::remove(path.c_str());
 }
@@ -130,16 +131,16 @@ TEST_CASE("checkpoint arguments are validated", "[md][io]") {
   const std::string path = tempPath("invalid.h5");
   Checkpoint c = makeCheckpoint(10, 3);
   Checkpoint bad = c;
-  bad.extra.fy.pop_back();
-  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra),
+  bad.fy.pop_back();
+  CHECK_THROWS_WITH(writeCheckpoint(path, bad),
                     Catch::Contains("fy has 9 entries, expected N = 10"));
   bad = c;
-  bad.extra.dt = 0.0;
-  CHECK_THROWS_WITH(writeCheckpoint(path, bad.state, bad.extra),
+  bad.dt = 0.0;
+  CHECK_THROWS_WITH(writeCheckpoint(path, bad),
                     Catch::Contains("dt must be positive"));
   bad = c;
   bad.state.charge.clear();
-  CHECK_THROWS_AS(writeCheckpoint(path, bad.state, bad.extra), std::invalid_argument);
+  CHECK_THROWS_AS(writeCheckpoint(path, bad), std::invalid_argument);
   CHECK_FALSE(fileExists(path));
 }
 
@@ -149,7 +150,7 @@ TEST_CASE("corrupt or foreign checkpoints give clear errors", "[md][io]") {
   // a recognisable pattern in x to locate its bytes in the file
   for (std::size_t i = 0; i < c.state.x.size(); ++i)
     c.state.x[i] = 1.0 + 1e-9 * static_cast<double>(i);
-  writeCheckpoint(path, c.state, c.extra);
+  writeCheckpoint(path, c);
   const std::string bytes = slurp(path);
 
   SECTION("truncated") {

@@ -298,7 +298,7 @@ TEST_CASE(
     CHECK(worst < sp.bound);
   }
   // (c) a restart at a step between Coulomb evaluations continues bit for bit (the last slow force
-  // travels with the checkpoint: Engine::extraState)
+  // travels with the checkpoint: Engine::engineState)
   {
     MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
     c.charging.mode = "exchange";
@@ -313,7 +313,7 @@ TEST_CASE(
     first.run(203);                             // 203 = 50 x 4 + 3
     const Frame mid = first.frame();
     Engine resumed(c, mid, /*allow_contacts=*/true);
-    resumed.restore(mid, first.forces(), first.observables().collisions, first.extraState());
+    resumed.restore(mid, first.forces(), first.observables().collisions, first.engineState());
     resumed.run(200);
     const Frame a = one.frame(), b = resumed.frame();
     CHECK(a.x == b.x);
@@ -370,7 +370,7 @@ TEST_CASE(
     CHECK(worst < 4e-4);
   }
   // (b) a restart continues bit for bit, also after the interval has changed (the interval in
-  // force and the one before it travel with the checkpoint: Engine::extraState)
+  // force and the one before it travel with the checkpoint: Engine::engineState)
   {
     MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
     c.charging.mode = "exchange";
@@ -387,7 +387,7 @@ TEST_CASE(
     const int k_mid = first.slowInterval();
     const Frame mid = first.frame();
     Engine resumed(c, mid, /*allow_contacts=*/true);
-    resumed.restore(mid, first.forces(), first.observables().collisions, first.extraState());
+    resumed.restore(mid, first.forces(), first.observables().collisions, first.engineState());
     CHECK(resumed.slowInterval() == k_mid);
     resumed.run(500);
     INFO("interval at the restart " << k_mid << " (base " << first.coulombSetup()->every
@@ -402,7 +402,7 @@ TEST_CASE(
 
 TEST_CASE("a restart keeps the split it was written with, whatever \"auto\" means now",
           "[md][coulomb]") {
-  // The checkpoint records the resolved r_fast and every_max (Engine::extraState); one without
+  // The checkpoint records the resolved r_fast and every_max (Engine::engineState); one without
   // them was written when "auto" meant r_fast = 3.5 d and every_max = 4 x every, and continues
   // with that (since issue 15's session 14 "auto" is 16 x every).
   MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
@@ -422,8 +422,8 @@ TEST_CASE("a restart keeps the split it was written with, whatever \"auto\" mean
     resumed.run(40);
     CHECK(first.frame().x == resumed.frame().x);  // and so it continues bit for bit
   }
-  ck.extra.real_scalars.erase("coulomb_r_fast");
-  ck.extra.int_scalars.erase("coulomb_every_max");
+  ck.engine.reals.erase("coulomb_r_fast");
+  ck.engine.ints.erase("coulomb_every_max");
   Engine legacy(automatic, ck);
   CHECK(legacy.coulombSetup()->r_fast == 3.5);
   CHECK(legacy.coulombSetup()->every_max == 4 * legacy.coulombSetup()->every);

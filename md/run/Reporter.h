@@ -1,0 +1,32 @@
+#pragma once
+/// \file Reporter.h
+/// What looks at a run between chunks of steps (OpenMM's reporters are the model): the run's own
+/// outputs (md/run/OutputReporters.h: trajectory, checkpoints), the progress line
+/// (md/run/RunLog.h), a collision log (md/lammps/CollisionLog.h), a user's callback.
+#include <cstdint>
+#include <limits>
+
+namespace granagg::md {
+
+class Simulation;
+
+/// Called by md::Simulation::run() after each chunk of steps, in order: the trajectory, the
+/// checkpoints, then the reporters added with Simulation::addReporter. A reporter never changes
+/// the physics of the run; under MPI every rank holds the same reporters and calls them in the
+/// same order, so that their collective engine calls match.
+class Reporter {
+ public:
+  virtual ~Reporter() = default;
+  /// The step at which this reporter next wants to be called; the run then stops there. The
+  /// default has no wish: report() is still called after every chunk (at most
+  /// output.observable_interval steps).
+  virtual std::int64_t nextStep(const Simulation&) const {
+    return std::numeric_limits<std::int64_t>::max();
+  }
+  /// Called after each chunk of steps, with the engine at the chunk's end.
+  virtual void report(const Simulation& sim) = 0;
+  /// Called once when run() ends (normally or not).
+  virtual void finish(const Simulation&) {}
+};
+
+}  // namespace granagg::md
