@@ -144,18 +144,20 @@ void FixCharging::init() {
   if (any_bad)
     error->all(FLERR, me + " needs unit spheres of unit mass (diameter 1, mass 1: set group all "
                            "mass 1.0)");
-  // Between runs (whichflag 0), LAMMPS's write_restart (and write_data) call init() and then
-  // move atoms between ranks and within the arrays (pbc, exchange), which atom->f does not
-  // follow. The forces of the state are kept now in the array that migrates with the atoms: the
-  // restart file takes them from there (pack_restart), and the next run's setup puts them back
-  // (setup()). Not before the first run (no forces yet), nor over forces read from a restart
-  // file that no run has restored yet.
-  if (update->whichflag == 0 && update->first_update && !m_restore_forces) {
-    double** f = atom->f;
-    for (int i = 0; i < atom->nlocal; ++i)
-      for (int k = 0; k < 3; ++k) m_frestart[i][k] = f[i][k];
-    m_restore_forces = true;
-  }
+  // Between runs (whichflag 0), LAMMPS's write_data (and write_restart without noinit) call
+  // init() and then move atoms between ranks and within the arrays (pbc, exchange), which
+  // atom->f does not follow: the forces are kept in the array that migrates with the atoms.
+  if (update->whichflag == 0) keepForcesForRestart();
+}
+
+void FixCharging::keepForcesForRestart() {
+  // Not before the first run (no forces yet), nor over forces read from a restart file that no
+  // run has restored yet.
+  if (!update->first_update || m_restore_forces) return;
+  double** f = atom->f;
+  for (int i = 0; i < atom->nlocal; ++i)
+    for (int k = 0; k < 3; ++k) m_frestart[i][k] = f[i][k];
+  m_restore_forces = true;
 }
 
 void FixCharging::setup(int /*vflag*/) {

@@ -124,6 +124,10 @@ class FixCharging : public LAMMPS_NS::Fix {
   void clearCollisionRecords() { m_records.clear(); }
   const ChargeExchange::Params& params() const { return m_params; }
   bool exchanges() const { return m_exchange; }
+  /// Between runs, before `write_restart ... noinit`: keeps the forces of the state in the
+  /// per-atom array that the restart file stores (pack_restart) and the next run's setup puts
+  /// back (setup()).
+  void keepForcesForRestart();
 
  private:
   ChargeExchange::Params m_params;

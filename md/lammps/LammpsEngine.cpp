@@ -464,10 +464,17 @@ void LammpsEngine::saveCheckpoint(const fs::path& /*folder: the constructor's*/,
   const std::int64_t now = step();
   const std::string name = "checkpoint-" + std::to_string(now) + ".restart";
   const fs::path partial = m_folder / (name + ".partial");
-  m_lmp->input->one("write_restart " + partial.string());  // rank 0 writes the file
-  // write_restart moved atoms between ranks: the next run starts with LAMMPS's setup, in which
-  // the fix puts the forces of this state back (FixCharging.h)
+  // write_restart without noinit runs its own init() and setup_pre_exchange(), in which fix
+  // neigh/history rebuilds its per-atom contact history from a neighbour list that init() has
+  // invalidated: "Neighbor history overflow", or a fault in its reverse communication, with
+  // contacts. Instead a `run 0` (LAMMPS's setup: atoms wrapped into the box and moved to their
+  // ranks, the list rebuilt, the history made per atom again by fix neigh/history's post_run)
+  // brings the state into the form a restart file needs, and write_restart then writes it as
+  // it is. atom->f does not follow the atoms there: the fix keeps the state's forces in its
+  // migrating per-atom array first and puts them back in setup (FixCharging.h).
+  m_fix->keepForcesForRestart();
   m_lmp->input->one("run 0 post no");
+  m_lmp->input->one("write_restart " + partial.string() + " noinit");  // rank 0 writes it
   onRankZero(m_rank, m_comm, [&] {
     syncToDisk(partial);
     fs::rename(partial, m_folder / name);

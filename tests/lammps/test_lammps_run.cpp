@@ -393,9 +393,9 @@ std::string chargedGas(const fs::path& dir, int checkpoint_interval) {
 }  // namespace
 
 TEST_CASE("granagg-lammps checkpoints change its run only by rounding", "[lammps][mpi]") {
-  // write_restart moves atoms between ranks, and atom->f does not follow them; the run goes on
-  // from LAMMPS's setup, where fix granagg/charging puts the forces of the state back (kept in
-  // its migrating per-atom array). Recomputed there instead, they carry the full-step velocity
+  // After a checkpoint the run goes on from LAMMPS's setup, which moves atoms between ranks, and
+  // atom->f does not follow them; fix granagg/charging puts the forces of the state back there
+  // (kept in its migrating per-atom array). Recomputed there instead, they carry the full-step velocity
   // in the granular damping, and written from atom->f they belong to other atoms: without the
   // kept forces the runs below differ by 8 % in v, with them by 1e-14.
   const fs::path dir = test::tempDir("lammps_checkpoints");
@@ -420,6 +420,32 @@ TEST_CASE("granagg-lammps checkpoints change its run only by rounding", "[lammps
         observable(dir / "plain", "collisions").value.back());
   CHECK(fs::exists(dir / "often" / "checkpoint-300.restart"));
   CHECK(!fs::exists(dir / "often" / "checkpoint-294.restart"));  // the older ones are removed
+}
+
+TEST_CASE("granagg-lammps checkpoints a gas in contact, from a granagg md frame, and restarts",
+          "[lammps][mpi]") {
+  // write_restart's own init() made fix neigh/history rebuild its per-atom contact history from
+  // a neighbour list that init() had invalidated: "Neighbor history overflow" (or a fault) at
+  // the first checkpoint of a run with contacts. Checkpoints are written with noinit.
+  const fs::path dir = test::tempDir("lammps_contact_checkpoint");
+  const std::string gas = " --preset paper --set system.N=1000 --set output.frames_per_decade=0";
+  const Run md = sh(std::string(GRANAGG_BINARY) + " md" + gas +
+                    " --set coulomb.K=5 --set charging.Q=0.05 --set run.t_end=1 --threads 1 -q"
+                    " --out " + (dir / "md").string());
+  INFO(md.output);
+  REQUIRE(md.status == 0);
+  REQUIRE(observable(dir / "md", "contacts_per_particle").value.back() > 0.05);
+  const std::string from = " --set system.initial=" + (dir / "md" / "traj.h5").string();
+  const Run first = lammpsRun(2, gas + from + " --set run.t_end=0.2 --set "
+                                   "output.checkpoint_interval=20 -q --out " +
+                                   (dir / "o").string());
+  INFO(first.output);
+  REQUIRE(first.status == 0);
+  CHECK(fs::exists(dir / "o" / "checkpoint.toml"));
+  const Run more = lammpsRun(2, "--restart " + (dir / "o").string() + " --set run.t_end=0.4 -q");
+  INFO(more.output);
+  REQUIRE(more.status == 0);
+  CHECK(lastFrame(dir / "o").time == Approx(0.4).margin(0.004));  // (the whole step nearest)
 }
 
 TEST_CASE("granagg-lammps stops on SIGTERM to one rank with a checkpoint, refuses a second "
