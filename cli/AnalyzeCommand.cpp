@@ -90,6 +90,11 @@ void registerAnalyzeCommand(CLI::App& app, const CliContext& ctx) {
   c->add_option("--tolerance", a->s.tolerance,
                 "Particle clusters: bonded when |r_ij| <= 1 + tolerance (default 0.05)");
   c->add_flag("--no-particle", a->s.no_particle, "Skip particle clusters and N_stick");
+  c->add_flag("--no-structure-factor", a->s.no_structure,
+              "Skip the structure factor S(k) (S_k.csv) and the density length l_density");
+  c->add_option("--structure-kcut", a->s.structure_k_cut,
+                "k_c in 1/d of the density length l = 2 pi / k_1, k_1 the first moment of S(k) "
+                "over k <= k_c (default pi)");
   c->add_option("--slope-ratio", a->s.slope_ratio,
                 "p of the local slope z(t) = ln[S(t)/S(t/p)]/ln p (default 2)");
   c->add_option("--fit-window", a->s.fit_window,

@@ -16,6 +16,13 @@ ClusterSizes ClusterSizes::fromSizes(const std::vector<std::uint64_t>& sizes) {
     if (s > c.largest) c.largest = s;
   }
   c.S = c.mass > 0 ? static_cast<double>(m2 / static_cast<long double>(c.mass)) : std::nan("");
+  const long double big = static_cast<long double>(c.largest);
+  c.S_without_largest =
+      c.clusters >= 2
+          ? static_cast<double>((m2 - big * big) / (static_cast<long double>(c.mass) - big))
+          : std::nan("");
+  c.largest_share =
+      c.mass > 0 ? static_cast<double>(big / static_cast<long double>(c.mass)) : std::nan("");
   return c;
 }
 

@@ -42,6 +42,11 @@ AnalysisOptions analysisOptions(const AnalyzeSettings& a, bool write_grid) {
   if (write_grid && a.no_grid)
     throw std::invalid_argument("--write-grid needs grid clusters (drop --no-grid).");
   o.particle.tolerance = a.tolerance;
+  o.structure_factor = !a.no_structure;
+  if (!(a.structure_k_cut > 0.0) || !std::isfinite(a.structure_k_cut))
+    throw std::invalid_argument("--structure-kcut must be > 0 and finite (got " +
+                                common::formatReal(a.structure_k_cut) + ")");
+  o.structure.k_cut = a.structure_k_cut;
   o.slope_ratio = a.slope_ratio;
   if (!a.fit_window.empty()) {
     if (a.fit_window.size() != 2)

@@ -16,6 +16,8 @@ namespace granagg::analysis {
 struct AnalyzeSettings {
   bool allow_partial = false;
   bool no_grid = false, no_particle = false;
+  bool no_structure = false;        ///< --no-structure-factor
+  double structure_k_cut = 3.14159265358979323846;  ///< --structure-kcut (k_c of l, 1/d)
   double grid_spacing = 2.0, grid_min_fill = 0.25;
   int grid_min_count = 0;
   std::string grid_assign = "ngp";

@@ -248,10 +248,20 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       "in particles); "
       "clusters = number of clusters; largest = largest s; occupied_fraction = occupied grid sites "
       "/ all sites; "
-      "mean_contacts = partners within 1 + tolerance per particle; z_local = ln[S(t)/S(t/p)]/ln p",
+      "mean_contacts = partners within 1 + tolerance per particle; z_local = ln[S(t)/S(t/p)]/ln p; "
+      "S_*_without_largest = (sum s^2 N_s - s_max^2) / (sum s N_s - s_max); largest_share_* = "
+      "s_max / sum s N_s; l_density = 2 pi / k_1, k_1 the first moment of S(k) over k <= k_c "
+      "(analysis/stats/StructureFactor.h; an ideal gas gives about 4 pi / k_c)",
       {"t", "step", "S_grid", "S_particle", "clusters_grid", "clusters_particle", "largest_grid",
        "largest_particle", "occupied_fraction", "mean_contacts", "z_local_grid",
-       "z_local_particle"});
+       "z_local_particle", "S_grid_without_largest", "S_particle_without_largest",
+       "largest_share_grid", "largest_share_particle", "l_density"});
+  Table S_k("S_k",
+            "t: time; k: shell centre m 2 pi / L [1/d]; S_k: static structure factor "
+            "<|sum_j exp(-i k.r_j)|^2>/N over the shell (CIC mesh, FFTW, Jing's alias "
+            "correction: analysis/stats/StructureFactor.h); modes: independent wave vectors in "
+            "the shell",
+            {"t", "k", "S_k", "modes"}, 2);
   Table Ns_grid("N_s_grid",
                 "t: time; s: cluster size in grid sites; N_s: number of grid clusters of s sites",
                 {"t", "s", "N_s"}, 2);
@@ -342,6 +352,7 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
     const double t = f.time;
     t_series.push_back(t);
     double sg = NaN, sp = NaN, cg = NaN, cp = NaN, lg = NaN, lp = NaN, occ = NaN, mc = NaN;
+    double sg_rest = NaN, sp_rest = NaN, share_g = NaN, share_p = NaN, l_density = NaN;
     PowerLawMleResult fg, fp;
     std::vector<double> ls_g{NaN, NaN, NaN}, ls_p{NaN, NaN, NaN};
     if (o.grid_clusters) {
@@ -350,6 +361,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       sg = c.S;
       cg = static_cast<double>(c.clusters);
       lg = static_cast<double>(c.largest);
+      sg_rest = c.S_without_largest;
+      share_g = c.largest_share;
       occ = grid.occupiedFraction();
       for (const auto& [s, count] : c.n_s)
         Ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
@@ -363,6 +376,8 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       sp = c.S;
       cp = static_cast<double>(c.clusters);
       lp = static_cast<double>(c.largest);
+      sp_rest = c.S_without_largest;
+      share_p = c.largest_share;
       mc = 2.0 * static_cast<double>(part.bonds()) / static_cast<double>(f.size());
       for (const auto& [s, count] : c.n_s)
         Ns_part.add({t, static_cast<double>(s), static_cast<double>(count)});
@@ -379,7 +394,14 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
     }
     Sg.push_back(sg);
     Sp.push_back(sp);
-    S_t.add({t, static_cast<double>(f.step), sg, sp, cg, cp, lg, lp, occ, mc, NaN, NaN});
+    if (o.structure_factor) {
+      const StructureFactor sk = structureFactor(f, o.structure);
+      l_density = sk.length;
+      for (std::size_t m = 0; m < sk.k.size(); ++m)
+        S_k.add({t, sk.k[m], sk.S[m], static_cast<double>(sk.modes[m])});
+    }
+    S_t.add({t, static_cast<double>(f.step), sg, sp, cg, cp, lg, lp, occ, mc, NaN, NaN, sg_rest,
+             sp_rest, share_g, share_p, l_density});
     auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
     fisher.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)),
                 fv(fg, double(fg.n_tail)), fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err),
@@ -463,6 +485,7 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   r.tables.push_back(std::move(S_t));
   if (o.grid_clusters) r.tables.push_back(std::move(Ns_grid));
   if (o.particle_clusters) r.tables.push_back(std::move(Ns_part));
+  if (o.structure_factor) r.tables.push_back(std::move(S_k));
   r.tables.push_back(std::move(fisher));
   r.tables.push_back(std::move(thermo));
   if (!msd.rows.empty()) r.tables.push_back(std::move(msd));

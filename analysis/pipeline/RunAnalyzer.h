@@ -14,6 +14,7 @@
 #include "analysis/clusters/ParticleClusters.h"
 #include "analysis/io/Frame.h"
 #include "analysis/pipeline/Table.h"
+#include "analysis/stats/StructureFactor.h"
 
 namespace granagg::analysis {
 
@@ -23,6 +24,9 @@ struct AnalysisOptions {
   ParticleClustersParams particle;  ///< particle clusters: |r_ij| <= 1.05
   bool grid_clusters = true;        ///< compute grid clusters
   bool particle_clusters = true;    ///< compute particle clusters (and N_stick)
+  /// S(k) per frame (table S_k) and the density field's length l (S_t's l_density column)
+  bool structure_factor = true;
+  StructureFactorOptions structure;  ///< its mesh and the cut-off k_c of l
   double slope_ratio = 2.0;         ///< p of the local slope z(t) = ln[S(t)/S(t/p)] / ln p
   double fit_t_min = 0.0;  ///< growth-exponent window; 0 and 0: the last decade [t_last/10, t_last]
   double fit_t_max = 0.0;

@@ -1,0 +1,60 @@
+#pragma once
+/// \file StructureFactor.h
+/// The static structure factor S(k) of the particle positions and the characteristic length of
+/// the density field derived from it: a measure of clustering that needs no grid of occupied
+/// sites and no contact criterion, as studies of clustering in freely cooling granular gases use
+/// (Goldhirsch & Zanetti, PRL 70, 1619 (1993); Brito & Ernst, Europhys. Lett. 43, 497 (1998);
+/// Das & Puri, PRE 68, 011302 (2003); Paul & Das, PRE 96, 012105 (2017)). docs/model.md
+/// section 10 gives the definitions.
+///
+///     S(k) = < |rho_k|^2 > / N,   rho_k = sum_j exp(-i k . r_j),   k = (2 pi / L) n, n != 0
+///
+/// averaged over the wave vectors of a spherical shell |k| in [k_m - dk/2, k_m + dk/2), dk =
+/// 2 pi / L, k_m = m dk. An ideal gas has S(k) = 1 at every k != 0; clusters raise S at small k.
+///
+/// Method. The positions are assigned to an M^3 mesh by cloud-in-cell (CIC) and transformed with
+/// FFTW (real to complex). The mesh's |rho_k|^2 is divided by the CIC window's aliased sum for
+/// uncorrelated particles, C(k) = prod_a [1 - (2/3) sin^2(k_a h / 2)] (Jing, ApJ 620, 559 (2005),
+/// eq. 20, p = 2), so that an ideal gas gives S = 1 exactly in expectation at every k below the
+/// mesh's Nyquist wavenumber; for correlated positions the correction is exact to O((k h)^2)
+/// relative. The mesh spacing is h = L / M <= h_max (default 1/2 d), so that the cut-off
+/// k_c = pi / d of the length below lies at half the Nyquist wavenumber pi / h or lower.
+///
+/// Characteristic length. The first moment of S over the shells up to the cut-off k_c,
+///
+///     k_1 = sum_{k_m <= k_c} k_m S(k_m) / sum_{k_m <= k_c} S(k_m),   l = 2 pi / k_1,
+///
+/// (Das & Puri 2003, their eq. 8, with shells weighted equally). An ideal gas, S = 1, gives the
+/// baseline l_0 = 2 pi / mean(k_m) ~ 4 pi / k_c = 4 d at k_c = pi; clusters larger than that
+/// raise l towards the box size. The first zero of the density correlation function C(r) was
+/// the alternative; it has no value for an unclustered gas (C is noise around zero from the
+/// first bin on), where the first moment has its stated baseline, so the first moment is used.
+#include <cstddef>
+#include <vector>
+
+#include "analysis/io/Frame.h"
+
+namespace granagg::analysis {
+
+struct StructureFactorOptions {
+  double h_max = 0.5;         ///< largest mesh spacing [d]
+  double k_cut = 3.14159265358979323846;  ///< k_c of the first moment [1/d]
+  std::size_t max_mesh = 512;  ///< largest M (memory: ~12 M^3 bytes); h may then exceed h_max
+};
+
+/// S(k) in spherical shells, and l.
+struct StructureFactor {
+  std::vector<double> k;      ///< shell centres k_m = m 2 pi / L, m = 1 .. (shells below Nyquist)
+  std::vector<double> S;      ///< S(k_m), the mean over the shell's independent wave vectors
+  std::vector<std::size_t> modes;  ///< independent wave vectors in the shell (one of each +-k)
+  std::size_t mesh = 0;       ///< M
+  double k_cut = 0.0;         ///< k_c used (at most the largest shell centre)
+  double k1 = 0.0;            ///< first moment over k_m <= k_c (NaN when no shell: L < 2 pi / k_c)
+  double length = 0.0;        ///< l = 2 pi / k_1
+};
+
+/// S(k) and l of the positions of `frame` (wrapped into [0, L)). Throws std::invalid_argument for
+/// an empty frame or bad options.
+StructureFactor structureFactor(const Frame& frame, const StructureFactorOptions& options = {});
+
+}  // namespace granagg::analysis
