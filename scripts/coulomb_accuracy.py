@@ -31,6 +31,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ensemble_welch as ew  # noqa: E402
 from ensemble_welch import OBSERVABLES, ensemble_stats  # noqa: E402
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TIMES = (50.0, 100.0, 150.0)
 SETS = ("ref", "default", "fast", "follow", "fastfollow", "rfast25", "rfast20", "rfast20cap32",
         "rfast20cap64")
@@ -134,7 +135,9 @@ def main():
                 "(accuracy 1e-5, every 1); Welch's t test per observable and time\n")
         f.write("# runs: " + ", ".join(f"{s} {nruns[s]}" for s in data) + "\n")
         if ref_csv:
-            f.write(f"# reference statistics (means, sd, runs) from {ref_csv}\n")
+            # relative to the repository: the line must not name the machine's folders
+            src = os.path.abspath(ref_csv).replace(ROOT + os.sep, "")
+            f.write(f"# reference statistics (means, sd, runs) from {src}\n")
         f.write("setting,observable,t,mean,ref_mean,sd,ref_sd,rel_diff,rel_detectable,t_stat,p\n")
         for r in rows:
             f.write("%s,%s,%g,%.6g,%.6g,%.4g,%.4g,%.4g,%.4g,%.3f,%.4g\n" % r)

@@ -38,6 +38,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from granagg_tables import col, load_json, meta, read  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
 PAPER = load_json(os.path.join(HERE, "..", "data", "reference", "paper.json"))
 
 # part folder -> (label, colour)
@@ -51,6 +52,12 @@ PARTS = [
     ("charged-K5-Q0.1", "K = 5, Q = 0.1", "C5"),
 ]
 FISHER_TIMES = [50.0, 100.0, 150.0]
+
+
+def repo_relative(text):
+    """A path or a command line with the paths inside the repository written relative to its
+    root: the provenance lines of the committed tables must not name the machine's folders."""
+    return text.replace(ROOT + os.sep, "")
 
 
 def fmt(x, p=3):
@@ -168,9 +175,9 @@ def main():
                             "largest_grid_mean", "mean_contacts_mean")
                 if col(S, c) is not None]
         with open(os.path.join(rep, f"S_{p.name}.csv"), "w") as fo:
-            fo.write(f"# ensemble S(t) of {p.label} ({runs} runs), "
-                     f"from {p.path('analysis', 'S_t.csv')}\n")
-            fo.write(f"# command = {md.get('command', '?')}\n")
+            src = repo_relative(os.path.abspath(p.path("analysis", "S_t.csv")))
+            fo.write(f"# ensemble S(t) of {p.label} ({runs} runs), from {src}\n")
+            fo.write(f"# command = {repo_relative(md.get('command', '?'))}\n")
             fo.write(",".join(keep) + "\n")
             for k in range(len(S)):
                 fo.write(",".join(f"{S[c][k]:.6g}" for c in keep) + "\n")
