@@ -731,17 +731,21 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_
                      f"LS: {ls}; MLE: {ml} | "
                      f"see text | printed as -tau; LS = least squares on log-binned N_s "
                      f"(the paper's method) |")
-        for v in vals:
-            if v:
-                csv_rows.append(dict(quantity_id=3, 
-                                     K=by.get(part, {}).get("K", float("nan")),
-                                     N=by.get(part, {}).get("N", float("nan")),
-                                     runs=by.get(part, {}).get("runs", 0),
-                                     t_end=v["t"], t0=v["t"], t1=v["t"], value=-v["tau_ls_grid"],
-                                     low=-v["tau_ls_grid"] - 1.96 * v["tau_ls_grid_err"],
-                                     high=-v["tau_ls_grid"] + 1.96 * v["tau_ls_grid_err"],
-                                     onset=float("nan"),
-                                     growth_factor=float("nan"), paper=pv["t50"], zloc_min=float("nan"), zloc_max=float("nan")))
+        e = by.get(part, {})
+        for t, v in zip((50, 100, 150), vals):
+            if not v:
+                continue
+            # t_end: the ensemble's last frame, as in the z rows; the frame is t0 = t1. paper: its
+            # slope at this t (paper.json has t = 50 and 150; nan at t = 100)
+            csv_rows.append(dict(quantity_id=3, K=e.get("K", float("nan")),
+                                 N=e.get("N", float("nan")), runs=e.get("runs", 0),
+                                 t_end=e.get("t_end", float("nan")), t0=v["t"], t1=v["t"],
+                                 value=-v["tau_ls_grid"],
+                                 low=-v["tau_ls_grid"] - 1.96 * v["tau_ls_grid_err"],
+                                 high=-v["tau_ls_grid"] + 1.96 * v["tau_ls_grid_err"],
+                                 onset=float("nan"), growth_factor=float("nan"),
+                                 paper=pv.get(f"t{t}", float("nan")),
+                                 zloc_min=float("nan"), zloc_max=float("nan")))
     # charging exponent
     ce = PAPER["charging_rate_exponent"]
     for part in ("charged-K5", "charged-K1", "charged-K0.25", "neutral"):
@@ -806,7 +810,8 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_
               "# validation study verdict numbers (scripts/validation_report.py; "
               "docs/validation.md); quantity_id 1 = the headline z of an ensemble "
               "(granagg pair prints it beside a demo), 2 = other windows of z, 3 = Fisher slopes "
-              "(-tau, log-binned least squares, at t = t0); numeric columns only "
+              "(-tau, log-binned least squares, at the frame t0 = t1; paper: the paper's slope "
+              "at that t, nan where it prints none); numeric columns only "
               "(granagg's common::readCsv reads it)")
 
 
