@@ -54,4 +54,6 @@ std::string printfString(const char* fmt, ...) {
   return out;
 }
 
+std::string formatShort(double x) { return printfString("%.4g", x); }
+
 }  // namespace granagg::common

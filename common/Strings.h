@@ -12,4 +12,7 @@ std::string join(const std::vector<std::string>& parts, const std::string& sep);
 bool parseReal(const std::string& s, double& out);
 /// printf into a std::string, of any length (the compiler checks the arguments against fmt).
 std::string printfString(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+/// A number for people: 4 significant digits ("%.4g"; formatReal's round-trip digits are for
+/// tables and for input values echoed in errors).
+std::string formatShort(double x);
 }  // namespace granagg::common

@@ -92,18 +92,8 @@ void GridClusters::compute(const double* pos, std::size_t np, double L) {
           if (m_occupied[o])
             m_uf.unite(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(o));
       }
-  m_labels.assign(cells, -1);
-  std::vector<std::int32_t> label_of_root(cells, -1);
-  std::vector<std::uint64_t> sizes;
-  for (std::size_t c = 0; c < cells; ++c) {
-    if (!m_occupied[c]) continue;
-    const std::uint32_t r = m_uf.find(static_cast<std::uint32_t>(c));
-    if (label_of_root[r] < 0) {
-      label_of_root[r] = static_cast<std::int32_t>(sizes.size());
-      sizes.push_back(m_uf.rootSize(r));
-    }
-    m_labels[c] = label_of_root[r];
-  }
+  const std::vector<std::uint64_t> sizes =
+      m_uf.label(m_labels, [this](std::size_t c) { return m_occupied[c] != 0; });
   m_result = ClusterSizes::fromSizes(sizes);
   m_computed = true;
 }

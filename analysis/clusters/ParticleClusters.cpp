@@ -130,17 +130,7 @@ void ParticleClusters::compute(const double* pos, std::size_t np, double L) {
     ++m_contacts[j];
   }
   m_bonds = pairs.size();
-  m_labels.assign(np, -1);
-  std::vector<std::int32_t> label_of_root(np, -1);
-  std::vector<std::uint64_t> sizes;
-  for (std::size_t i = 0; i < np; ++i) {
-    const std::uint32_t r = m_uf.find(static_cast<std::uint32_t>(i));
-    if (label_of_root[r] < 0) {
-      label_of_root[r] = static_cast<std::int32_t>(sizes.size());
-      sizes.push_back(m_uf.rootSize(r));
-    }
-    m_labels[i] = label_of_root[r];
-  }
+  const std::vector<std::uint64_t> sizes = m_uf.label(m_labels, [](std::size_t) { return true; });
   m_result = ClusterSizes::fromSizes(sizes);
   m_computed = true;
 }

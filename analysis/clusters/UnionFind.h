@@ -36,6 +36,25 @@ class UnionFind {
   }
   /// Size of the set whose root is r.
   std::uint32_t rootSize(std::uint32_t r) const { return m_size[r]; }
+  /// Numbers the sets of the elements i with member(i): labels[i] = 0, 1, ... in the order of
+  /// each set's first element (-1 for the others). Returns the size of each labelled set.
+  template <class Member>
+  std::vector<std::uint64_t> label(std::vector<std::int32_t>& labels, Member member) {
+    const std::size_t n = m_parent.size();
+    labels.assign(n, -1);
+    std::vector<std::int32_t> label_of_root(n, -1);
+    std::vector<std::uint64_t> sizes;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!member(i)) continue;
+      const std::uint32_t r = find(static_cast<std::uint32_t>(i));
+      if (label_of_root[r] < 0) {
+        label_of_root[r] = static_cast<std::int32_t>(sizes.size());
+        sizes.push_back(m_size[r]);
+      }
+      labels[i] = label_of_root[r];
+    }
+    return sizes;
+  }
   std::size_t size() const { return m_parent.size(); }
 
  private:

@@ -21,6 +21,7 @@
 #include <variant>
 
 #include "common/Csv.h"
+#include "common/Strings.h"
 #include "md/potentials/ContactModels.h"
 
 namespace granagg::md {
@@ -408,21 +409,14 @@ void readTable(const toml::table& root, const std::string& source_name, MdConfig
   throw ConfigError(message, issues.size() == 1 ? issues.front().key : "");
 }
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
 // Applies one "section.key=value" override.
 void applyOverride(const std::string& raw, MdConfig& config,
                    std::map<std::string, std::string>& origin) {
   const std::string prefix = "--set " + raw + ": ";
   const auto eq = raw.find('=');
   if (eq == std::string::npos) throw ConfigError(prefix + "expected section.key=value", "");
-  const std::string full = trim(raw.substr(0, eq));
-  const std::string text = trim(raw.substr(eq + 1));
+  const std::string full = common::trim(raw.substr(0, eq));
+  const std::string text = common::trim(raw.substr(eq + 1));
   if (text.find_first_of("\r\n") != std::string::npos)
     throw ConfigError(prefix + "the value must be on one line", full);
   const auto dot = full.find('.');

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/Strings.h"
 #include "md/engine/Engine.h"
 
 namespace granagg::md {
@@ -18,13 +19,6 @@ namespace {
 // 1e-12) would overflow the step counter or hang in building the frame schedule.
 constexpr double MAX_STEPS = 1e12;  // ~30 years at 1e3 steps/s
 constexpr double MAX_FRAMES = 1e6;  // ~a petabyte at N = 50016
-
-/// A number for an error message: four significant digits.
-std::string people(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", x);
-  return b;
-}
 
 /// Memory a run needs per particle, at least: the peak resident memory of `granagg md` (CPU
 /// build) grows by 616 B per particle neutral and by about 2.6 kB with Coulomb forces at K = 5
@@ -59,9 +53,9 @@ void checkMemory(const MdConfig& c) {
   if (need > machine)
     throw std::invalid_argument(
         "system.N = " + std::to_string(c.system.N) + " needs about " + gigabytes(need) +
-        " of memory (at least " + people(per_particle) + " bytes per particle for the engine's " +
+        " of memory (at least " + common::formatShort(per_particle) + " bytes per particle for the engine's " +
         what + "), more than this machine's " + gigabytes(machine) +
-        ": lower system.N (to at most " + people(std::floor(machine / per_particle)) + " here)");
+        ": lower system.N (to at most " + common::formatShort(std::floor(machine / per_particle)) + " here)");
 }
 
 }  // namespace
@@ -70,13 +64,13 @@ void checkSchedule(const MdConfig& c) {
   std::string why;
   const double dt = Engine::chooseTimeStep(c, &why);
   if (!(dt > 0.0) || !std::isfinite(dt))
-    throw std::invalid_argument("integrator.dt: the time step is " + people(dt) + " (" + why +
+    throw std::invalid_argument("integrator.dt: the time step is " + common::formatShort(dt) + " (" + why +
                                 "): it must be positive and finite; check contact.* or give "
                                 "integrator.dt");
   const double steps = c.run.t_end / dt;
   if (!(steps <= MAX_STEPS))
-    throw std::invalid_argument("run.t_end = " + people(c.run.t_end) + " at dt = " + people(dt) +
-                                " is " + people(steps) + " steps, more than 1e12: lower run.t_end");
+    throw std::invalid_argument("run.t_end = " + common::formatShort(c.run.t_end) + " at dt = " + common::formatShort(dt) +
+                                " is " + common::formatShort(steps) + " steps, more than 1e12: lower run.t_end");
   double frames = 0.0;
   if (c.output.frames_per_decade > 0) {
     const double t0 = std::max(0.01, dt);
@@ -86,8 +80,8 @@ void checkSchedule(const MdConfig& c) {
   if (!(frames <= MAX_FRAMES))
     throw std::invalid_argument(
         "output.frames_per_decade = " + std::to_string(c.output.frames_per_decade) +
-        " and output.frame_interval = " + people(c.output.frame_interval) + " ask for " +
-        people(std::round(frames)) + " frames up to run.t_end = " + people(c.run.t_end) +
+        " and output.frame_interval = " + common::formatShort(c.output.frame_interval) + " ask for " +
+        common::formatShort(std::round(frames)) + " frames up to run.t_end = " + common::formatShort(c.run.t_end) +
         ", more than 1e6: space them further apart");
   checkMemory(c);
 }

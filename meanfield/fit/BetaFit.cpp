@@ -13,6 +13,7 @@
 
 #include "common/Csv.h"
 #include "common/Statistics.h"
+#include "common/Strings.h"
 #include "meanfield/kernels/Kernel.h"
 #include "meanfield/solvers/SectionalSolver.h"
 #include "meanfield/solvers/SmolResult.h"
@@ -22,14 +23,6 @@ namespace granagg::meanfield {
 using common::formatReal;
 
 namespace {
-
-/// A measured number in a note for people: 4 significant digits (formatReal's round-trip digits
-/// are for tables, and for input values echoed in errors).
-std::string rounded(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", x);
-  return buf;
-}
 
 constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -292,8 +285,8 @@ ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window,
     f.points = static_cast<int>(idx.size());
     f.confidence = o.confidence;
     f.interval_method = "none";
-    f.note = "S is " + rounded(f.S0) + " at every sample of the window [" + rounded(f.t0) +
-             ", " + rounded(f.t1) + "]: it does not grow, no growth exponent.";
+    f.note = "S is " + common::formatShort(f.S0) + " at every sample of the window [" + common::formatShort(f.t0) +
+             ", " + common::formatShort(f.t1) + "]: it does not grow, no growth exponent.";
     return f;
   }
   double c0, se;
@@ -510,8 +503,8 @@ BetaFromZ betaAsymptotic(double z, double z_low, double z_high) {
     out.beta = out.beta_low = out.beta_high = NaN;
     out.note =
         std::isfinite(z)
-            ? (z <= 0.0 ? "z = " + rounded(z) + " <= 0: S does not grow, no beta."
-                        : "z = " + rounded(z) +
+            ? (z <= 0.0 ? "z = " + common::formatShort(z) + " <= 0: S does not grow, no beta."
+                        : "z = " + common::formatShort(z) +
                               " >= 3: faster than 3 beta/(beta + 3) for every beta, no beta.")
             : "z is not finite: no beta.";
     return out;
@@ -520,9 +513,9 @@ BetaFromZ betaAsymptotic(double z, double z_low, double z_high) {
   out.beta_low = beta(z_low);
   out.beta_high = beta(z_high);
   if (std::isfinite(z_high) && z_high >= 3.0)
-    out.note += "z_high = " + rounded(z_high) + " >= 3: no upper bound on beta. ";
+    out.note += "z_high = " + common::formatShort(z_high) + " >= 3: no upper bound on beta. ";
   if (std::isfinite(z_low) && z_low <= 0.0)
-    out.note += "z_low = " + rounded(z_low) + " <= 0: the interval reaches beta = 0. ";
+    out.note += "z_low = " + common::formatShort(z_low) + " <= 0: the interval reaches beta = 0. ";
   if (!out.note.empty()) out.note.pop_back();
   return out;
 }
@@ -534,7 +527,7 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
   std::string note;
   const double S_floor = 1.0001;
   if (S0 < S_floor) {
-    note += "window starts at S = " + rounded(S0) +
+    note += "window starts at S = " + common::formatShort(S0) +
             " <= 1, the mean field's initial S; compared from S = 1.0001. ";
     S0 = S_floor;
   }
@@ -559,8 +552,8 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
     if (!std::isfinite(zt)) return NaN;
     if (zt <= out.z_at_beta_min || zt >= out.z_at_beta_max) {
       const bool below = zt <= out.z_at_beta_min;
-      note += std::string(what) + " = " + rounded(zt) + " lies " + (below ? "below" : "above") +
-              " the mean-field z = " + rounded(below ? out.z_at_beta_min : out.z_at_beta_max) +
+      note += std::string(what) + " = " + common::formatShort(zt) + " lies " + (below ? "below" : "above") +
+              " the mean-field z = " + common::formatShort(below ? out.z_at_beta_min : out.z_at_beta_max) +
               " at beta = " + formatReal(below ? beta_min : beta_max) +
               (central ? ": no beta" : ": clamped to the range") + ". ";
       return central ? NaN : (below ? beta_min : beta_max);

@@ -31,7 +31,7 @@ nlohmann::ordered_json num(double x) {
 /// "v [lo, hi]" to 4 digits; "v" alone without an interval; "n/a" without a value.
 std::string interval(double v, double lo, double hi) {
   if (!std::isfinite(v)) return "n/a";
-  if (!std::isfinite(lo) && !std::isfinite(hi)) return common::printfString("%.4g", v);
+  if (!std::isfinite(lo) && !std::isfinite(hi)) return common::formatShort(v);
   return common::printfString("%.4g [%.4g, %.4g]", v, lo, hi);
 }
 

@@ -1,8 +1,11 @@
 #pragma once
 // Charge configurations shared by the Coulomb tests (test_ewald.cpp, test_pppm.cpp): ionic
-// crystals with nearest-neighbour distance 1, whose Madelung constants are published.
+// crystals with nearest-neighbour distance 1, whose Madelung constants are published; and the
+// rms force difference the accuracy tests compare with.
 #include <cmath>
 #include <vector>
+
+#include "md/coulomb/Ewald.h"
 
 namespace granagg::md::testing {
 
@@ -47,6 +50,16 @@ inline Charges cscl(int cells) {
         c.add((i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a, -1.0);
       }
   return c;
+}
+
+/// The rms over particles of |F_a - F_b|.
+inline double rmsDifference(const CoulombResult& a, const CoulombResult& b) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < a.fx.size(); ++i) {
+    const double dx = a.fx[i] - b.fx[i], dy = a.fy[i] - b.fy[i], dz = a.fz[i] - b.fz[i];
+    s += dx * dx + dy * dy + dz * dz;
+  }
+  return std::sqrt(s / static_cast<double>(a.fx.size()));
 }
 
 }  // namespace granagg::md::testing

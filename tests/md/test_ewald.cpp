@@ -16,6 +16,7 @@
 #include "md/coulomb/RealSpace.h"
 
 using namespace granagg::md;
+using granagg::md::testing::rmsDifference;
 using granagg::md::testing::Charges;
 using granagg::md::testing::cscl;
 using granagg::md::testing::nacl;
@@ -34,15 +35,6 @@ Charges randomCharges(int n, double L, bool neutral, unsigned seed) {
 CoulombResult ewald(const Charges& c, double accuracy, double r_cut = 0.0, double K = 1.0) {
   const EwaldParams p = chooseEwaldParams(accuracy, c.x.size(), c.L, c.sumQ2(), r_cut);
   return EwaldReference(p, c.L, K).compute(c.x, c.y, c.z, c.q);
-}
-
-double rmsDifference(const CoulombResult& a, const CoulombResult& b) {
-  double s = 0.0;
-  for (std::size_t i = 0; i < a.fx.size(); ++i) {
-    const double dx = a.fx[i] - b.fx[i], dy = a.fy[i] - b.fy[i], dz = a.fz[i] - b.fz[i];
-    s += dx * dx + dy * dy + dz * dz;
-  }
-  return std::sqrt(s / a.fx.size());
 }
 
 constexpr double MADELUNG_NACL = 1.747564594633;

@@ -21,6 +21,7 @@
 #include "md/coulomb/Pppm.h"
 
 using namespace granagg::md;
+using granagg::md::testing::rmsDifference;
 using granagg::md::testing::Charges;
 using granagg::md::testing::cscl;
 using granagg::md::testing::nacl;
@@ -57,14 +58,6 @@ CoulombResult pppmTotal(Pppm& pppm, const Charges& c, double K) {
   return r;
 }
 
-double rmsDifference(const CoulombResult& a, const CoulombResult& b) {
-  double s = 0.0;
-  for (std::size_t i = 0; i < a.fx.size(); ++i) {
-    const double dx = a.fx[i] - b.fx[i], dy = a.fy[i] - b.fy[i], dz = a.fz[i] - b.fz[i];
-    s += dx * dx + dy * dy + dz * dz;
-  }
-  return std::sqrt(s / a.fx.size());
-}
 double rmsForce(const CoulombResult& a) {
   double s = 0.0;
   for (std::size_t i = 0; i < a.fx.size(); ++i)
