@@ -1,6 +1,6 @@
 #pragma once
 /// \file Statistics.h
-/// The statistics every module's fits share (issue 16: one implementation, one interval rule):
+/// The statistics every module's fits share (one implementation, one interval rule):
 /// ordinary least squares of a line, Student-t intervals, and the bootstrap interval over
 /// independent runs. GSL underneath (gsl_fit_linear, gsl_cdf_tdist_Pinv, gsl_stats_sd).
 ///

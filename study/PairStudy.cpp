@@ -264,9 +264,9 @@ void PairStudy::runMd(std::vector<RunJob> all) {
   std::stable_sort(todo.begin(), todo.end(),
                    [](const RunJob& a, const RunJob& b) { return a.cost > b.cost; });
 
-  // Default: two OpenMP threads per run. The engine's one-thread path is currently several times
-  // slower per core than its two-thread path (measured 2026-11-23: N = 500 neutral, 1.9e5 vs
-  // 1.2e6 particle-steps/s), so one run per core loses on a 2-core machine.
+  // Default: two OpenMP threads per run. The engine's one-thread path is several times slower
+  // per core than its two-thread path (N = 500 neutral: 1.9e5 against 1.2e6 particle-steps/s;
+  // docs/pair.md), so one run per core loses on a 2-core machine.
   // A granagg-lammps run takes lammps.ranks cores.
   const int default_jobs =
       std::max(1, m_launch.lammps() ? m_cores / m_c.lammps_ranks : m_cores / 2);

@@ -87,7 +87,7 @@ struct RunJob {
   /// record must match
   std::string spec;
   std::string
-      legacy_spec;  ///< the same with the hash of records made before 2026-12-02 (Process.h)
+      legacy_spec;  ///< the same with the legacy hash basis of older records (Process.h)
   double cost = 0;  ///< particle-steps, x100 with Coulomb: longest first
   bool restart = false;
 };

@@ -52,8 +52,8 @@ void appendText(const std::filesystem::path& p, const std::string& text);
 
 /// The FNV-1a 64-bit offset basis (Fowler, Noll, Vo; draft-eastlake-fnv).
 constexpr std::uint64_t FNV1A_BASIS = 14695981039346656037ULL;
-/// Until 2026-12-02 the basis lacked its last digit (1469598103934665603): not FNV-1a, though as
-/// good a hash. Run records made then carry it; PairStudy still accepts them (RunJob).
+/// The basis short of its last digit (1469598103934665603): not FNV-1a, though as good a hash.
+/// Older run records carry it (docs/pair.md); PairStudy still accepts them (RunJob).
 constexpr std::uint64_t LEGACY_HASH_BASIS = 1469598103934665603ULL;
 
 /// FNV-1a 64-bit hash as 16 hex digits: identifies a resolved configuration in a run's spec.

@@ -33,7 +33,7 @@ namespace granagg::md {
 struct SystemConfig {
   int N = 1000;              ///< number of particles (>= 2)
   double phi = 0.076;        ///< filling fraction N pi / (6 L^3), in (0, 0.6)
-  std::uint64_t seed = 1;    ///< seeds positions, velocities (and charging, issue 4)
+  std::uint64_t seed = 1;    ///< seeds positions, velocities and charging
   double temperature = 1.0;  ///< initial granular temperature T_g(0) (= T0 = 1 in reduced units)
   std::string initial = "random";  ///< "random", or a CSV / H5MD file with positions, velocities
   /// Deepest overlap 1 - r an initial file may hold (contacts of a running gas are physical);

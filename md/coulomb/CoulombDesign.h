@@ -31,8 +31,8 @@ struct CoulombSetup {
   int every_max = 1;
 };
 
-/// `coulomb.r_fast = "auto"`: the pair force within 2 d is fast. 2 d since issue 15: the ensemble
-/// of the paper's K = 5 gas is indistinguishable from the tight reference and the cold gas runs
+/// `coulomb.r_fast = "auto"`: the pair force within 2 d is fast. At 2 d the ensemble of the
+/// paper's K = 5 gas is indistinguishable from the tight reference and the cold gas runs
 /// 1.5x faster; energy drift 4x that of 3.5 d, 0.1 % of the cold gas's dissipation
 /// (docs/coulomb.md, docs/benchmarks-coulomb.md).
 constexpr double R_FAST_AUTO = 2.0;

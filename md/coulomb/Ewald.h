@@ -1,7 +1,7 @@
 #pragma once
 /// \file Ewald.h
 /// Plain Ewald summation of the periodic Coulomb interaction: the reference for the mesh method
-/// (docs/model.md section 4; issue 4). Host-only, double precision, written to be obviously correct
+/// (docs/model.md section 4). Host-only, double precision, written to be obviously correct
 /// rather than fast: O(N^2) real space over all images within r_cut and an explicit reciprocal sum.
 ///
 /// For N charges q_i in a periodic cube of edge L (volume V = L^3) with coupling K and tinfoil

@@ -68,14 +68,13 @@ constexpr double SLOW_INTERVAL = 0.016;
 // (64 steps at the paper preset's dt), so that in the cold gas the interval is set by the gas's
 // speeds, not by the cap: ensembles at caps 16, 32 and 64 are indistinguishable from the tight
 // reference, and the cold gas's energy drift is at most 3e-5 of E_kin per 1000 steps at each
-// (docs/benchmarks-coulomb.md, "Session 14"). 4 (16 steps) until issue 15's session 14.
+// (docs/benchmarks-coulomb.md).
 constexpr int SLOW_INTERVAL_GROWTH = 16;
-// what "auto" meant for checkpoints that do not record their every_max (written in session 9 of
-// issue 15, before the split was recorded)
+// What "auto" means for a checkpoint that does not record its every_max (an older checkpoint
+// format; docs/coulomb.md): the cap that wrote it, so that it continues as it ran.
 constexpr int SLOW_INTERVAL_GROWTH_BEFORE_RECORDED = 4;
-// coulomb.r_fast = "auto" is R_FAST_AUTO (md/coulomb/CoulombDesign.h). What "auto" meant for
-// checkpoints that do not record their split (written before issue 15's change of R_FAST_AUTO; they
-// continue with the split they were written with)
+// coulomb.r_fast = "auto" is R_FAST_AUTO (md/coulomb/CoulombDesign.h). What "auto" means for a
+// checkpoint that does not record its split (an older format): the split that wrote it.
 constexpr double R_FAST_AUTO_BEFORE_RECORDED = 3.5;
 
 /// The run's configuration with the multiple-time-step split that wrote `ck`: its "auto"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file PhaseTimer.h
-/// Wall time of the MD step by phase (issue 15: where the time goes; `granagg md --profile`).
+/// Wall time of the MD step by phase: where the time goes (`granagg md --profile`).
 /// What no phase covers (observables, output, checkpoints, the Coulomb list rebuilt for an energy)
 /// is the loop's time minus their sum. Opt-in: a disabled timer (the default) reads no clock and
 /// synchronises nothing. Enabled, each scope waits for the device before reading the clock on the

@@ -21,7 +21,7 @@ struct MomentSample {
   /// last section (sectional), or integration error.
   double mass_loss = 0.0;
   /// False when mass_loss exceeds the solver's tolerance: S is then not a valid solution of the
-  /// untruncated equation and must not be used (issue 2: never reported as if valid).
+  /// untruncated equation and must not be used (never reported as if valid).
   bool valid = true;
   /// Size range in use at this time (largest size class, or largest pivot).
   double max_size = 0.0;
