@@ -1,7 +1,8 @@
 #pragma once
 /// \file Checkpoint.h
 /// Restart files (docs/ARCHITECTURE.md): everything a run needs to continue bit for bit as the
-/// uninterrupted run would (same backend and thread count), stored in HDF5 at full precision.
+/// uninterrupted run would (same build and backend, any thread count), stored in HDF5 at full
+/// precision.
 ///
 /// Layout (HDF5; readable with h5py for inspection):
 ///

@@ -6,7 +6,7 @@
 ///     `elasticEnergy(xi, params)` (HD, called per pair by md/compute/ContactForce);
 ///   - `name`, the value of `contact.model` that selects it;
 ///   - `fromConfig(ContactConfig, m_eff)` and `autoContactTime(params, v, m_eff, why)` (host).
-/// The engine holds a ContactParams and never names a model; md/compute/ContactForce dispatches
+/// The engine holds a ContactModel and never names a model; md/compute/ContactForce dispatches
 /// on it with std::visit, which instantiates the force pass for every model in the list.
 /// Adding a model: its header, one entry in ContactModel below, a test in
 /// tests/md/test_contact_forces.cpp (and its keys in md/config).
