@@ -6,12 +6,10 @@
 #include <stdexcept>
 
 #include "analysis/io/TrajectoryReader.h"
+#include "analysis/pipeline/FrameObservables.h"
 #include "analysis/stats/ChargeStats.h"
 #include "analysis/stats/GrowthMarkers.h"
-#include "analysis/stats/Msd.h"
 #include "analysis/stats/PowerLawFit.h"
-#include "analysis/stats/PowerLawMle.h"
-#include "analysis/stats/VelocityStats.h"
 #include "common/Csv.h"
 #include "common/Strings.h"
 
@@ -54,24 +52,6 @@ std::pair<double, double> fitWindow(const AnalysisOptions& o, const std::vector<
   const double last = t.empty() ? 0.0 : t.back();
   return {last / 10.0, last};
 }
-
-const std::vector<std::string> FISHER_COLUMNS = {"t",
-                                                 "tau_grid",
-                                                 "tau_grid_err",
-                                                 "xmin_grid",
-                                                 "tail_grid",
-                                                 "ks_grid",
-                                                 "tau_particle",
-                                                 "tau_particle_err",
-                                                 "xmin_particle",
-                                                 "tail_particle",
-                                                 "ks_particle",
-                                                 "tau_ls_grid",
-                                                 "tau_ls_grid_err",
-                                                 "bins_ls_grid",
-                                                 "tau_ls_particle",
-                                                 "tau_ls_particle_err",
-                                                 "bins_ls_particle"};
 
 const std::vector<std::string> FITS_COLUMNS = {"z_grid",
                                                "z_grid_err",
@@ -179,12 +159,6 @@ double standardErrorOfAll(const std::vector<double>& x) {
   return std::sqrt(ss / static_cast<double>(x.size() - 1) / static_cast<double>(x.size()));
 }
 
-/// The paper's Fisher exponent (log-binned least squares) as three table values.
-std::vector<double> lsColumns(const std::map<std::uint64_t, std::uint64_t>& n_s, double ratio) {
-  const LogBinnedFit f = fitLogBinnedPowerLaw(n_s, ratio);
-  return {f.valid ? f.tau : NaN, f.valid ? f.tau_err : NaN, static_cast<double>(f.bins)};
-}
-
 }  // namespace
 
 void AnalysisOptions::validate() const {
@@ -236,80 +210,14 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
   r.parameters = reader->parameters();
   resolveKappa(o, r);
 
-  GridClusters grid(o.grid);
-  ParticleClusters part(o.particle);
-  SpeedHistogram hist(o.speed_max, o.speed_bins);
-  MsdFromOrigin msd0;
-  MsdAllOrigins msd_all(o.msd_origins == "t0" ? 0 : o.msd_max_bytes);
-
-  Table S_t(
-      "S_t",
-      "t: time [sqrt(m d^2/T0)]; step; S = sum s^2 N_s / sum s N_s (grid: s in sites; particle: s "
-      "in particles); "
-      "clusters = number of clusters; largest = largest s; occupied_fraction = occupied grid sites "
-      "/ all sites; "
-      "mean_contacts = partners within 1 + tolerance per particle; z_local = ln[S(t)/S(t/p)]/ln p; "
-      "S_*_without_largest = (sum s^2 N_s - s_max^2) / (sum s N_s - s_max); largest_share_* = "
-      "s_max / sum s N_s; l_density = 2 pi / k_1, k_1 the first moment of S(k) over k <= k_c "
-      "(analysis/stats/StructureFactor.h; an ideal gas gives about 4 pi / k_c)",
-      {"t", "step", "S_grid", "S_particle", "clusters_grid", "clusters_particle", "largest_grid",
-       "largest_particle", "occupied_fraction", "mean_contacts", "z_local_grid",
-       "z_local_particle", "S_grid_without_largest", "S_particle_without_largest",
-       "largest_share_grid", "largest_share_particle", "l_density"});
-  Table S_k("S_k",
-            "t: time; k: shell centre m 2 pi / L [1/d]; S_k: static structure factor "
-            "<|sum_j exp(-i k.r_j)|^2>/N over the shell (CIC mesh, FFTW, Jing's alias "
-            "correction: analysis/stats/StructureFactor.h); modes: independent wave vectors in "
-            "the shell",
-            {"t", "k", "S_k", "modes"}, 2);
-  Table Ns_grid("N_s_grid",
-                "t: time; s: cluster size in grid sites; N_s: number of grid clusters of s sites",
-                {"t", "s", "N_s"}, 2);
-  Ns_grid.missing_is_zero = true;
-  Table Ns_part(
-      "N_s_particle",
-      "t: time; s: cluster size in particles; N_s: number of particle clusters of s particles",
-      {"t", "s", "N_s"}, 2);
-  Ns_part.missing_is_zero = true;
-  Table fisher("fisher",
-               "Fisher exponent tau of N_s ~ s^-tau per frame: discrete power-law MLE with xmin by "
-               "KS distance "
-               "(Clauset, Shalizi & Newman 2009); tau_err = 1/sqrt(n I(tau)); tail = clusters with "
-               "s >= xmin; ks = KS "
-               "distance; NaN when fewer than min_tail clusters or no maximum; tau_ls: the paper's "
-               "estimator, minus the "
-               "least-squares slope of ln N_s on ln s over logarithmic bins "
-               "(analysis/stats/GrowthMarkers.h), "
-               "bins_ls = non-empty bins (NaN below 3)",
-               FISHER_COLUMNS);
-  Table thermo(
-      "thermo",
-      "t: time; T_g = <|v - <v>|^2>/3 [T0]; a2 = (3/5)<c^4>/<c^2>^2 - 1 (Sonine) and its standard "
-      "error; "
-      "mean_abs_q = <|q|> [q_ref]; rms_q; net_q = sum q; max_abs_q; corr_absq_speed = Pearson "
-      "correlation of |q~| and v~",
-      {"t", "T_g", "a2", "a2_err", "mean_abs_q", "rms_q", "net_q", "max_abs_q", "corr_absq_speed"});
-  Table msd("msd",
-            "t: time; msd = <|r(t) - r(t0)|^2> [d^2] from the first frame t0, unwrapped with image "
-            "counts",
-            {"t", "msd"});
-  Table speed("speed_dist",
-              "t: time; v_low, v_high: bin of v~ = |c|/<|c|^2>^{1/2}; f: probability density of "
-              "v~; f_maxwell: the "
-              "Maxwellian sqrt(54/pi) v~^2 exp(-3 v~^2/2) averaged over the bin; count: particles "
-              "in the bin",
-              {"t", "v_low", "v_high", "f", "f_maxwell", "count"}, 3);
-  std::vector<std::string> stick_cols{"t", "n_stick_mean"};
-  Table nstick("nstick", "", {});
-  std::vector<std::size_t> tracked;
-  std::vector<double> t_series, Sg, Sp, mean_q;
-  double last_scatter_t = NaN;
-  std::vector<double> last_q, last_speeds;
-  std::vector<std::int64_t> last_ids;
+  ClusterObservables clusters(o);
+  StructureObservable structure(o);
+  MotionObservables motion(o);
+  GrowthTable growth;
 
   Frame f;
   std::size_t n_particles = 0;
-  bool have_vel = false, have_q = false, first = true;
+  bool first = true;
   while (true) {
     try {
       if (!reader->next(f)) break;
@@ -321,7 +229,7 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
                               "has " + std::to_string(f.size()) +
                                   " particles, the first frame had " + std::to_string(n_particles));
       }
-      if (!first && !t_series.empty() && !(f.time > t_series.back()))
+      if (!first && !growth.times().empty() && !(f.time > growth.times().back()))
         throw TrajectoryError(reader->path(), f.index,
                               "time " + common::formatReal(f.time) + " does not increase");
     } catch (const TrajectoryError& e) {
@@ -331,195 +239,45 @@ RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const Ru
       break;
     }
     if (first) {
-      have_vel = f.hasVelocities();
-      have_q = f.hasCharges();
-      // N_stick: particles with the smallest ids (frames are in id order)
-      for (std::size_t i = 0; i < std::min(o.track, f.size()); ++i) {
-        tracked.push_back(i);
-        stick_cols.push_back("n_stick_id" + std::to_string(f.id[i]));
-      }
-      nstick = Table("nstick",
-                     "t: time; n_stick_id<k>: number of particles within 1 + tolerance of tracked "
-                     "particle k (N_stick, "
-                     "contact persistence); n_stick_mean: their mean",
-                     stick_cols);
-      if (!f.hasImages()) r.notes.push_back("no image counts in the trajectory: MSD skipped");
-      if (!have_vel)
-        r.notes.push_back("no velocities: T_g, a2, f(v~) and the charge-speed scatter skipped");
-      if (!have_q) r.notes.push_back("no charges: charge observables skipped");
+      clusters.first(f);
+      motion.first(f, r);
       first = false;
     }
-    const double t = f.time;
-    t_series.push_back(t);
-    double sg = NaN, sp = NaN, cg = NaN, cp = NaN, lg = NaN, lp = NaN, occ = NaN, mc = NaN;
-    double sg_rest = NaN, sp_rest = NaN, share_g = NaN, share_p = NaN, l_density = NaN;
-    PowerLawMleResult fg, fp;
-    std::vector<double> ls_g{NaN, NaN, NaN}, ls_p{NaN, NaN, NaN};
-    if (o.grid_clusters) {
-      grid.compute(f);
-      const ClusterSizes& c = grid.result();
-      sg = c.S;
-      cg = static_cast<double>(c.clusters);
-      lg = static_cast<double>(c.largest);
-      sg_rest = c.S_without_largest;
-      share_g = c.largest_share;
-      occ = grid.occupiedFraction();
-      for (const auto& [s, count] : c.n_s)
-        Ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
-      fg = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
-      ls_g = lsColumns(c.n_s, o.fisher_bin_ratio);
-      if (cb.grid) cb.grid(f, grid);
-    }
-    if (o.particle_clusters) {
-      part.compute(f);
-      const ClusterSizes& c = part.result();
-      sp = c.S;
-      cp = static_cast<double>(c.clusters);
-      lp = static_cast<double>(c.largest);
-      sp_rest = c.S_without_largest;
-      share_p = c.largest_share;
-      mc = 2.0 * static_cast<double>(part.bonds()) / static_cast<double>(f.size());
-      for (const auto& [s, count] : c.n_s)
-        Ns_part.add({t, static_cast<double>(s), static_cast<double>(count)});
-      fp = fitDiscretePowerLawKs(c.n_s, o.mle_min_tail);
-      ls_p = lsColumns(c.n_s, o.fisher_bin_ratio);
-      std::vector<double> row{t, 0.0};
-      double sum = 0;
-      for (std::size_t i : tracked) {
-        row.push_back(part.contacts()[i]);
-        sum += part.contacts()[i];
-      }
-      row[1] = tracked.empty() ? NaN : sum / static_cast<double>(tracked.size());
-      nstick.add(row);
-    }
-    Sg.push_back(sg);
-    Sp.push_back(sp);
-    if (o.structure_factor) {
-      const StructureFactor sk = structureFactor(f, o.structure);
-      l_density = sk.length;
-      for (std::size_t m = 0; m < sk.k.size(); ++m)
-        S_k.add({t, sk.k[m], sk.S[m], static_cast<double>(sk.modes[m])});
-    }
-    S_t.add({t, static_cast<double>(f.step), sg, sp, cg, cp, lg, lp, occ, mc, NaN, NaN, sg_rest,
-             sp_rest, share_g, share_p, l_density});
-    auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
-    fisher.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)),
-                fv(fg, double(fg.n_tail)), fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err),
-                fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks), ls_g[0], ls_g[1],
-                ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
-
-    std::vector<double> speeds;
-    VelocityMoments vm;
-    vm.T_g = vm.a2 = vm.a2_err = NaN;
-    if (have_vel && f.hasVelocities()) {
-      vm = velocityMoments(f.velocity);
-      hist.reset();
-      speeds = hist.add(f.velocity);
-      const auto dens = hist.density();
-      for (int k = 0; k < hist.bins(); ++k) {
-        const double lo = hist.binLow(k), hi = lo + hist.binWidth();
-        const double fm =
-            (maxwellianScaledSpeedCdf(hi) - maxwellianScaledSpeedCdf(lo)) / hist.binWidth();
-        speed.add({t, lo, hi, dens[static_cast<std::size_t>(k)], fm,
-                   hist.counts()[static_cast<std::size_t>(k)]});
-      }
-    }
-    ChargeMoments qm{NaN, NaN, NaN, NaN};
-    double corr = NaN;
-    if (have_q && f.hasCharges()) {
-      qm = chargeMoments(f.charge);
-      if (!speeds.empty()) {
-        std::vector<double> aq = scaledCharges(f.charge);
-        for (double& x : aq) x = std::fabs(x);
-        corr = pearson(aq, speeds);
-      }
-    }
-    mean_q.push_back(qm.mean_abs);
-    thermo.add({t, vm.T_g, vm.a2, vm.a2_err, qm.mean_abs, qm.rms, qm.net, qm.max_abs, corr});
-    if (f.hasImages()) {
-      msd0.accumulate(f);
-      msd.add({t, msd0.msd().back()});
-      if (o.msd_origins != "t0") msd_all.accumulate(f);
-    } else if (o.msd_origins != "t0") {
-      msd_all.accumulate(f);  // records why it is unavailable
-    }
-    // charge-speed scatter: kept for the last frame only (the table is built after the loop)
-    if (have_q && !speeds.empty()) {
-      last_scatter_t = t;
-      last_q = scaledCharges(f.charge);
-      last_speeds = std::move(speeds);
-      last_ids = f.id;
-    }
+    const ClusterObservables::Row c = clusters.add(f, cb);
+    const double l = o.structure_factor ? structure.add(f) : NaN;
+    growth.add(f.time, f.step, c, l);
+    motion.add(f);
     ++r.frames;
     if (cb.progress) cb.progress(r.frames, reader->frameCountHint());
   }
   if (r.frames == 0) throw std::invalid_argument("trajectory '" + path + "' holds no frames");
   r.particles = n_particles;
-  if (o.grid_clusters) {
-    r.grid_cells = grid.cellsPerSide();
-    r.grid_cell_size = grid.cellSize();
-    r.grid_min_count = grid.minCount();
-  }
+  clusters.describe(r);
+  growth.finish(o.slope_ratio);
 
-  // Local slopes of S(t).
-  const auto zg = localSlope(t_series, Sg, o.slope_ratio),
-             zp = localSlope(t_series, Sp, o.slope_ratio);
-  for (std::size_t k = 0; k < S_t.rows.size(); ++k) {
-    S_t.rows[k][10] = zg[k];
-    S_t.rows[k][11] = zp[k];
-  }
-  // Fits.
-  const auto [w0, w1] = fitWindow(o, t_series);
-  const PowerLawFitResult fit_g = fitPowerLaw(t_series, Sg, w0, w1),
-                          fit_p = fitPowerLaw(t_series, Sp, w0, w1);
+  // the growth exponents over the window, the charging rate and the onsets
+  const std::vector<double>& t = growth.times();
+  const auto [w0, w1] = fitWindow(o, t);
+  const PowerLawFitResult fit_g = fitPowerLaw(t, growth.sGrid(), w0, w1),
+                          fit_p = fitPowerLaw(t, growth.sParticle(), w0, w1);
   PowerLawFitResult fit_q;
-  if (have_q) {
-    const auto [tr, rate] = chargingRate(t_series, mean_q);
+  if (motion.hasCharges()) {
+    const auto [tr, rate] = chargingRate(t, motion.meanAbsCharge());
     fit_q = fitPowerLaw(tr, rate, o.charge_fit_t_min, o.charge_fit_t_max);
   }
   Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
   fits.ensemble = false;
   fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, r.kappa, o.charge_fit_t_min, o.charge_fit_t_max,
-                      1, onsetsOf(t_series, Sg, Sp, o), o));
+                      1, onsetsOf(t, growth.sGrid(), growth.sParticle(), o), o));
 
-  r.tables.push_back(std::move(S_t));
-  if (o.grid_clusters) r.tables.push_back(std::move(Ns_grid));
-  if (o.particle_clusters) r.tables.push_back(std::move(Ns_part));
-  if (o.structure_factor) r.tables.push_back(std::move(S_k));
-  r.tables.push_back(std::move(fisher));
-  r.tables.push_back(std::move(thermo));
-  if (!msd.rows.empty()) r.tables.push_back(std::move(msd));
-  if (o.msd_origins != "t0") {
-    if (msd_all.available()) {
-      std::vector<double> lag;
-      const auto m = msd_all.compute(lag);
-      Table ma("msd_all_origins",
-               "lag: time lag [sqrt(m d^2/T0)]; msd = <|r(t0 + lag) - r(t0)|^2> averaged over all "
-               "time origins t0 "
-               "(FFT method; frames evenly spaced)",
-               {"lag", "msd"});
-      for (std::size_t k = 0; k < m.size(); ++k) ma.add({lag[k], m[k]});
-      r.tables.push_back(std::move(ma));
-    } else if (o.msd_origins == "all") {
-      throw std::invalid_argument("--msd-origins all: not possible for '" + path +
-                                  "': " + msd_all.reason());
-    } else {
-      r.notes.push_back("all-origins MSD skipped: " + msd_all.reason());
-    }
-  }
-  if (!speed.rows.empty()) r.tables.push_back(std::move(speed));
-  if (!last_q.empty()) {
-    Table sc("charge_speed",
-             "id: particle id; q_tilde = q / <q^2>^{1/2}; v_tilde = |c| / <|c|^2>^{1/2} (last "
-             "frame analysed, at time t)",
-             {"t", "id", "q_tilde", "v_tilde"});
-    sc.ensemble = false;
-    sc.rows.reserve(last_q.size());
-    for (std::size_t i = 0; i < last_q.size(); ++i)
-      sc.add({last_scatter_t, static_cast<double>(last_ids[i]), last_q[i], last_speeds[i]});
-    r.tables.push_back(std::move(sc));
-  }
-  if (o.particle_clusters && !tracked.empty()) r.tables.push_back(std::move(nstick));
+  // the tables in the order of the output
+  r.tables.push_back(std::move(growth.table()));
+  if (o.grid_clusters) r.tables.push_back(std::move(clusters.nsGrid()));
+  if (o.particle_clusters) r.tables.push_back(std::move(clusters.nsParticle()));
+  if (o.structure_factor) r.tables.push_back(std::move(structure.table()));
+  r.tables.push_back(std::move(clusters.fisher()));
+  motion.finish(path, r);
+  if (o.particle_clusters && clusters.tracks()) r.tables.push_back(std::move(clusters.nstick()));
   r.tables.push_back(std::move(fits));
   if (r.partial) r.notes.push_back("partial: " + r.partial_reason);
   return r;
@@ -590,21 +348,7 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
     for (const auto& kv : p) times[kv.first] = true;
     for (const auto& kv : times) {
       const double t = kv.first;
-      PowerLawMleResult fg, fp;
-      std::vector<double> ls_g{NaN, NaN, NaN}, ls_p{NaN, NaN, NaN};
-      if (g.count(t)) {
-        fg = fitDiscretePowerLawKs(g[t], o.mle_min_tail);
-        ls_g = lsColumns(g[t], o.fisher_bin_ratio);
-      }
-      if (p.count(t)) {
-        fp = fitDiscretePowerLawKs(p[t], o.mle_min_tail);
-        ls_p = lsColumns(p[t], o.fisher_bin_ratio);
-      }
-      auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
-      pooled.add({t, fv(fg, fg.tau), fv(fg, fg.tau_err), fv(fg, double(fg.xmin)),
-                  fv(fg, double(fg.n_tail)), fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err),
-                  fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks), ls_g[0],
-                  ls_g[1], ls_g[2], ls_p[0], ls_p[1], ls_p[2]});
+      pooled.add(fisherRow(t, g.count(t) ? &g[t] : nullptr, p.count(t) ? &p[t] : nullptr, o));
     }
     out.push_back(std::move(pooled));
   }

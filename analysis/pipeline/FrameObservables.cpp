@@ -1,0 +1,314 @@
+#include "analysis/pipeline/FrameObservables.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "analysis/stats/ChargeStats.h"
+#include "analysis/stats/GrowthMarkers.h"
+#include "analysis/stats/PowerLawFit.h"
+#include "analysis/stats/StructureFactor.h"
+
+namespace granagg::analysis {
+
+namespace {
+
+const double NaN = std::numeric_limits<double>::quiet_NaN();
+
+/// The paper's Fisher exponent (log-binned least squares) as three table values.
+std::vector<double> lsColumns(const std::map<std::uint64_t, std::uint64_t>& n_s, double ratio) {
+  const LogBinnedFit f = fitLogBinnedPowerLaw(n_s, ratio);
+  return {f.valid ? f.tau : NaN, f.valid ? f.tau_err : NaN, static_cast<double>(f.bins)};
+}
+
+}  // namespace
+
+const std::vector<std::string> FISHER_COLUMNS = {
+    "t",           "tau_grid",        "tau_grid_err",        "xmin_grid",
+    "tail_grid",   "ks_grid",         "tau_particle",        "tau_particle_err",
+    "xmin_particle", "tail_particle", "ks_particle",         "tau_ls_grid",
+    "tau_ls_grid_err", "bins_ls_grid", "tau_ls_particle",    "tau_ls_particle_err",
+    "bins_ls_particle"};
+
+std::vector<double> fisherRow(double t, const std::map<std::uint64_t, std::uint64_t>* grid,
+                              const std::map<std::uint64_t, std::uint64_t>* particle,
+                              const AnalysisOptions& o) {
+  PowerLawMleResult fg, fp;
+  std::vector<double> ls_g{NaN, NaN, NaN}, ls_p{NaN, NaN, NaN};
+  if (grid) {
+    fg = fitDiscretePowerLawKs(*grid, o.mle_min_tail);
+    ls_g = lsColumns(*grid, o.fisher_bin_ratio);
+  }
+  if (particle) {
+    fp = fitDiscretePowerLawKs(*particle, o.mle_min_tail);
+    ls_p = lsColumns(*particle, o.fisher_bin_ratio);
+  }
+  auto fv = [](const PowerLawMleResult& m, double x) { return m.valid ? x : NaN; };
+  return {t,         fv(fg, fg.tau),      fv(fg, fg.tau_err), fv(fg, double(fg.xmin)),
+          fv(fg, double(fg.n_tail)), fv(fg, fg.ks), fv(fp, fp.tau), fv(fp, fp.tau_err),
+          fv(fp, double(fp.xmin)), fv(fp, double(fp.n_tail)), fv(fp, fp.ks), ls_g[0],
+          ls_g[1],   ls_g[2],             ls_p[0],            ls_p[1],
+          ls_p[2]};
+}
+
+// ---- clusters ----------------------------------------------------------------------------------
+
+ClusterObservables::ClusterObservables(const AnalysisOptions& o)
+    : m_o(o),
+      m_grid(o.grid),
+      m_particle(o.particle),
+      m_ns_grid("N_s_grid",
+                "t: time; s: cluster size in grid sites; N_s: number of grid clusters of s sites",
+                {"t", "s", "N_s"}, 2),
+      m_ns_particle(
+          "N_s_particle",
+          "t: time; s: cluster size in particles; N_s: number of particle clusters of s particles",
+          {"t", "s", "N_s"}, 2),
+      m_fisher("fisher",
+               "Fisher exponent tau of N_s ~ s^-tau per frame: discrete power-law MLE with xmin by "
+               "KS distance (Clauset, Shalizi & Newman 2009); tau_err = 1/sqrt(n I(tau)); tail = "
+               "clusters with s >= xmin; ks = KS distance; NaN when fewer than min_tail clusters "
+               "or no maximum; tau_ls: the paper's estimator, minus the least-squares slope of "
+               "ln N_s on ln s over logarithmic bins (analysis/stats/GrowthMarkers.h), bins_ls = "
+               "non-empty bins (NaN below 3)",
+               FISHER_COLUMNS),
+      m_nstick("nstick", "", {}) {
+  m_ns_grid.missing_is_zero = true;
+  m_ns_particle.missing_is_zero = true;
+}
+
+void ClusterObservables::first(const Frame& f) {
+  std::vector<std::string> columns{"t", "n_stick_mean"};
+  for (std::size_t i = 0; i < std::min(m_o.track, f.size()); ++i) {
+    m_tracked.push_back(i);
+    columns.push_back("n_stick_id" + std::to_string(f.id[i]));
+  }
+  m_nstick = Table("nstick",
+                   "t: time; n_stick_id<k>: number of particles within 1 + tolerance of tracked "
+                   "particle k (N_stick, contact persistence); n_stick_mean: their mean",
+                   columns);
+}
+
+ClusterObservables::Row ClusterObservables::add(const Frame& f, const RunCallbacks& cb) {
+  Row row{NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN};
+  const double t = f.time;
+  const std::map<std::uint64_t, std::uint64_t>* grid_ns = nullptr;
+  const std::map<std::uint64_t, std::uint64_t>* particle_ns = nullptr;
+  if (m_o.grid_clusters) {
+    m_grid.compute(f);
+    const ClusterSizes& c = m_grid.result();
+    row.S_grid = c.S;
+    row.clusters_grid = static_cast<double>(c.clusters);
+    row.largest_grid = static_cast<double>(c.largest);
+    row.S_grid_without_largest = c.S_without_largest;
+    row.largest_share_grid = c.largest_share;
+    row.occupied_fraction = m_grid.occupiedFraction();
+    for (const auto& [s, count] : c.n_s)
+      m_ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
+    grid_ns = &c.n_s;
+    if (cb.grid) cb.grid(f, m_grid);
+  }
+  if (m_o.particle_clusters) {
+    m_particle.compute(f);
+    const ClusterSizes& c = m_particle.result();
+    row.S_particle = c.S;
+    row.clusters_particle = static_cast<double>(c.clusters);
+    row.largest_particle = static_cast<double>(c.largest);
+    row.S_particle_without_largest = c.S_without_largest;
+    row.largest_share_particle = c.largest_share;
+    row.mean_contacts =
+        2.0 * static_cast<double>(m_particle.bonds()) / static_cast<double>(f.size());
+    for (const auto& [s, count] : c.n_s)
+      m_ns_particle.add({t, static_cast<double>(s), static_cast<double>(count)});
+    particle_ns = &c.n_s;
+    std::vector<double> stick{t, 0.0};
+    double sum = 0;
+    for (std::size_t i : m_tracked) {
+      stick.push_back(m_particle.contacts()[i]);
+      sum += m_particle.contacts()[i];
+    }
+    stick[1] = m_tracked.empty() ? NaN : sum / static_cast<double>(m_tracked.size());
+    m_nstick.add(stick);
+  }
+  m_fisher.add(fisherRow(t, grid_ns, particle_ns, m_o));
+  return row;
+}
+
+void ClusterObservables::describe(RunResult& r) const {
+  if (!m_o.grid_clusters) return;
+  r.grid_cells = m_grid.cellsPerSide();
+  r.grid_cell_size = m_grid.cellSize();
+  r.grid_min_count = m_grid.minCount();
+}
+
+// ---- structure factor --------------------------------------------------------------------------
+
+StructureObservable::StructureObservable(const AnalysisOptions& o)
+    : m_o(o),
+      m_table("S_k",
+              "t: time; k: shell centre m 2 pi / L [1/d]; S_k: static structure factor "
+              "<|sum_j exp(-i k.r_j)|^2>/N over the shell (CIC mesh, FFTW, Jing's alias "
+              "correction: analysis/stats/StructureFactor.h); modes: independent wave vectors in "
+              "the shell",
+              {"t", "k", "S_k", "modes"}, 2) {}
+
+double StructureObservable::add(const Frame& f) {
+  const StructureFactor sk = structureFactor(f, m_o.structure);
+  for (std::size_t m = 0; m < sk.k.size(); ++m)
+    m_table.add({f.time, sk.k[m], sk.S[m], static_cast<double>(sk.modes[m])});
+  return sk.length;
+}
+
+// ---- velocities, charges, displacements --------------------------------------------------------
+
+MotionObservables::MotionObservables(const AnalysisOptions& o)
+    : m_o(o),
+      m_hist(o.speed_max, o.speed_bins),
+      m_msd_all(o.msd_origins == "t0" ? 0 : o.msd_max_bytes),
+      m_thermo("thermo",
+               "t: time; T_g = <|v - <v>|^2>/3 [T0]; a2 = (3/5)<c^4>/<c^2>^2 - 1 (Sonine) and its "
+               "standard error; mean_abs_q = <|q|> [q_ref]; rms_q; net_q = sum q; max_abs_q; "
+               "corr_absq_speed = Pearson correlation of |q~| and v~",
+               {"t", "T_g", "a2", "a2_err", "mean_abs_q", "rms_q", "net_q", "max_abs_q",
+                "corr_absq_speed"}),
+      m_msd("msd",
+            "t: time; msd = <|r(t) - r(t0)|^2> [d^2] from the first frame t0, unwrapped with image "
+            "counts",
+            {"t", "msd"}),
+      m_speed("speed_dist",
+              "t: time; v_low, v_high: bin of v~ = |c|/<|c|^2>^{1/2}; f: probability density of "
+              "v~; f_maxwell: the Maxwellian sqrt(54/pi) v~^2 exp(-3 v~^2/2) averaged over the "
+              "bin; count: particles in the bin",
+              {"t", "v_low", "v_high", "f", "f_maxwell", "count"}, 3) {}
+
+void MotionObservables::first(const Frame& f, RunResult& r) {
+  m_have_vel = f.hasVelocities();
+  m_have_q = f.hasCharges();
+  if (!f.hasImages()) r.notes.push_back("no image counts in the trajectory: MSD skipped");
+  if (!m_have_vel)
+    r.notes.push_back("no velocities: T_g, a2, f(v~) and the charge-speed scatter skipped");
+  if (!m_have_q) r.notes.push_back("no charges: charge observables skipped");
+}
+
+void MotionObservables::add(const Frame& f) {
+  const double t = f.time;
+  std::vector<double> speeds;
+  VelocityMoments vm;
+  vm.T_g = vm.a2 = vm.a2_err = NaN;
+  if (m_have_vel && f.hasVelocities()) {
+    vm = velocityMoments(f.velocity);
+    m_hist.reset();
+    speeds = m_hist.add(f.velocity);
+    const auto dens = m_hist.density();
+    for (int k = 0; k < m_hist.bins(); ++k) {
+      const double lo = m_hist.binLow(k), hi = lo + m_hist.binWidth();
+      const double fm =
+          (maxwellianScaledSpeedCdf(hi) - maxwellianScaledSpeedCdf(lo)) / m_hist.binWidth();
+      m_speed.add({t, lo, hi, dens[static_cast<std::size_t>(k)], fm,
+                   m_hist.counts()[static_cast<std::size_t>(k)]});
+    }
+  }
+  ChargeMoments qm{NaN, NaN, NaN, NaN};
+  double corr = NaN;
+  if (m_have_q && f.hasCharges()) {
+    qm = chargeMoments(f.charge);
+    if (!speeds.empty()) {
+      std::vector<double> aq = scaledCharges(f.charge);
+      for (double& x : aq) x = std::fabs(x);
+      corr = pearson(aq, speeds);
+    }
+  }
+  m_mean_q.push_back(qm.mean_abs);
+  m_thermo.add({t, vm.T_g, vm.a2, vm.a2_err, qm.mean_abs, qm.rms, qm.net, qm.max_abs, corr});
+  if (f.hasImages()) {
+    m_msd0.accumulate(f);
+    m_msd.add({t, m_msd0.msd().back()});
+    if (m_o.msd_origins != "t0") m_msd_all.accumulate(f);
+  } else if (m_o.msd_origins != "t0") {
+    m_msd_all.accumulate(f);  // records why it is unavailable
+  }
+  // charge-speed scatter: kept for the last frame only (the table is built at the end)
+  if (m_have_q && !speeds.empty()) {
+    m_scatter_t = t;
+    m_scatter_q = scaledCharges(f.charge);
+    m_scatter_v = std::move(speeds);
+    m_scatter_ids = f.id;
+  }
+}
+
+void MotionObservables::finish(const std::string& path, RunResult& r) {
+  r.tables.push_back(std::move(m_thermo));
+  if (!m_msd.rows.empty()) r.tables.push_back(std::move(m_msd));
+  if (m_o.msd_origins != "t0") {
+    if (m_msd_all.available()) {
+      std::vector<double> lag;
+      const auto m = m_msd_all.compute(lag);
+      Table all("msd_all_origins",
+                "lag: time lag [sqrt(m d^2/T0)]; msd = <|r(t0 + lag) - r(t0)|^2> averaged over "
+                "all time origins t0 (FFT method; frames evenly spaced)",
+                {"lag", "msd"});
+      for (std::size_t k = 0; k < m.size(); ++k) all.add({lag[k], m[k]});
+      r.tables.push_back(std::move(all));
+    } else if (m_o.msd_origins == "all") {
+      throw std::invalid_argument("--msd-origins all: not possible for '" + path +
+                                  "': " + m_msd_all.reason());
+    } else {
+      r.notes.push_back("all-origins MSD skipped: " + m_msd_all.reason());
+    }
+  }
+  if (!m_speed.rows.empty()) r.tables.push_back(std::move(m_speed));
+  if (!m_scatter_q.empty()) {
+    Table sc("charge_speed",
+             "id: particle id; q_tilde = q / <q^2>^{1/2}; v_tilde = |c| / <|c|^2>^{1/2} (last "
+             "frame analysed, at time t)",
+             {"t", "id", "q_tilde", "v_tilde"});
+    sc.ensemble = false;
+    sc.rows.reserve(m_scatter_q.size());
+    for (std::size_t i = 0; i < m_scatter_q.size(); ++i)
+      sc.add({m_scatter_t, static_cast<double>(m_scatter_ids[i]), m_scatter_q[i],
+              m_scatter_v[i]});
+    r.tables.push_back(std::move(sc));
+  }
+}
+
+// ---- S_t ---------------------------------------------------------------------------------------
+
+GrowthTable::GrowthTable()
+    : m_table("S_t",
+              "t: time [sqrt(m d^2/T0)]; step; S = sum s^2 N_s / sum s N_s (grid: s in sites; "
+              "particle: s in particles); clusters = number of clusters; largest = largest s; "
+              "occupied_fraction = occupied grid sites / all sites; mean_contacts = partners "
+              "within 1 + tolerance per particle; z_local = ln[S(t)/S(t/p)]/ln p; "
+              "S_*_without_largest = (sum s^2 N_s - s_max^2) / (sum s N_s - s_max); "
+              "largest_share_* = s_max / sum s N_s; l_density = 2 pi / k_1, k_1 the first moment "
+              "of S(k) over k <= k_c (analysis/stats/StructureFactor.h; an ideal gas gives about "
+              "4 pi / k_c)",
+              {"t", "step", "S_grid", "S_particle", "clusters_grid", "clusters_particle",
+               "largest_grid", "largest_particle", "occupied_fraction", "mean_contacts",
+               "z_local_grid", "z_local_particle", "S_grid_without_largest",
+               "S_particle_without_largest", "largest_share_grid", "largest_share_particle",
+               "l_density"}) {}
+
+void GrowthTable::add(double t, std::int64_t step, const ClusterObservables::Row& c,
+                      double l_density) {
+  m_t.push_back(t);
+  m_S_grid.push_back(c.S_grid);
+  m_S_particle.push_back(c.S_particle);
+  // the local slopes come when the series is complete (finish)
+  m_table.add({t, static_cast<double>(step), c.S_grid, c.S_particle, c.clusters_grid,
+               c.clusters_particle, c.largest_grid, c.largest_particle, c.occupied_fraction,
+               c.mean_contacts, NaN, NaN, c.S_grid_without_largest, c.S_particle_without_largest,
+               c.largest_share_grid, c.largest_share_particle, l_density});
+}
+
+void GrowthTable::finish(double slope_ratio) {
+  const auto zg = localSlope(m_t, m_S_grid, slope_ratio);
+  const auto zp = localSlope(m_t, m_S_particle, slope_ratio);
+  const std::size_t cg = m_table.column("z_local_grid"), cp = m_table.column("z_local_particle");
+  for (std::size_t k = 0; k < m_table.rows.size(); ++k) {
+    m_table.rows[k][cg] = zg[k];
+    m_table.rows[k][cp] = zp[k];
+  }
+}
+
+}  // namespace granagg::analysis
