@@ -89,38 +89,41 @@ void ClusterObservables::first(const Frame& f) {
                    columns);
 }
 
+namespace {
+
+ClusterObservables::Sizes sizesOf(const ClusterSizes& c) {
+  return {c.S, static_cast<double>(c.clusters), static_cast<double>(c.largest),
+          c.S_without_largest, c.largest_share};
+}
+
+void addSizes(Table& table, double t, const ClusterSizes& c) {
+  for (const auto& [s, count] : c.n_s)
+    table.add({t, static_cast<double>(s), static_cast<double>(count)});
+}
+
+}  // namespace
+
 ClusterObservables::Row ClusterObservables::add(const Frame& f, const RunCallbacks& cb) {
-  Row row{NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN, NaN};
+  const Sizes none{NaN, NaN, NaN, NaN, NaN};
+  Row row{none, none, NaN, NaN};
   const double t = f.time;
   const std::map<std::uint64_t, std::uint64_t>* grid_ns = nullptr;
   const std::map<std::uint64_t, std::uint64_t>* particle_ns = nullptr;
   if (m_o.grid_clusters) {
     m_grid.compute(f);
-    const ClusterSizes& c = m_grid.result();
-    row.S_grid = c.S;
-    row.clusters_grid = static_cast<double>(c.clusters);
-    row.largest_grid = static_cast<double>(c.largest);
-    row.S_grid_without_largest = c.S_without_largest;
-    row.largest_share_grid = c.largest_share;
+    row.grid = sizesOf(m_grid.result());
     row.occupied_fraction = m_grid.occupiedFraction();
-    for (const auto& [s, count] : c.n_s)
-      m_ns_grid.add({t, static_cast<double>(s), static_cast<double>(count)});
-    grid_ns = &c.n_s;
+    addSizes(m_ns_grid, t, m_grid.result());
+    grid_ns = &m_grid.result().n_s;
     if (cb.grid) cb.grid(f, m_grid);
   }
   if (m_o.particle_clusters) {
     m_particle.compute(f);
-    const ClusterSizes& c = m_particle.result();
-    row.S_particle = c.S;
-    row.clusters_particle = static_cast<double>(c.clusters);
-    row.largest_particle = static_cast<double>(c.largest);
-    row.S_particle_without_largest = c.S_without_largest;
-    row.largest_share_particle = c.largest_share;
+    row.particle = sizesOf(m_particle.result());
     row.mean_contacts =
         2.0 * static_cast<double>(m_particle.bonds()) / static_cast<double>(f.size());
-    for (const auto& [s, count] : c.n_s)
-      m_ns_particle.add({t, static_cast<double>(s), static_cast<double>(count)});
-    particle_ns = &c.n_s;
+    addSizes(m_ns_particle, t, m_particle.result());
+    particle_ns = &m_particle.result().n_s;
     std::vector<double> stick{t, 0.0};
     double sum = 0;
     for (std::size_t i : m_tracked) {
@@ -292,13 +295,13 @@ GrowthTable::GrowthTable()
 void GrowthTable::add(double t, std::int64_t step, const ClusterObservables::Row& c,
                       double l_density) {
   m_t.push_back(t);
-  m_S_grid.push_back(c.S_grid);
-  m_S_particle.push_back(c.S_particle);
+  m_S_grid.push_back(c.grid.S);
+  m_S_particle.push_back(c.particle.S);
   // the local slopes come when the series is complete (finish)
-  m_table.add({t, static_cast<double>(step), c.S_grid, c.S_particle, c.clusters_grid,
-               c.clusters_particle, c.largest_grid, c.largest_particle, c.occupied_fraction,
-               c.mean_contacts, NaN, NaN, c.S_grid_without_largest, c.S_particle_without_largest,
-               c.largest_share_grid, c.largest_share_particle, l_density});
+  m_table.add({t, static_cast<double>(step), c.grid.S, c.particle.S, c.grid.clusters,
+               c.particle.clusters, c.grid.largest, c.particle.largest, c.occupied_fraction,
+               c.mean_contacts, NaN, NaN, c.grid.S_without_largest, c.particle.S_without_largest,
+               c.grid.largest_share, c.particle.largest_share, l_density});
 }
 
 void GrowthTable::finish(double slope_ratio) {

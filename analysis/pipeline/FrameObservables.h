@@ -37,11 +37,14 @@ std::vector<double> fisherRow(double t, const std::map<std::uint64_t, std::uint6
 /// Grid and particle clusters of each frame.
 class ClusterObservables {
  public:
-  /// What S_t takes from the clusters of one frame (NaN for a definition that is off).
+  /// What S_t takes from one definition's clusters (NaN when the definition is off).
+  struct Sizes {
+    double S, clusters, largest, S_without_largest, largest_share;
+  };
+  /// What S_t takes from the clusters of one frame.
   struct Row {
-    double S_grid, S_particle, clusters_grid, clusters_particle, largest_grid, largest_particle,
-        occupied_fraction, mean_contacts, S_grid_without_largest, S_particle_without_largest,
-        largest_share_grid, largest_share_particle;
+    Sizes grid, particle;
+    double occupied_fraction, mean_contacts;
   };
 
   explicit ClusterObservables(const AnalysisOptions& o);
