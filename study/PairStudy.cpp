@@ -14,13 +14,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <deque>
 #include <stdexcept>
 
 #include "common/Csv.h"
 #include "common/FolderLock.h"
 #include "common/Interrupted.h"
 #include "common/Version.h"
+#include "study/JobPool.h"
 #include "study/Process.h"
 #include "study/Slurm.h"
 
@@ -229,10 +229,11 @@ void PairStudy::emitSlurm() {
       " array tasks + a follow-up job); submit with: bash " + path.string());
 }
 
-void PairStudy::runMd(std::vector<RunJob> all) {
-  // Which runs are finished (done.json with the same spec), which can restart from a checkpoint.
+/// The runs still to do: those without a done.json of the same spec (finished ones are counted in
+/// `done` and skipped), each marked to restart from its checkpoint where one belongs to it.
+std::vector<RunJob> PairStudy::runsToDo(std::vector<RunJob>& all, int& done) {
   std::vector<RunJob> todo;
-  int done = 0;
+  done = 0;
   for (RunJob& j : all) {
     const fs::path marker = j.dir / "done.json";
     if (fs::exists(marker)) {
@@ -254,6 +255,12 @@ void PairStudy::runMd(std::vector<RunJob> all) {
                 recordOf(j.dir / "run.json", j);
     todo.push_back(j);
   }
+  return todo;
+}
+
+void PairStudy::runMd(std::vector<RunJob> all) {
+  int done = 0;
+  std::vector<RunJob> todo = runsToDo(all, done);
   if (todo.empty()) {
     if (m_a.run_index < 0) say("md: all " + std::to_string(all.size()) + " runs finished already");
     return;
@@ -273,26 +280,21 @@ void PairStudy::runMd(std::vector<RunJob> all) {
   const int jobs = std::max(
       1, std::min<int>(m_a.jobs > 0 ? m_a.jobs : default_jobs, static_cast<int>(todo.size())));
   const int threads = m_a.threads > 0 ? m_a.threads : std::max(1, m_cores / jobs);
-  struct Running {
-    RunJob job;
-    clock::time_point start;
-  };
-  std::deque<RunJob> pending(todo.begin(), todo.end());
-  std::map<pid_t, Running> running;
   std::vector<std::string> failed;
   const bool tty = !m_a.quiet && ::isatty(2);
   const auto t0 = clock::now();
-  std::size_t finished = 0;
-  auto progress = [&]() {
+  JobPoolCallbacks cb;
+  cb.progress = [&](std::size_t finished, std::size_t running) {
     if (!tty) return;
     std::fprintf(stderr, "\rpair: md %zu/%zu runs done, %zu running (%d jobs x %d %s), %.0f s   ",
-                 finished, todo.size(), running.size(), jobs,
+                 finished, todo.size(), running, jobs,
                  m_launch.lammps() ? m_c.lammps_ranks : threads,
                  m_launch.lammps() ? "ranks" : "threads",
                  std::chrono::duration<double>(clock::now() - t0).count());
     std::fflush(stderr);
   };
-  auto start = [&](RunJob j) {
+  cb.start = [&](std::size_t i) {
+    const RunJob& j = todo[i];
     fs::create_directories(j.dir);
     if (!j.restart) {
       // A fresh start: clear what an interrupted attempt left behind.
@@ -310,79 +312,60 @@ void PairStudy::runMd(std::vector<RunJob> all) {
             (j.restart ? "restarting from its checkpoint" : "started") + " (seed " +
             std::to_string(j.seed) + ")",
         !tty);
-    const pid_t pid = spawn(argv, j.log);
-    running[pid] = {j, clock::now()};
+    return spawn(argv, j.log);
   };
-
-  while (!pending.empty() || !running.empty()) {
-    while (!stopped() && static_cast<int>(running.size()) < jobs && !pending.empty()) {
-      start(pending.front());
-      pending.pop_front();
-    }
-    progress();
-    int st = 0;
-    const pid_t pid = ::waitpid(-1, &st, WNOHANG);
-    if (stopped()) {
-      // each run stops at the end of its chunk of steps with a checkpoint (granagg md handles
-      // the signal); the next pair resumes it from there (RunJob::restart)
-      const int sig = stopped();
-      for (auto& [p, r] : running) stopRun(p);
-      if (tty) std::fprintf(stderr, "\n");
-      for (auto& [p, r] : running) {
-        int child = 0;
-        while (::waitpid(p, &child, 0) < 0 && errno == EINTR) {
-        }
-        say("md " + kName(r.job.K) + " run " + std::to_string(r.job.r) + ": stopped (" +
-            runLastLine(r.job) + ")");
-      }
-      say("interrupted (signal " + std::to_string(sig) +
-          "): finished runs are kept, stopped runs continue from their checkpoints; run the "
-          "same command again to resume");
-      throw common::Interrupted("pair: interrupted; run the same command again to resume", sig);
-    }
-    if (pid == 0 || (pid < 0 && errno == EINTR)) {
-      ::usleep(200000);
-      continue;
-    }
-    if (pid < 0) throw std::runtime_error("waitpid failed: " + std::string(std::strerror(errno)));
-    auto it = running.find(pid);
-    if (it == running.end()) continue;
-    Running r = it->second;
-    running.erase(it);
-    const double wall = std::chrono::duration<double>(clock::now() - r.start).count();
+  cb.ended = [&](std::size_t i, int st, double wall) {
+    RunJob& job = todo[i];
     const bool ok = WIFEXITED(st) && WEXITSTATUS(st) == 0;
-    const std::string name = kName(r.job.K) + " run " + std::to_string(r.job.r);
+    const std::string name = kName(job.K) + " run " + std::to_string(job.r);
     if (ok) {
-      nlohmann::ordered_json rec = runRecord(r.job);
+      nlohmann::ordered_json rec = runRecord(job);
       rec["wall_seconds"] = wall;
       if (m_launch.lammps())
         rec["launcher"] = joinCommand(m_launch.launcher);
       else
         rec["threads"] = threads;
-      rec["restarted"] = r.job.restart;
+      rec["restarted"] = job.restart;
       rec["finished"] = nowUtc();
       rec["granagg"] = common::versionString();
-      writeText(r.job.dir / "done.json", rec.dump(2) + "\n");
-      ++finished;
-      m_changed_k.insert(kName(r.job.K));
+      writeText(job.dir / "done.json", rec.dump(2) + "\n");
+      m_changed_k.insert(kName(job.K));
       if (tty) std::fprintf(stderr, "\r%100s\r", "");
       say("md " + name + ": done in " + formatReal(std::round(wall * 10) / 10) + " s" +
-          (r.job.restart ? " (restarted)" : ""));
-    } else if (r.job.restart) {
-      // The checkpoint could not be continued (e.g. a trajectory cut by a kill): start afresh.
-      say("md " + name + ": restart failed (" + runLastLine(r.job) + "); starting it afresh",
-          !tty);
-      r.job.restart = false;
-      pending.push_front(r.job);
-    } else {
-      ++finished;
-      const std::string why = WIFEXITED(st) ? "exit status " + std::to_string(WEXITSTATUS(st))
-                                            : "killed by signal " + std::to_string(WTERMSIG(st));
-      failed.push_back(name);
-      if (tty) std::fprintf(stderr, "\r%100s\r", "");
-      say("md " + name + ": FAILED (" + why + "): " + runLastLine(r.job) +
-          " [log: " + r.job.log.string() + "]");
+          (job.restart ? " (restarted)" : ""));
+      return false;
     }
+    if (job.restart) {
+      // The checkpoint could not be continued (e.g. a trajectory cut by a kill): start afresh.
+      say("md " + name + ": restart failed (" + runLastLine(job) + "); starting it afresh", !tty);
+      job.restart = false;
+      return true;
+    }
+    const std::string why = WIFEXITED(st) ? "exit status " + std::to_string(WEXITSTATUS(st))
+                                          : "killed by signal " + std::to_string(WTERMSIG(st));
+    failed.push_back(name);
+    if (tty) std::fprintf(stderr, "\r%100s\r", "");
+    say("md " + name + ": FAILED (" + why + "): " + runLastLine(job) +
+        " [log: " + job.log.string() + "]");
+    return false;
+  };
+  // each run stops at the end of its chunk of steps with a checkpoint (granagg md handles the
+  // signal); the next pair resumes it from there (RunJob::restart)
+  cb.stop_requested = [&] { return stopped(); };
+  bool first_stopped = true;
+  cb.stop = [&](std::size_t, pid_t pid) { stopRun(pid); };
+  cb.stopped = [&](std::size_t i) {
+    if (first_stopped && tty) std::fprintf(stderr, "\n");
+    first_stopped = false;
+    say("md " + kName(todo[i].K) + " run " + std::to_string(todo[i].r) + ": stopped (" +
+        runLastLine(todo[i]) + ")");
+  };
+  if (const int sig = runJobPool(todo.size(), jobs, cb)) {
+    if (first_stopped && tty) std::fprintf(stderr, "\n");
+    say("interrupted (signal " + std::to_string(sig) +
+        "): finished runs are kept, stopped runs continue from their checkpoints; run the "
+        "same command again to resume");
+    throw common::Interrupted("pair: interrupted; run the same command again to resume", sig);
   }
   if (tty) std::fprintf(stderr, "\r%100s\r", "");
   m_timing["md"] += std::chrono::duration<double>(clock::now() - t0).count();

@@ -112,6 +112,8 @@ class PairStudy {
   std::string batchCommand() const;
   void emitSlurm();
   void setUpLaunch();
+  /// The runs of `all` still to do (finished ones counted in `done`), restarts marked.
+  std::vector<RunJob> runsToDo(std::vector<RunJob>& all, int& done);
   void runMd(std::vector<RunJob> jobs);
   void stopRun(pid_t pid);
   std::string runLastLine(const RunJob& j) const;
