@@ -59,7 +59,7 @@ std::map<std::string, double> clusteringEnsemble(const fs::path& dir, double eps
 }  // namespace
 
 TEST_CASE("a strongly dissipative gas clusters within seconds, an elastic one does not",
-          "[cluster-growth]") {
+          "[cluster-growth][slow]") {
   const fs::path dir =
       fs::temp_directory_path() / ("granagg_clustering_" + std::to_string(::getpid()));
   fs::remove_all(dir);

@@ -183,7 +183,7 @@ TEST_CASE("fit-beta recovers z of an exact power law exactly", "[cli][fitbeta]")
 }
 
 TEST_CASE("fit-beta writes no number for a beta_fit at a bound of the search range",
-          "[cli][fitbeta]") {
+          "[cli][fitbeta][slow]") {
   // S = t^2.6 grows faster than every mean-field curve in [1.5, 6] (z = 3 beta / (beta + 3) <= 2):
   // the curve fit ends at beta = 6, which is the search bound, not a result: no number for it in
   // fit_beta.csv and fit_beta.json.
@@ -320,7 +320,7 @@ TEST_CASE("fit-beta recovers beta = 2.5 from noisy mean-field S(t) given as CSV"
   fs::remove_all(dir);
 }
 
-TEST_CASE("fit-beta reads run columns, analyze folders and analysis.h5", "[cli][fitbeta]") {
+TEST_CASE("fit-beta reads run columns, analyze folders and analysis.h5", "[cli][fitbeta][slow]") {
   // Five runs of S_MF(t; 3) with 8 % noise each, as (a) one CSV with columns S_run0..S_run4
   // (--column S_run), (b) an analyze folder (S_t.csv with S_grid_mean, per_run/S_t.csv) and (c) an
   // analysis.h5: the same z and beta from z from all three; intervals by bootstrap over the runs.

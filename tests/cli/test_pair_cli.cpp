@@ -91,7 +91,7 @@ TEST_CASE("pair --emit-batch slurm writes a job-array script and runs nothing", 
 }
 
 TEST_CASE("pair on the tiny preset makes every output and resumes without redoing finished runs",
-          "[cli][pair]") {
+          "[cli][pair][slow]") {
   const fs::path dir = tempDir("e2e");
   const fs::path out = dir / "study";
   const std::string cmd = "pair --preset tiny --jobs 2 --out " + out.string();

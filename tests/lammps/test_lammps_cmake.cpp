@@ -34,7 +34,7 @@ Run configure(const fs::path& build, const fs::path& lammps) {
 }  // namespace
 
 TEST_CASE("CMake uses the LAMMPS named by -DLAMMPS_DIR: an install prefix or a source tree",
-          "[lammps][cmake]") {
+          "[lammps][cmake][slow]") {
   const fs::path dir = granagg::test::tempDir("lammps_cmake");
   {  // an install prefix: <prefix>/lib/cmake/LAMMPS/LAMMPSConfig.cmake, of a version of its own
     const fs::path config = dir / "prefix" / "lib" / "cmake" / "LAMMPS";

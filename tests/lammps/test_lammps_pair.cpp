@@ -16,7 +16,7 @@ using namespace granagg;
 namespace fs = std::filesystem;
 
 TEST_CASE("pair with engine = lammps runs its MD through granagg-lammps, analyses it and resumes",
-          "[lammps][mpi][pair]") {
+          "[lammps][mpi][pair][slow]") {
   const fs::path dir = test::tempDir("lammps_pair");
   const fs::path out = dir / "study";
   // Open MPI refuses root unless told, and 2 ranks may exceed this machine's cores

@@ -170,7 +170,7 @@ TEST_CASE("granagg-lammps gives a two-body collision the restitution of granagg'
 
 TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collision, and granagg "
           "analyze reads its trajectory",
-          "[lammps][mpi]") {
+          "[lammps][mpi][slow]") {
   const fs::path dir = test::tempDir("lammps_gas");
   const int N = 1000;
   const double dt = 0.003;
@@ -286,7 +286,7 @@ TEST_CASE("granagg-lammps charges a K = 5 gas on 2 ranks exactly once per collis
 
 TEST_CASE("granagg-lammps rejects a key LAMMPS cannot honour: exit 2, the key named, nothing "
           "written",
-          "[lammps][mpi]") {
+          "[lammps][mpi][slow]") {
   const fs::path dir = test::tempDir("lammps_bad");
   for (const std::string& set : {std::string("--set coulomb.K=5 --set coulomb.every=8"),
                                  std::string("--set coulomb.K=5 --set coulomb.r_fast=3"),
@@ -392,12 +392,12 @@ std::string chargedGas(const fs::path& dir, int checkpoint_interval) {
 
 }  // namespace
 
-TEST_CASE("granagg-lammps checkpoints change its run only by rounding", "[lammps][mpi]") {
+TEST_CASE("granagg-lammps checkpoints change its run only by rounding", "[lammps][mpi][slow]") {
   // After a checkpoint the run goes on from LAMMPS's setup, which moves atoms between ranks, and
   // atom->f does not follow them; fix granagg/charging puts the forces of the state back there
-  // (kept in its migrating per-atom array). Recomputed there instead, they carry the full-step velocity
-  // in the granular damping, and written from atom->f they belong to other atoms: without the
-  // kept forces the runs below differ by 8 % in v, with them by 1e-14.
+  // (kept in its migrating per-atom array). Recomputed there instead, they carry the full-step
+  // velocity in the granular damping, and written from atom->f they belong to other atoms:
+  // without the kept forces the runs below differ by 8 % in v, with them by 1e-14.
   const fs::path dir = test::tempDir("lammps_checkpoints");
   const std::string t_end = " --set run.t_end=" + common::formatReal(300 * 0.003);
   const Run plain = lammpsRun(2, "--config " + chargedGas(dir, 0) + t_end + " -q --out " +
@@ -450,7 +450,7 @@ TEST_CASE("granagg-lammps checkpoints a gas in contact, from a granagg md frame,
 
 TEST_CASE("granagg-lammps stops on SIGTERM to one rank with a checkpoint, refuses a second "
           "command into its folder, and --restart continues the run",
-          "[lammps][mpi][signal]") {
+          "[lammps][mpi][signal][slow]") {
   const fs::path dir = test::tempDir("lammps_sigterm");
   const std::string cfg = chargedGas(dir, 2000);
   const std::string b = (dir / "b").string();

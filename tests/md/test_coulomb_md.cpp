@@ -66,7 +66,7 @@ TEST_CASE("engine forces with PPPM equal converged plain Ewald plus contacts", "
 }
 
 TEST_CASE("fixed charges and elastic contacts: energy drift below 1e-4 over 1e4 steps",
-          "[md][coulomb]") {
+          "[md][coulomb][slow]") {
   // PPPM (production) over 1e4 steps; plain Ewald (the O(N^2) reference, slow) over 2e3 steps.
   for (const std::string method : {"pppm", "ewald"}) {
     INFO("method " << method);
@@ -129,7 +129,7 @@ TEST_CASE("monopolar charges cool more slowly than Haff's law", "[md][coulomb]")
 
 TEST_CASE(
     "an oppositely charged pair settles at the equilibrium overlap of Coulomb and Hertz forces",
-    "[md][coulomb]") {
+    "[md][coulomb][slow]") {
   // Two particles, charges +1 and -1, released near contact in a large box, K = 5 (the paper's
   // strongest coupling), default Hertz E and D, auto dt: they collide, the damping takes the energy
   // out, and the pair comes to rest where E xi^{3/2} balances the attraction. That balance is the
@@ -232,7 +232,7 @@ TEST_CASE(
 TEST_CASE(
     "multiple time stepping: physical forces, energy conservation at K = 5, and a restart between "
     "evaluations",
-    "[md][coulomb]") {
+    "[md][coulomb][slow]") {
   // (a) the engine's physical force (contact + fast + slow) equals contacts + converged Ewald,
   // with the default coulomb.every = 8 (the split must lose nothing)
   {
@@ -328,7 +328,7 @@ TEST_CASE(
 
 TEST_CASE(
     "multiple time stepping that follows the gas: bounded interval, energy, restart bit for bit",
-    "[md][coulomb]") {
+    "[md][coulomb][slow]") {
   // coulomb.every_max > every: at each evaluation the next interval is floor(k_base v_ref / (2
   // max|u|)) within [k_base, every_max] (Engine.h). impact_speed_max = v_ref = 16 (the time step
   // is fixed, so it sets only this reference) makes the interval vary between 8 and 16 steps in a

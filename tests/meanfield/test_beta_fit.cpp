@@ -175,7 +175,7 @@ TEST_CASE("fit-beta automatic window finds the late plateau of the local slope",
 }
 
 TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S_c and tau_c",
-          "[meanfield][fitbeta]") {
+          "[meanfield][fitbeta][slow]") {
   // 60 samples from t = 0.05 tau_c to S_MF = 2e3 (MD-like: the paper's S range), 3 % log-normal
   // noise, S_c = 1.6, tau_c = 3.7 (t -> t / tau_c: a shift of ln 3.7 in ln t). Without noise the
   // fit returns beta within 0.01 and S_c, tau_c within 0.5 % (the difference between the data's
@@ -223,7 +223,7 @@ TEST_CASE("fit-beta recovers beta 2, 2.5 and 3 from noisy mean-field S(t) with S
 }
 
 TEST_CASE("fit-beta full-curve intervals stay inside the search range, at a bound there is none",
-          "[meanfield][fitbeta]") {
+          "[meanfield][fitbeta][slow]") {
   // Few noisy samples early in the growth (10 samples up to S = 20, 15 % noise): beta is barely
   // determined, and an interval formed in beta itself reached below 0 ("1.50 [-4.36, 7.36]",
   // issue 17). Formed in the logistic parameter of fitCurve it stays inside [1.5, 6]; fits that

@@ -88,7 +88,7 @@ TEST_CASE("discrete solver reproduces the additive-kernel exact solution",
 }
 
 TEST_CASE("discrete solver reproduces the multiplicative-kernel exact solution before gelation",
-          "[meanfield][discrete]") {
+          "[meanfield][discrete][slow]") {
   checkAgainstExact(Kernel::multiplicative(), multiplicativeExact(), {0.2, 0.5, 0.7, 0.8}, 2048,
                     "bdf");
   checkAgainstExact(Kernel::multiplicative(), multiplicativeExact(), {0.2, 0.5}, 300, "bdf-dense");

@@ -240,7 +240,7 @@ TEST_CASE("sectional truncation is reported, never hidden", "[meanfield][section
 }
 
 TEST_CASE("sectional grid grows with S and agrees with a fixed grid that covers the solve",
-          "[meanfield][sectional]") {
+          "[meanfield][sectional][slow]") {
   // The README's example: beta = 3 to t = 1e7 (S ~ 2e11) outgrows the first grid (last pivot
   // 1e12; the distribution's tail reaches it at t ~ 5e6). Reference: one fixed grid up to 1e16,
   // which holds the whole solve. Growing only appends pivots, so both grids discretise the
