@@ -14,6 +14,8 @@
 #                REPEATS=3  THREADS="1 2" (granagg md)  RANKS="1 2" (granagg-lammps, lmp)
 #                EVERY1_THREADS="1" (also granagg md with coulomb.every = 1 on these thread
 #                counts: every force at every step, as LAMMPS integrates; "" skips it)
+#                RESPA_EVERY=4 (charged: also granagg-lammps with coulomb.every = RESPA_EVERY,
+#                run_style respa with the PPPM mesh every RESPA_EVERY steps; "" skips it)
 #                G=build/bin/granagg  GL=build/bin/granagg-lammps
 #                WAIT_LOAD=0.5  WAIT_MAX=300 (wait until the 1-minute load is below WAIT_LOAD,
 #                at most WAIT_MAX seconds, then run anyway and say the load)
@@ -31,7 +33,9 @@
 # - granagg md: the default multiple time stepping (coulomb.every = "auto"), and with
 #   EVERY1_THREADS coulomb.every = 1.
 # - granagg-lammps: the translated input (OUT/lammps.in: gran/hertz/history + coul/long + pppm with
-#   granagg's PPPM design, fix nve/sphere) with fix granagg/charging, every force every step.
+#   granagg's PPPM design, fix nve/sphere) with fix granagg/charging, every force every step;
+#   charged also with RESPA_EVERY (its rate counts steps of granagg's dt: RESPA_EVERY per
+#   LAMMPS step, so that every row advances the same time per particle-step).
 # - plain LAMMPS: that same lammps.in and initial.data, run by Debian's `lmp`, without the line
 #   `fix granagg ...` (nothing else changes: the same PPPM grid, G, cutoff, skin, dt, thermo).
 #   The ratio granagg-lammps / plain LAMMPS on one rank is the overhead of the fix.
@@ -68,6 +72,7 @@ REPEATS=${REPEATS:-3}
 THREADS=${THREADS:-"1 2"}
 RANKS=${RANKS:-"1 2"}
 EVERY1_THREADS=${EVERY1_THREADS-1}
+RESPA_EVERY=${RESPA_EVERY-4}
 G=$(realpath "${G:-build/bin/granagg}")
 GL=$(realpath "${GL:-build/bin/granagg-lammps}")
 WAIT_LOAD=${WAIT_LOAD:-0.5}
@@ -160,6 +165,22 @@ gl_time() {  # case n1 n2 ranks -> seconds of steps n1..n2 (LAMMPS's loop times)
   lammps_loop_seconds "$OUT/run/gl_${c}_$np/log.lammps" 2
 }
 
+gl_respa_time() {  # n1 n2 ranks k -> seconds of steps n1..n2 of dt (charged, coulomb.every = k:
+  # LAMMPS's steps are k dt, chunks of n1 / k of them)
+  local n1=$1 n2=$2 np=$3 k=$4 launch dir=$OUT/run/glr_$3
+  [ $((n1 % k)) -eq 0 ] || { echo "RESPA_EVERY = $k must divide $n1" >&2; exit 2; }
+  mapfile -t launch < <(lmp_launch "$np")
+  # shellcheck disable=SC2046
+  OMP_NUM_THREADS=1 "${launch[@]}" "$GL" --preset paper $(case_sets charged) \
+    $(common_sets $((n1 / k)) "$n2") --set coulomb.every="$k" --out "$dir" --force \
+    > "$OUT/run/glr.log" 2>&1 || { cat "$OUT/run/glr.log" >&2; exit 1; }
+  local steps
+  steps=$(awk '/^Loop time of/ {s += $9} END {print s}' "$dir/log.lammps")
+  [ "$steps" = "$((n2 / k))" ] || { echo "granagg-lammps ran $steps steps, not $((n2 / k))" >&2
+                                     exit 1; }
+  lammps_loop_seconds "$dir/log.lammps" 2
+}
+
 plain_input() {  # case n1 n2 ranks -> $OUT/run/lmp_<case>/in.lammps: the input of granagg-lammps's
   # run on that many ranks (the same for any count) without the fix
   local c=$1 n1=$2 n2=$3 src=$OUT/run/gl_${1}_$4 dst=$OUT/run/lmp_$1
@@ -187,6 +208,8 @@ echo "case,N,code,cores,n1,n2,particle_steps_per_s,per_core,min_over_repeats,max
 declare -A CODE=(
   [lammps]="LAMMPS (plain lmp): the same input without fix granagg/charging; MPI ranks"
   [granagg-lammps]="granagg-lammps: LAMMPS + fix granagg/charging; MPI ranks"
+  [granagg-lammps-respa]="granagg-lammps, coulomb.every = ${RESPA_EVERY:-0} (run_style respa:\
+ PPPM every ${RESPA_EVERY:-0} steps); MPI ranks"
   [granagg-md]="granagg md, coulomb.every = auto (the default); OpenMP threads"
   [granagg-md-every1]="granagg md, coulomb.every = 1; OpenMP threads")
 ROWS=()
@@ -231,12 +254,18 @@ for c in charged neutral; do
     for th in $THREADS; do add "g$th" "$(granagg_time $c "$n1" "$n2" "$th" auto)"; done
     if [ $c = charged ]; then
       for th in $EVERY1_THREADS; do add "g1_$th" "$(granagg_time $c "$n1" "$n2" "$th" 1)"; done
+      if [ -n "$RESPA_EVERY" ]; then
+        for np in $RANKS; do add "glr$np" "$(gl_respa_time "$n1" "$n2" "$np" "$RESPA_EVERY")"; done
+      fi
     fi
     say "  repeat $rep (load $(load1)):" \
       "$(for k in "${!R[@]}"; do printf '%s %s; ' "$k" "${R[$k]}"; done)"
   done
   for np in $RANKS; do row $c lammps "$np" "lmp$np" "$n1" "$n2"; done
   for np in $RANKS; do row $c granagg-lammps "$np" "gl$np" "$n1" "$n2"; done
+  if [ $c = charged ] && [ -n "$RESPA_EVERY" ]; then
+    for np in $RANKS; do row $c granagg-lammps-respa "$np" "glr$np" "$n1" "$n2"; done
+  fi
   for th in $THREADS; do row $c granagg-md "$th" "g$th" "$n1" "$n2"; done
   if [ $c = charged ]; then
     for th in $EVERY1_THREADS; do row $c granagg-md-every1 "$th" "g1_$th" "$n1" "$n2"; done

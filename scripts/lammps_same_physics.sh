@@ -18,6 +18,8 @@
 #                2 cores: a granagg-lammps run is about 1.8e8 particle-steps at 2e5 per second)
 #     --set KEY=VALUE    appended to both engines' configuration (repeatable; e.g. a small test:
 #                        --set system.N=2000 --set run.t_end=20 --set output.frame_interval=5)
+#     --lammps-set KEY=VALUE  appended to granagg-lammps's configuration only (repeatable; e.g.
+#                        --lammps-set coulomb.every=4: rRESPA against granagg md at every step)
 #     --times "A B C"    the comparison times instead of the part's (frames must exist there)
 #     --threads T        granagg md threads (default 2)    --ranks P  granagg-lammps ranks (2)
 #     --include-unfinished  also analyse runs that stopped before run.t_end (each time is then
@@ -45,6 +47,7 @@ THREADS=2
 RANKS=2
 PARTS=()
 SETS=()
+LAMMPS_SETS=()
 TIMES=""
 UNFINISHED=0
 ANALYZE_ONLY=0
@@ -57,6 +60,8 @@ while [ $# -gt 0 ]; do
     --part) case ${2:-} in neutral|charged) PARTS+=("$2") ;;
               *) die "--part must be neutral or charged, not '${2:-}'" ;; esac; shift 2 ;;
     --set) [[ ${2:-} == *=* ]] || die "--set needs KEY=VALUE"; SETS+=(--set "$2"); shift 2 ;;
+    --lammps-set) [[ ${2:-} == *=* ]] || die "--lammps-set needs KEY=VALUE"
+                  LAMMPS_SETS+=(--set "$2"); shift 2 ;;
     --times) TIMES=${2:-}; [ -n "$TIMES" ] || die "--times needs times"; shift 2 ;;
     --threads) THREADS=${2:-}; shift 2 ;;
     --ranks) RANKS=${2:-}; shift 2 ;;
@@ -116,7 +121,7 @@ run_one() {
     else
       # shellcheck disable=SC2207
       cmd=("$MPIRUN" "${ROOT_FLAG[@]}" --oversubscribe -np "$RANKS" "$GL" $(part_args "$part")
-           "${SETS[@]}" --set system.seed="$seed" --out "$dir" --force)
+           "${SETS[@]}" "${LAMMPS_SETS[@]}" --set system.seed="$seed" --out "$dir" --force)
     fi
   fi
   say "$part $engine run $seed: ${cmd[*]}"
@@ -143,7 +148,8 @@ run_one() {
 }
 
 say "granagg: $("$G" --version 2>&1 | head -1); parts: ${PARTS[*]}; $RUNS runs per engine;" \
-    "granagg md on $THREADS threads, granagg-lammps on $RANKS ranks; extra: ${SETS[*]:-none}"
+    "granagg md on $THREADS threads, granagg-lammps on $RANKS ranks; extra: ${SETS[*]:-none};" \
+    "granagg-lammps only: ${LAMMPS_SETS[*]:-none}"
 if [ "$ANALYZE_ONLY" = 0 ]; then
   for part in "${PARTS[@]}"; do
     for seed in $(seq 1 "$RUNS"); do

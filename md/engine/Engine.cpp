@@ -666,6 +666,8 @@ double Engine::chooseTimeStep(const MdConfig& c, std::string* reason) {
   return dt;
 }
 
+double Engine::impactSpeedMax(const MdConfig& config) { return md::impactSpeedMax(config); }
+
 int Engine::coulombEvery(const MdConfig& c, double dt) {
   // multiple time stepping with PPPM only: the plain-Ewald reference has no fast/slow split
   if (c.coulomb.method != "pppm") return 1;

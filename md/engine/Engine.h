@@ -135,6 +135,9 @@ class Engine : public RunEngine {
   /// Steps between evaluations of the slow Coulomb part for a configuration and time step
   /// (coulomb.every, or "auto": every 0.016 time units; 1 for plain Ewald).
   static int coulombEvery(const MdConfig& config, double dt);
+  /// The fastest impact the time step resolves (integrator.impact_speed_max, or "auto": exceeded
+  /// by a fraction 1e-6 of collisions in a Maxwellian gas at the initial temperature).
+  static double impactSpeedMax(const MdConfig& config);
   /// The time step chosen for a configuration (fixed, or auto from the contact time) and why.
   static double chooseTimeStep(const MdConfig& config, std::string* reason = nullptr);
 

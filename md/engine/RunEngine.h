@@ -79,6 +79,8 @@ class RunEngine {
   virtual std::int64_t step() const = 0;
   virtual double time() const = 0;
   virtual double dt() const = 0;
+  /// Why dt is what it is, where the engine says more than Engine::chooseTimeStep (empty: that).
+  virtual std::string dtReason() const { return {}; }
   /// The edge L of the periodic cube.
   virtual double box() const = 0;
   /// The number of particles N (on every rank).

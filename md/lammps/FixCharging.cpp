@@ -17,10 +17,15 @@ Fix* createFixCharging(LAMMPS* lmp, int narg, char** arg) {
   return new FixCharging(lmp, narg, arg);
 }
 
-/// Values per atom that migrate: the saved force and the restart force.
-constexpr int EXCHANGE_SIZE = 6;
-/// Values per atom in a restart file: the count itself and the force.
-constexpr int RESTART_SIZE = 4;
+/// Values per atom that migrate: the saved force, the kept force and the mesh force.
+constexpr int EXCHANGE_SIZE = 9;
+/// Values per atom in a restart file: the count itself, the kept force and the mesh force (a
+/// file with count 4 has no mesh force).
+constexpr int RESTART_SIZE = 7;
+/// The first value of the global restart data: a collision count is never negative, so a
+/// negative first value marks the layout (marker, collisions, respa K); without it the value is
+/// the collision count alone.
+constexpr double RESTART_LAYOUT_2 = -2.0;
 
 }  // namespace
 
@@ -32,7 +37,7 @@ FixCharging::FixCharging(LAMMPS* lmp, int narg, char** arg) : Fix(lmp, narg, arg
   const std::string usage =
       std::string("fix ID group ") + STYLE +
       " pair STYLE seed S Q Q kappa K psi1 MIN MAX psi2 HALF_WIDTH exchange yes|no "
-      "max_overlap X [record yes|no]";
+      "max_overlap X [record yes|no] [respa K]";
   auto number = [&](int k) {
     char* end = nullptr;
     const double v = std::strtod(arg[k], &end);
@@ -84,6 +89,12 @@ FixCharging::FixCharging(LAMMPS* lmp, int narg, char** arg) : Fix(lmp, narg, arg
     } else if (key == "record" && left >= 1) {
       m_record = yesNo(k + 1);
       k += 2;
+    } else if (key == "respa" && left >= 1) {
+      const double loop = number(k + 1);
+      if (!(loop >= 1.0 && loop <= 1000.0) || loop != std::floor(loop))
+        error->all(FLERR, std::string("fix ") + STYLE + ": respa takes an integer K in [1, 1000]");
+      m_respa_loop = static_cast<int>(loop);
+      k += 2;
     } else {
       error->all(FLERR, std::string("fix ") + STYLE + ": unknown or incomplete keyword '" + key +
                             "'; usage: " + usage);
@@ -105,7 +116,8 @@ FixCharging::FixCharging(LAMMPS* lmp, int narg, char** arg) : Fix(lmp, narg, arg
   atom->add_callback(Atom::GROW);
   atom->add_callback(Atom::RESTART);
   for (int i = 0; i < atom->nmax; ++i)
-    for (int k = 0; k < 3; ++k) m_fprev[i][k] = m_vpred[i][k] = m_frestart[i][k] = 0.0;
+    for (int k = 0; k < 3; ++k)
+      m_fprev[i][k] = m_vpred[i][k] = m_frestart[i][k] = m_fslow[i][k] = 0.0;
 }
 
 FixCharging::~FixCharging() {
@@ -115,9 +127,13 @@ FixCharging::~FixCharging() {
   memory->destroy(m_vpred);
   memory->destroy(m_dq);
   memory->destroy(m_frestart);
+  memory->destroy(m_fslow);
 }
 
 int FixCharging::setmask() {
+  if (m_respa_loop > 1)
+    return FixConst::POST_INTEGRATE_RESPA | FixConst::PRE_FORCE_RESPA |
+           FixConst::POST_FORCE_RESPA | FixConst::PRE_REVERSE;
   return FixConst::POST_INTEGRATE | FixConst::PRE_FORCE | FixConst::END_OF_STEP;
 }
 
@@ -130,8 +146,19 @@ void FixCharging::init() {
     error->all(FLERR, me + " needs newton_pair on (each pair on one rank)");
   if (!comm->ghost_velocity)
     error->all(FLERR, me + " needs comm_modify vel yes (ghost velocities)");
-  if (std::strcmp(update->integrate_style, "verlet") != 0)
-    error->all(FLERR, me + " supports run_style verlet only");
+  const bool respa = std::strncmp(update->integrate_style, "respa", 5) == 0;
+  if (m_respa_loop > 1 && !respa)
+    error->all(FLERR, me + " with respa " + std::to_string(m_respa_loop) +
+                          " needs run_style respa 2 " + std::to_string(m_respa_loop) +
+                          " pair 1 kspace 2");
+  if (m_respa_loop == 1 && std::strcmp(update->integrate_style, "verlet") != 0)
+    error->all(FLERR, me + " without respa K supports run_style verlet only");
+  // forces kept by a run with another integration are not this one's levels: recomputed
+  if (m_restart_loop != m_respa_loop) {
+    m_restore_forces = false;
+    m_restart_loop = m_respa_loop;
+  }
+  m_inner_steps = 0;
   m_pair = force->pair_match(m_pair_style, 1, 0);
   if (!m_pair) error->all(FLERR, me + ": no pair style " + m_pair_style + " is defined");
   // granagg's particles: unit spheres of unit mass (the charging rule's m_eff = 1/2, and the
@@ -153,7 +180,8 @@ void FixCharging::init() {
 void FixCharging::keepForcesForRestart() {
   // Not before the first run (no forces yet), nor over forces read from a restart file that no
   // run has restored yet.
-  if (!update->first_update || m_restore_forces) return;
+  // Under rRESPA the forces of each level are kept at every step and every setup.
+  if (m_respa_loop > 1 || !update->first_update || m_restore_forces) return;
   double** f = atom->f;
   for (int i = 0; i < atom->nlocal; ++i)
     for (int k = 0; k < 3; ++k) m_frestart[i][k] = f[i][k];
@@ -161,6 +189,7 @@ void FixCharging::keepForcesForRestart() {
 }
 
 void FixCharging::setup(int /*vflag*/) {
+  if (m_respa_loop > 1) return;  // restored per level (setup_pre_reverse)
   if (!(m_restore_forces || restart_reset)) return;
   // the forces of the step the restart was written at, in place of setup's recomputed ones
   double** f = atom->f;
@@ -179,20 +208,97 @@ void FixCharging::post_integrate() {
 
 void FixCharging::setup_pre_force(int /*vflag*/) {
   // the contact statistics of the state a run starts from (no step is taken: no collisions)
-  scanContacts(false);
+  scanContacts(false, update->dt, update->ntimestep, 0.0);
 }
 
-void FixCharging::pre_force(int /*vflag*/) { scanContacts(true); }
+void FixCharging::pre_force(int /*vflag*/) {
+  scanContacts(true, update->dt, update->ntimestep, 0.0);
+}
 
-void FixCharging::scanContacts(bool step_taken) {
+void FixCharging::setup_pre_force_respa(int /*vflag*/, int ilevel) {
+  m_setup_level = ilevel;
+  if (ilevel == 0) scanContacts(false, update->dt / m_respa_loop, update->ntimestep, 0.0);
+}
+
+void FixCharging::setup_pre_reverse(int /*eflag*/, int /*vflag*/) {
+  if (m_respa_loop == 1) return;
+  // The forces of level m_setup_level, before LAMMPS's reverse communication and its copy into
+  // the level's store. Kept forces replace them: the owned atoms get them and the ghosts zero,
+  // so that the reverse communication adds nothing. Otherwise (a new run's first setup) they
+  // are the state's forces: completed here by the reverse communication (the ghosts are then
+  // zeroed, so that LAMMPS's adds nothing again) and kept.
+  double** f = atom->f;
+  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
+  double** kept = m_setup_level == 0 ? m_frestart : m_fslow;
+  if (m_restore_forces) {
+    for (int i = 0; i < nlocal; ++i)
+      for (int k = 0; k < 3; ++k) f[i][k] = kept[i][k];
+  } else {
+    if (m_setup_level == 0) comm->reverse_comm();
+    for (int i = 0; i < nlocal; ++i)
+      for (int k = 0; k < 3; ++k) kept[i][k] = f[i][k];
+  }
+  for (int i = nlocal; i < nall; ++i)
+    for (int k = 0; k < 3; ++k) f[i][k] = 0.0;
+  if (m_setup_level == 1) {
+    m_restore_forces = true;  // both levels kept: every later setup restores them
+    restart_reset = 0;
+  }
+}
+
+void FixCharging::post_integrate_respa(int ilevel, int /*iloop*/) {
+  if (ilevel == 0) post_integrate();  // f_in(t_{n-1}), which kicked the drift velocities
+}
+
+void FixCharging::pre_force_respa(int /*vflag*/, int ilevel, int iloop) {
+  const std::string me = std::string("fix ") + STYLE;
+  if (ilevel == 0) {
+    if (iloop >= m_respa_loop)
+      error->all(FLERR, me + ": run_style respa takes more than respa " +
+                            std::to_string(m_respa_loop) + " inner steps per outer step");
+    ++m_inner_steps;
+    const double dt = update->dt / m_respa_loop;
+    const std::int64_t step =
+        (static_cast<std::int64_t>(update->ntimestep) - 1) * m_respa_loop + iloop + 1;
+    const double slow_kick = iloop == m_respa_loop - 1 ? 0.5 * update->dt * force->ftm2v : 0.0;
+    scanContacts(true, dt, step, slow_kick);
+  } else if (ilevel == 1) {
+    if (m_inner_steps != m_respa_loop)
+      error->all(FLERR, me + ": run_style respa took " + std::to_string(m_inner_steps) +
+                            " inner steps in an outer step; respa " +
+                            std::to_string(m_respa_loop) + " says how many it must take");
+    m_inner_steps = 0;
+    // sum q and sum q^2 of the charges the mesh force is about to use (self and background
+    // terms, and PPPM's estimates)
+    if (m_exchange && force->kspace) force->kspace->qsum_qsq(0);
+  } else {
+    error->all(FLERR, me + " supports two rRESPA levels (pair 1 kspace 2)");
+  }
+}
+
+void FixCharging::post_force_respa(int /*vflag*/, int ilevel, int iloop) {
+  const double* const* f = atom->f;  // this level's force, complete for the owned atoms
+  const int nlocal = atom->nlocal;
+  if (ilevel == 0) {
+    applyExchange();
+    if (iloop == m_respa_loop - 1)  // the inner force of the state at the outer boundary
+      for (int i = 0; i < nlocal; ++i)
+        for (int k = 0; k < 3; ++k) m_frestart[i][k] = f[i][k];
+  } else if (ilevel == 1) {
+    for (int i = 0; i < nlocal; ++i)
+      for (int k = 0; k < 3; ++k) m_fslow[i][k] = f[i][k];
+    m_restore_forces = true;
+  }
+}
+
+void FixCharging::scanContacts(bool step_taken, double dt, std::int64_t step,
+                               double slow_kick) {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
   double** x = atom->x;
   double** v = atom->v;
   const double* radius = atom->radius;
   const double* rmass = atom->rmass;
   const tagint* tag = atom->tag;
-  const double dt = update->dt;
-  const std::int64_t step = update->ntimestep;
 
   const bool exchange = m_exchange && step_taken;
   if (exchange) {
@@ -202,6 +308,10 @@ void FixCharging::scanContacts(bool step_taken) {
     for (int i = 0; i < nlocal; ++i) {
       const double dtfm = dtf / rmass[i];
       for (int k = 0; k < 3; ++k) m_vpred[i][k] = v[i][k] + dtfm * m_fprev[i][k];
+      if (slow_kick != 0.0) {
+        const double sm = slow_kick / rmass[i];
+        for (int k = 0; k < 3; ++k) m_vpred[i][k] += sm * m_fslow[i][k];
+      }
     }
     comm->forward_comm_fix(this);  // ghosts: predicted velocities and current charges
     for (int i = 0; i < nall; ++i) m_dq[i] = 0.0;
@@ -275,18 +385,24 @@ void FixCharging::scanContacts(bool step_taken) {
 
 void FixCharging::end_of_step() {
   if (!m_exchange) return;
+  applyExchange();
+  // sum q and sum q^2 enter the k-space energy (self and background terms) and its estimates
+  if (force->kspace) force->kspace->qsum_qsq(0);
+}
+
+void FixCharging::applyExchange() {
+  if (!m_exchange) return;
   // the exchange of this step takes effect after its forces (the engine's kick applies it)
   double* q = atom->q;
   for (int i = 0; i < atom->nlocal; ++i)
     if (m_dq[i] != 0.0) q[i] += m_dq[i];
-  // sum q and sum q^2 enter the k-space energy (self and background terms) and its estimates
-  if (force->kspace) force->kspace->qsum_qsq(0);
 }
 
 void FixCharging::grow_arrays(int nmax) {
   memory->grow(m_fprev, nmax, 3, "granagg/charging:fprev");
   memory->grow(m_vpred, nmax, 3, "granagg/charging:vpred");
   memory->grow(m_frestart, nmax, 3, "granagg/charging:frestart");
+  memory->grow(m_fslow, nmax, 3, "granagg/charging:fslow");
   memory->grow(m_dq, nmax, "granagg/charging:dq");
   m_nmax = nmax;
 }
@@ -295,6 +411,7 @@ void FixCharging::copy_arrays(int i, int j, int /*delflag*/) {
   for (int k = 0; k < 3; ++k) {
     m_fprev[j][k] = m_fprev[i][k];
     m_frestart[j][k] = m_frestart[i][k];
+    m_fslow[j][k] = m_fslow[i][k];
   }
 }
 
@@ -302,6 +419,7 @@ int FixCharging::pack_exchange(int i, double* buf) {
   for (int k = 0; k < 3; ++k) {
     buf[k] = m_fprev[i][k];
     buf[3 + k] = m_frestart[i][k];
+    buf[6 + k] = m_fslow[i][k];
   }
   return EXCHANGE_SIZE;
 }
@@ -310,6 +428,7 @@ int FixCharging::unpack_exchange(int nlocal, double* buf) {
   for (int k = 0; k < 3; ++k) {
     m_fprev[nlocal][k] = buf[k];
     m_frestart[nlocal][k] = buf[3 + k];
+    m_fslow[nlocal][k] = buf[6 + k];
   }
   ++m_migrations;
   return EXCHANGE_SIZE;
@@ -319,9 +438,13 @@ int FixCharging::pack_restart(int i, double* buf) {
   // the forces of the state: in the migrating array while a restore is pending (init() between
   // runs, or a restart file read and not yet run), else atom->f (the `restart` command's output
   // during a run, where atoms have not moved since the forces)
+  // (rRESPA: the kept forces of both levels, always current after a setup)
   const double* f = m_restore_forces ? m_frestart[i] : atom->f[i];
   buf[0] = RESTART_SIZE;
-  for (int k = 0; k < 3; ++k) buf[1 + k] = f[k];
+  for (int k = 0; k < 3; ++k) {
+    buf[1 + k] = f[k];
+    buf[4 + k] = m_respa_loop > 1 ? m_fslow[i][k] : 0.0;
+  }
   return RESTART_SIZE;
 }
 
@@ -330,8 +453,12 @@ void FixCharging::unpack_restart(int nlocal, int nth) {
   double** extra = atom->extra;
   int m = 0;
   for (int i = 0; i < nth; ++i) m += static_cast<int>(extra[nlocal][m]);
+  const int count = static_cast<int>(extra[nlocal][m]);
   ++m;
-  for (int k = 0; k < 3; ++k) m_frestart[nlocal][k] = extra[nlocal][m + k];
+  for (int k = 0; k < 3; ++k) {
+    m_frestart[nlocal][k] = extra[nlocal][m + k];
+    m_fslow[nlocal][k] = count >= RESTART_SIZE ? extra[nlocal][m + 3 + k] : 0.0;
+  }
   m_restore_forces = true;
 }
 
@@ -339,18 +466,27 @@ int FixCharging::size_restart(int /*nlocal*/) { return RESTART_SIZE; }
 int FixCharging::maxsize_restart() { return RESTART_SIZE; }
 
 void FixCharging::write_restart(FILE* fp) {
-  const double total = static_cast<double>(stats().collisions);  // collective
+  const double data[3] = {RESTART_LAYOUT_2, static_cast<double>(stats().collisions),
+                          static_cast<double>(m_respa_loop)};  // (stats(): collective)
   if (comm->me == 0) {
-    const int size = sizeof(double);
+    const int size = sizeof data;
     std::fwrite(&size, sizeof(int), 1, fp);
-    std::fwrite(&total, sizeof(double), 1, fp);
+    std::fwrite(data, sizeof(double), 3, fp);
   }
 }
 
 void FixCharging::restart(char* buf) {
-  double total = 0.0;
-  std::memcpy(&total, buf, sizeof total);
-  m_collisions_restart = static_cast<std::int64_t>(total);
+  double first = 0.0;
+  std::memcpy(&first, buf, sizeof first);
+  if (first == RESTART_LAYOUT_2) {
+    double rest[2];
+    std::memcpy(rest, buf + sizeof first, sizeof rest);
+    m_collisions_restart = static_cast<std::int64_t>(rest[0]);
+    m_restart_loop = static_cast<int>(rest[1]);
+  } else {
+    m_collisions_restart = static_cast<std::int64_t>(first);
+    m_restart_loop = 1;
+  }
   m_collisions_local = 0;
 }
 
@@ -390,7 +526,7 @@ void FixCharging::unpack_reverse_comm(int n, int* list, double* buf) {
 }
 
 double FixCharging::memory_usage() {
-  return static_cast<double>(m_nmax) * 10.0 * sizeof(double) +
+  return static_cast<double>(m_nmax) * 13.0 * sizeof(double) +
          static_cast<double>(m_records.capacity()) * sizeof(CollisionRecord);
 }
 

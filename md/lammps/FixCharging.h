@@ -7,13 +7,15 @@
 /// command (what PLUGIN does inside).
 ///
 ///     fix ID all granagg/charging pair STYLE seed S Q Q kappa K psi1 MIN MAX psi2 HALF_WIDTH
-///         exchange yes|no max_overlap X [record yes|no]
+///         exchange yes|no max_overlap X [record yes|no] [respa K]
 ///
 /// pair: the granular pair style whose neighbour list holds the contacts (gran/hertz/history,
 /// gran/hooke/history, possibly a sub-style of hybrid/overlay); the rest are ChargeExchange's
 /// parameters (psi2 = psi2_fraction kappa) and run.max_overlap. exchange no: charges never change
 /// (charging.mode = "fixed"), collisions and contacts are still counted. record yes: every
 /// collision is kept (step, ids, xi', charge gained by the lower id) for collisionRecords().
+/// respa K: the run uses `run_style respa 2 K pair 1 kspace 2` (below); default 1, run_style
+/// verlet.
 ///
 /// What it does, matching the engine (md/compute/ContactForce.h) step by step. LAMMPS's velocity
 /// Verlet (fix nve/sphere) runs a step as: kick + drift (initial_integrate), post_integrate,
@@ -51,9 +53,30 @@
 /// per-atom array that migrates, and the next run's setup puts them back in the writing process
 /// too (that run must not be `pre no`: the neighbour lists are stale after the move).
 ///
+/// rRESPA (respa K > 1): `run_style respa 2 K pair 1 kspace 2` integrates the pair forces
+/// (contacts and the real-space Coulomb force, r < r_cut) with the inner step dt = Dt / K and
+/// the PPPM mesh force with the outer step Dt (LAMMPS's `timestep`), as impulses of Dt at the
+/// outer boundaries: the impulse multiple-time-step method of granagg md (docs/coulomb.md),
+/// split at r_cut. LAMMPS then calls only the fixes' *_respa methods, and this fix does at the
+/// inner level what it does at every step under verlet:
+/// - post_integrate_respa: keeps the inner force f_in(t_{n-1}) that kicked the drift velocities;
+/// - pre_force_respa: the contact pass, with the inner step dt for the collision test and the
+///   charge-exchange counter n = (outer step - 1) K + inner index + 1: the inner steps counted
+///   from the initial state, as granagg md counts its steps;
+/// - post_force_respa: the exchange takes effect, after the inner forces of the step.
+/// The predicted velocity is u + (dt/2) f_in(t_{n-1}), plus at the last inner step of an outer
+/// step the half impulse (Dt/2) F_mesh that closes it: granagg md's prediction at an evaluation
+/// step (ContactStep::ext_predict_scale), except that F_mesh is the last evaluation's (the new
+/// one is computed after the inner steps). Under rRESPA every `run` starts with LAMMPS's full
+/// setup (`pre no` is refused), which recomputes the forces of each level from v(t_n); the fix
+/// keeps each level's force of the state (f_in at the last inner step, F_mesh at the outer
+/// level) and puts them back in the setup (setup_pre_reverse), so that a chunked or restarted
+/// run takes the same kicks as an uninterrupted one.
+///
 /// Requirements checked at init: atom_style with q, radius and rmass; unit spheres of unit mass
 /// (granagg's particles: the charging rule's m_eff = 1/2); newton_pair on; comm_modify vel yes;
-/// run_style verlet.
+/// run_style verlet, or respa with respa K (2 levels, K inner steps: checked at the first outer
+/// step).
 #include <cstdint>
 #include <vector>
 
@@ -97,6 +120,12 @@ class FixCharging : public LAMMPS_NS::Fix {
   void setup_pre_force(int vflag) override;
   void pre_force(int vflag) override;
   void end_of_step() override;
+  // rRESPA (respa K > 1)
+  void setup_pre_force_respa(int vflag, int ilevel) override;
+  void setup_pre_reverse(int eflag, int vflag) override;
+  void post_integrate_respa(int ilevel, int iloop) override;
+  void pre_force_respa(int vflag, int ilevel, int iloop) override;
+  void post_force_respa(int vflag, int ilevel, int iloop) override;
 
   void grow_arrays(int nmax) override;
   void copy_arrays(int i, int j, int delflag) override;
@@ -123,6 +152,8 @@ class FixCharging : public LAMMPS_NS::Fix {
   const std::vector<CollisionRecord>& collisionRecords() const { return m_records; }
   void clearCollisionRecords() { m_records.clear(); }
   const ChargeExchange::Params& params() const { return m_params; }
+  /// Inner steps per outer step (respa K; 1 under run_style verlet).
+  int respaLoop() const { return m_respa_loop; }
   bool exchanges() const { return m_exchange; }
   /// Between runs, before `write_restart ... noinit`: keeps the forces of the state in the
   /// per-atom array that the restart file stores (pack_restart) and the next run's setup puts
@@ -134,6 +165,10 @@ class FixCharging : public LAMMPS_NS::Fix {
   bool m_exchange = true;
   bool m_record = false;
   double m_max_overlap = 0.6;
+  int m_respa_loop = 1;     ///< respa K
+  int m_restart_loop = 1;   ///< the respa K of the run that wrote the restart file read
+  int m_setup_level = 0;    ///< the level whose forces LAMMPS's rRESPA setup is computing
+  int m_inner_steps = 0;    ///< inner steps taken in the current outer step
   std::string m_pair_style;
   LAMMPS_NS::Pair* m_pair = nullptr;
 
@@ -141,9 +176,11 @@ class FixCharging : public LAMMPS_NS::Fix {
   double** m_fprev = nullptr;     ///< f(t_{n-1}), saved at post_integrate (owned; migrates)
   double** m_vpred = nullptr;     ///< predicted v(t_n) (owned, then ghosts by forward comm)
   double* m_dq = nullptr;         ///< charge gained this step (owned and ghost, reverse comm)
-  double** m_frestart = nullptr;  ///< forces read from a restart file (owned; migrates)
+  double** m_frestart = nullptr;  ///< the state's (inner) force kept for a setup (owned; migrates)
+  double** m_fslow = nullptr;     ///< rRESPA: the last outer (mesh) force (owned; migrates)
   int m_nmax = 0;
-  bool m_restore_forces = false;  ///< m_frestart holds forces to put back at the next setup
+  bool m_restore_forces = false;  ///< m_frestart (and m_fslow) hold forces to put back at the
+                                  ///< next setup
 
   // local (this rank's) statistics of the last step and counters
   std::int64_t m_collisions_local = 0;  ///< cumulative, this rank
@@ -152,8 +189,12 @@ class FixCharging : public LAMMPS_NS::Fix {
   double m_overlap_sum = 0.0, m_max_overlap_now = 0.0, m_sum_xi52 = 0.0, m_sum_xi2 = 0.0;
   std::vector<CollisionRecord> m_records;
   /// The pass over the contacts: statistics and the overlap guard; with step_taken (pre_force
-  /// of a step, not a run's setup) also the collisions and their exchange.
-  void scanContacts(bool step_taken);
+  /// of a step, not a run's setup) also the collisions and their exchange. dt: the step just
+  /// taken (the inner step under rRESPA); step: the charge-exchange counter; slow_kick: the
+  /// factor of m_fslow in the predicted velocity (rRESPA's closing half impulse, else 0).
+  void scanContacts(bool step_taken, double dt, std::int64_t step, double slow_kick);
+  /// The exchange of the step takes effect (owned atoms; ghosts follow by forward communication).
+  void applyExchange();
 };
 
 }  // namespace granagg::md::lammps

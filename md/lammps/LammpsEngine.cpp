@@ -82,6 +82,7 @@ void broadcast(LammpsInput& in, MPI_Comm comm) {
   broadcast(steps, comm);
   int coulomb = in.coulomb ? 1 : 0;
   broadcast(coulomb, comm);
+  broadcast(in.respa_loop, comm);
   CoulombSetup& cs = in.coulomb_setup;
   broadcast(cs.method, comm);
   double reals[5] = {cs.alpha, cs.r_cut, cs.estimated_error, cs.sum_q2_design, cs.r_fast};
@@ -272,7 +273,10 @@ void LammpsEngine::run(std::int64_t steps) {
   // LAMMPS's run takes an int: chunks of at most 1e9 steps
   while (steps > 0) {
     const std::int64_t n = std::min<std::int64_t>(steps, 1000000000);
-    m_lmp->input->one("run " + std::to_string(n) + " pre no post no");
+    // (rRESPA refuses `pre no`: each run starts with its full setup, in which the fix puts the
+    // kept forces of the state back, FixCharging.h)
+    m_lmp->input->one("run " + std::to_string(n) +
+                      (m_input.respa_loop > 1 ? " post no" : " pre no post no"));
     steps -= n;
   }
 }

@@ -14,7 +14,10 @@
 ///   LAMMPS logs to log.lammps (appended on a restart), runs the input and `run 0` (the setup:
 ///   forces and energies of the first state).
 /// - run(n): `run n pre no post no`. No setup between chunks, so chunks change no result: the
-///   chunked run is bit-identical to one `run`.
+///   chunked run is bit-identical to one `run`. Under rRESPA (coulomb.every > 1, LammpsInput.h)
+///   LAMMPS refuses `pre no`: `run n post no`, whose setup recomputes the forces, and the fix
+///   puts the kept forces of each level back (FixCharging.h). Steps and dt are LAMMPS's outer
+///   steps there; frames and checkpoints fall on them.
 /// - frame(), forces(): gathered to rank 0 in id order (below). observables(): sums over ranks
 ///   (MPI_Allreduce) and the fix's contact statistics; the Coulomb energy is LAMMPS's
 ///   (pair coul/long + kspace, `pe`).
@@ -101,7 +104,9 @@ class LammpsEngine : public RunEngine {
   void run(std::int64_t steps) override;
   std::int64_t step() const override;
   double time() const override { return static_cast<double>(step()) * m_input.dt; }
+  /// LAMMPS's timestep: granagg's dt, or under rRESPA the outer step (LammpsInput.h).
   double dt() const override { return m_input.dt; }
+  std::string dtReason() const override { return m_input.dt_reason; }
   double box() const override { return m_box; }
   std::size_t size() const override { return m_N; }
   /// Wrapped positions with image counts, velocities and charges, in id order, on rank 0.

@@ -24,6 +24,22 @@ constexpr double UNIT_DENSITY = 6.0 / M_PI;
   throw std::invalid_argument(key + " = " + value + " cannot run on LAMMPS: " + why);
 }
 
+/// Inner steps per outer step: coulomb.every when set above 1 with Coulomb forces (rRESPA),
+/// else 1 ("auto" keeps every force at every step on LAMMPS, the path the same-physics
+/// ensembles validate).
+int respaLoop(const MdConfig& c) {
+  return c.coulomb.K > 0.0 && c.coulomb.every > 1 ? c.coulomb.every : 1;
+}
+
+/// LAMMPS's one neighbour skin. Under rRESPA LAMMPS checks the list only at outer steps, where a
+/// particle at the fastest impact speed moves k dt instead of dt between checks: the skin grows
+/// by twice the extra distance, 2 v_max (k - 1) dt, which keeps the margin of the checked-every-
+/// step list (md/neighbor/Skin.h).
+double lammpsSkin(const MdConfig& c, double dt) {
+  const int k = respaLoop(c);
+  return c.neighbor.skinCap() + 2.0 * Engine::impactSpeedMax(c) * (k - 1) * dt;
+}
+
 }  // namespace
 
 void checkLammpsCanRun(const MdConfig& c) {
@@ -32,21 +48,24 @@ void checkLammpsCanRun(const MdConfig& c) {
     if (cc.method != "pppm")
       cannot("coulomb.method", "\"" + cc.method + "\"",
              "granagg-lammps runs LAMMPS's PPPM; use coulomb.method = \"pppm\"");
-    if (cc.every > 1)
-      cannot("coulomb.every", std::to_string(cc.every),
-             "granagg-lammps evaluates every force at every step (run_style verlet; granagg's "
-             "multiple time stepping is not translated); use 1 or \"auto\"");
     if (cc.every_max > 1)
       cannot("coulomb.every_max", std::to_string(cc.every_max),
              "LAMMPS has no Coulomb interval that follows the gas; use 1 or \"auto\"");
     if (cc.r_fast > 0.0)
       cannot("coulomb.r_fast", formatReal(cc.r_fast),
-             "granagg-lammps has no near/far split of the Coulomb force (every force at every "
-             "step); use \"auto\"");
-    if (cc.skin > 0.0 && cc.skin != c.neighbor.skinCap())
-      cannot("coulomb.skin", formatReal(cc.skin),
-             "LAMMPS has one neighbour skin for all lists, neighbor.skin = " +
-                 formatReal(c.neighbor.skinCap()) + "; use \"auto\" or that value");
+             cc.every > 1 ? "LAMMPS's rRESPA splits the Coulomb force at the real-space cutoff "
+                            "(pair forces every step, the PPPM mesh every coulomb.every steps); "
+                            "use \"auto\""
+                          : "granagg-lammps has no near/far split of the Coulomb force (every "
+                            "force at every step); use \"auto\"");
+    if (cc.skin > 0.0) {
+      const double skin = lammpsSkin(c, Engine::chooseTimeStep(c));
+      if (cc.skin != skin)
+        cannot("coulomb.skin", formatReal(cc.skin),
+               "LAMMPS has one neighbour skin for all lists, " + formatReal(skin) +
+                   (respaLoop(c) > 1 ? " (neighbor.skin grown for rRESPA)" : " (neighbor.skin)") +
+                   "; use \"auto\" or that value");
+    }
   }
 }
 
@@ -70,7 +89,9 @@ LammpsInput translate(const MdConfig& c, std::size_t N, double L, double sum_q2_
                                 "quotes (LAMMPS reads it as a word): " + file);
   LammpsInput in;
   auto& cmd = in.commands;
-  const double skin = c.neighbor.skinCap();
+  const double dt = Engine::chooseTimeStep(c, &in.dt_reason);
+  const double skin = lammpsSkin(c, dt);
+  in.respa_loop = respaLoop(c);
 
   if (!restart) {
     cmd.push_back("units lj");
@@ -117,7 +138,14 @@ LammpsInput translate(const MdConfig& c, std::size_t N, double L, double sum_q2_
     s << "coulomb: PPPM as granagg designs it for coulomb.accuracy = " << c.coulomb.accuracy
       << ": alpha = " << d.pppm.alpha << ", r_cut = " << d.pppm.r_cut << ", mesh " << d.pppm.mesh
       << "^3, order " << d.pppm.order << " (estimated relative error " << d.setup.estimated_error
-      << "); every force at every step (coulomb.every = 1)";
+      << ")";
+    if (in.respa_loop > 1)
+      s << "; rRESPA: pair forces (contacts, real-space Coulomb r < r_cut) at every inner step "
+        << dt << ", the PPPM mesh force every " << in.respa_loop << " steps (outer step "
+        << in.respa_loop * dt << "); neighbour skin " << skin << " = neighbor.skin + 2 v_max ("
+        << in.respa_loop << " - 1) dt (LAMMPS checks the list at outer steps only)";
+    else
+      s << "; every force at every step (coulomb.every = 1)";
     in.notes.push_back(s.str());
   } else {
     cmd.push_back("pair_style " + gran);
@@ -137,9 +165,16 @@ LammpsInput translate(const MdConfig& c, std::size_t N, double L, double sum_q2_
                       (q.mode == "exchange" ? "yes" : "no") + " max_overlap " +
                       formatReal(c.run.max_overlap);
     if (record_collisions) fix += " record yes";
+    if (in.respa_loop > 1) fix += " respa " + std::to_string(in.respa_loop);
     cmd.push_back(fix);
   }
-  in.dt = Engine::chooseTimeStep(c, &in.dt_reason);
+  // LAMMPS's timestep is the outer step: under rRESPA k inner steps of dt
+  in.dt = in.respa_loop * dt;
+  if (in.respa_loop > 1) {
+    cmd.push_back("run_style respa 2 " + std::to_string(in.respa_loop) + " pair 1 kspace 2");
+    in.dt_reason += "; rRESPA outer step " + std::to_string(in.respa_loop) + " x " +
+                    formatReal(dt) + " = " + formatReal(in.dt);
+  }
   in.steps = static_cast<std::int64_t>(std::llround(c.run.t_end / in.dt));
   cmd.push_back("timestep " + formatReal(in.dt));
   cmd.push_back("thermo_style custom step time temp pe");

@@ -24,6 +24,11 @@
 /// - Charging, collision count, run.max_overlap: `fix granagg/charging` (FixCharging.h).
 /// - Integration: `fix nve/sphere`, `timestep` = Engine::chooseTimeStep, `comm_modify vel yes`,
 ///   `newton on`, neighbour skin neighbor.skin (auto: 0.3), checked every step.
+/// - coulomb.every = k > 1 (Coulomb forces): `run_style respa 2 k pair 1 kspace 2`, LAMMPS's
+///   impulse multiple time stepping split at r_cut: contacts and real-space Coulomb every step
+///   dt, the PPPM mesh every k steps; `timestep` is the outer step k dt, the fix is told
+///   `respa k`, and the skin grows to cover k steps between list checks (docs/lammps.md).
+///   "auto" stays at every force at every step (run_style verlet).
 ///
 /// What LAMMPS cannot honour is an error naming the key (checkLammpsCanRun); "auto" values that
 /// select a granagg-only method resolve to what LAMMPS does, and the notes say so.
@@ -43,9 +48,10 @@ inline constexpr const char* CHARGING_FIX_ID = "granagg";
 /// A configuration translated for LAMMPS.
 struct LammpsInput {
   std::vector<std::string> commands;  ///< everything before the run, in order
-  double dt = 0.0;
+  double dt = 0.0;           ///< LAMMPS's timestep: the outer step respa_loop x granagg's dt
+  int respa_loop = 1;        ///< inner steps per outer step (run_style respa; 1: verlet)
   std::string dt_reason;     ///< as Engine::chooseTimeStep says
-  std::int64_t steps = 0;    ///< llround(run.t_end / dt), as granagg md
+  std::int64_t steps = 0;    ///< llround(run.t_end / dt), as granagg md (outer steps)
   std::string pair_style;    ///< the granular pair style (FixCharging's `pair`)
   bool coulomb = false;      ///< coulomb.K > 0
   CoulombSetup coulomb_setup;  ///< coulomb: what granagg's design chose
@@ -57,8 +63,8 @@ struct LammpsInput {
 };
 
 /// Throws std::invalid_argument naming the first key whose value LAMMPS cannot honour (a
-/// method only granagg has, set explicitly): coulomb.every > 1, coulomb.every_max > 1,
-/// coulomb.r_fast, coulomb.skin other than the neighbour skin, coulomb.method = "ewald".
+/// method only granagg has, set explicitly): coulomb.every_max > 1, coulomb.r_fast,
+/// coulomb.skin other than LAMMPS's neighbour skin, coulomb.method = "ewald".
 void checkLammpsCanRun(const MdConfig& config);
 
 /// The input for `config` from `state` (as md::prepareInitialState gives it), stored as the data

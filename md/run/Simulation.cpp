@@ -47,6 +47,7 @@ struct Simulation::Impl {
     engine = std::move(e);
     engine->enableProfile(options.profile);
     Engine::chooseTimeStep(cfg, &dt_reason);
+    if (std::string why = engine->dtReason(); !why.empty()) dt_reason = std::move(why);
     last = static_cast<std::int64_t>(std::llround(cfg.run.t_end / engine->dt()));
     std::vector<std::int64_t> frames = Simulation::frameSteps(cfg, engine->dt(), last);
     const auto next_frame = static_cast<std::size_t>(

@@ -78,6 +78,38 @@ TEST_CASE("lammps input maps the spring-dashpot contact to gran/hooke/history", 
   CHECK(it->find("limit_damping") == std::string::npos);
 }
 
+TEST_CASE("lammps input translates coulomb.every = k to rRESPA: pair every dt, PPPM every k dt",
+          "[lammps]") {
+  const MdConfig c = config({"coulomb.K=5", "coulomb.every=4", "integrator.dt=0.002",
+                             "run.t_end=10"});
+  const auto in = lammps::translateConfig(c, randomInitialState(c), "/tmp/x.data");
+  CHECK(has(in, "run_style respa 2 4 pair 1 kspace 2"));
+  CHECK(in.respa_loop == 4);
+  CHECK(in.dt == 4 * 0.002);  // LAMMPS's timestep: the outer step
+  CHECK(has(in, "timestep " + common::formatReal(4 * 0.002)));
+  CHECK(in.steps == 1250);  // outer steps to t_end
+  bool respa_fix = false;
+  for (const auto& cmd : in.commands)
+    if (cmd.rfind("fix granagg all granagg/charging", 0) == 0)
+      respa_fix = cmd.size() > 8 && cmd.compare(cmd.size() - 8, 8, " respa 4") == 0;
+  CHECK(respa_fix);
+  // the skin covers 4 steps between list checks at the fastest impact speed (sqrt(4 ln 1e6) at
+  // T = 1): 0.3 + 2 x 7.43384 x 3 x 0.002
+  const double skin = 0.3 + 2.0 * std::sqrt(4.0 * std::log(1e6)) * 3 * 0.002;
+  CHECK(has(in, "neighbor " + common::formatReal(skin) + " bin"));
+  CHECK_NOTHROW(lammps::checkLammpsCanRun(
+      config({"coulomb.K=5", "coulomb.every=4", "integrator.dt=0.002",
+              "coulomb.skin=" + common::formatReal(skin)})));
+  // "auto" and 1 stay at every force at every step
+  for (const char* every : {"coulomb.every=1", "coulomb.every=auto"}) {
+    const auto plain = lammps::translateConfig(config({"coulomb.K=5", every}),
+                                               randomInitialState(c), "/tmp/x.data");
+    INFO(every);
+    CHECK(plain.respa_loop == 1);
+    for (const auto& cmd : plain.commands) CHECK(cmd.rfind("run_style", 0) == std::string::npos);
+  }
+}
+
 TEST_CASE("lammps input puts Coulomb in coul/long and pppm at granagg's PPPM design", "[lammps]") {
   const MdConfig c = config({"coulomb.K=5", "coulomb.accuracy=1e-4"});
   const Frame s = randomInitialState(c);
@@ -101,9 +133,10 @@ TEST_CASE("lammps input rejects what LAMMPS cannot honour, naming the key", "[la
     std::string key;
   };
   for (const Case& k :
-       {Case{{"coulomb.K=5", "coulomb.every=8"}, "coulomb.every"},
-        Case{{"coulomb.K=5", "coulomb.every_max=4"}, "coulomb.every_max"},
+       {Case{{"coulomb.K=5", "coulomb.every_max=4"}, "coulomb.every_max"},
         Case{{"coulomb.K=5", "coulomb.r_fast=3"}, "coulomb.r_fast"},
+        Case{{"coulomb.K=5", "coulomb.every=8", "coulomb.r_fast=3"}, "coulomb.r_fast"},
+        Case{{"coulomb.K=5", "coulomb.every=8", "coulomb.skin=0.3"}, "coulomb.skin"},
         Case{{"coulomb.K=5", "coulomb.skin=0.5"}, "coulomb.skin"},
         Case{{"coulomb.K=5", "coulomb.method=ewald"}, "coulomb.method"}}) {
     const MdConfig c = config(k.set);

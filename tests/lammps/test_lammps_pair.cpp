@@ -83,7 +83,7 @@ TEST_CASE("pair with engine = lammps runs its MD through granagg-lammps, analyse
   test::spit(dir / "bad.toml",
              "[pair]\nname = \"bad\"\nK = [5.0]\nruns = 1\n"
              "[md]\npreset = \"quick\"\nengine = \"lammps\"\n"
-             "set = [\"system.N=500\", \"coulomb.every=8\"]\n"
+             "set = [\"system.N=500\", \"coulomb.every_max=8\"]\n"
              "[lammps]\nlauncher = \"" +
                  launcher + "\"\n");
   const Run bad = sh("OMP_NUM_THREADS=1 " + std::string(GRANAGG_BINARY) + " pair --config " +
@@ -92,6 +92,6 @@ TEST_CASE("pair with engine = lammps runs its MD through granagg-lammps, analyse
   CHECK(bad.status == 1);
   CHECK_THAT(test::slurp(dir / "bad" / "pair.log"),
              Catch::Contains("md K5 run 0: FAILED (exit status 2): granagg-lammps: "
-                             "coulomb.every = 8 cannot run on LAMMPS"));
+                             "coulomb.every_max = 8 cannot run on LAMMPS"));
   fs::remove_all(dir);
 }

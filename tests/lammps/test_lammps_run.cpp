@@ -140,6 +140,70 @@ TEST_CASE("granagg-lammps exchanges at a collision exactly the charge of ChargeE
   CHECK(test::sameBits(f.charge[1], -dq0));
 }
 
+TEST_CASE("granagg-lammps under rRESPA exchanges at the inner step of a collision the charge of "
+          "ChargeExchange",
+          "[lammps][mpi]") {
+  // coulomb.every = 4: run_style respa with the pair forces every inner step dt and the mesh
+  // every 4; the collision must be found at its inner step and keyed by the inner step count
+  // (granagg md's step), with the inner dt in the drift undone
+  const fs::path dir = test::tempDir("lammps_charge_respa");
+  const double v = 0.5, dt = 1e-3;
+  const std::string state = twoBodyState(dir, v);
+  std::string cfg_text;
+  {
+    std::ifstream f(twoBodyConfig(dir, state, "exchange", dt, 0.05));
+    cfg_text.assign(std::istreambuf_iterator<char>(f), {});
+  }
+  const std::string cfg =
+      writeFile(dir / "respa.toml", cfg_text + "[coulomb]\nK = 5\nevery = 4\n");
+  const Run r = lammpsRun(2, "--config " + cfg + " --out " + (dir / "o").string() +
+                                 " --collisions -q");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+
+  // the free drift with LAMMPS's inner step (the outer timestep 4 dt divided by 4); the charges
+  // are 0 before the contact, so no force acts
+  const double inner = 4 * dt / 4;
+  double x0 = 1.999, x1 = 3.001, rx = 0.0;
+  std::int64_t step = 0;
+  do {
+    x0 += inner * (0.5 * v);
+    x1 += inner * -(0.5 * v);
+    ++step;
+    rx = x0 - x1;
+  } while (!(rx * rx < 1.0));
+  CHECK(step % 4 != 0);  // an inner step between outer boundaries
+  const double xi_dot = -((0.5 * v - -(0.5 * v)) * (rx * (1.0 / std::sqrt(rx * rx))));
+  md::ChargeExchange::Params p;
+  p.seed = 987654321;
+  const double dq0 = md::ChargeExchange::transferTo(p, step, 0, 1, xi_dot);
+
+  const common::CsvTable coll = common::readCsv((dir / "o" / "collisions.csv").string());
+  REQUIRE(coll.rows.size() == 1);
+  const auto& c = coll.rows[0];
+  CHECK(c[coll.column("step")] == step);
+  CHECK(test::sameBits(c[coll.column("xi_dot")], xi_dot));
+  CHECK(test::sameBits(c[coll.column("dq_lo")], dq0));
+  const md::Frame fin = lastFrame(dir / "o");
+  REQUIRE(fin.size() == 2);
+  CHECK(fin.step == std::llround(0.05 / (4 * dt)));  // LAMMPS's outer steps
+  CHECK(fin.time == Approx(fin.step * 4 * dt).epsilon(1e-12));
+  CHECK(test::sameBits(fin.charge[0], dq0));
+  CHECK(test::sameBits(fin.charge[1], -dq0));
+
+  // granagg md counts the same steps: with the charges 0 until the exchange the Coulomb force
+  // plays no part, and the engine without it (its multiple time stepping needs a larger box)
+  // charges at the same step
+  md::MdConfig mc = md::parseConfigFile(cfg);
+  mc.coulomb.K = 0.0;
+  md::Engine engine(mc, md::readInitialState(state, TWO_BODY_L));
+  engine.run(step - 1);
+  CHECK(engine.observables().collisions == 0);
+  engine.run(1);
+  CHECK(engine.observables().collisions == 1);
+  CHECK(test::sameBits(engine.frame().charge[0], dq0));
+}
+
 TEST_CASE("granagg-lammps gives a two-body collision the restitution of granagg's engine",
           "[lammps][mpi]") {
   const fs::path dir = test::tempDir("lammps_restitution");
@@ -288,7 +352,7 @@ TEST_CASE("granagg-lammps rejects a key LAMMPS cannot honour: exit 2, the key na
           "written",
           "[lammps][mpi][slow]") {
   const fs::path dir = test::tempDir("lammps_bad");
-  for (const std::string& set : {std::string("--set coulomb.K=5 --set coulomb.every=8"),
+  for (const std::string& set : {std::string("--set coulomb.K=5 --set coulomb.every_max=8"),
                                  std::string("--set coulomb.K=5 --set coulomb.r_fast=3"),
                                  std::string("--set system.bogus=1")}) {
     INFO(set);
@@ -420,6 +484,64 @@ TEST_CASE("granagg-lammps checkpoints change its run only by rounding", "[lammps
         observable(dir / "plain", "collisions").value.back());
   CHECK(fs::exists(dir / "often" / "checkpoint-300.restart"));
   CHECK(!fs::exists(dir / "often" / "checkpoint-294.restart"));  // the older ones are removed
+}
+
+TEST_CASE("granagg-lammps under rRESPA on 2 ranks: checkpoints change the run only by rounding, "
+          "and the charge is conserved",
+          "[lammps][mpi][slow]") {
+  // coulomb.every = 4 (run_style respa): every checkpoint is followed by LAMMPS's full setup,
+  // where the fix puts back the kept force of each level
+  const fs::path dir = test::tempDir("lammps_respa_checkpoints");
+  const std::string set = " --set run.t_end=" + common::formatReal(300 * 0.003) +
+                          " --set coulomb.every=4 -q --collisions --out ";
+  const Run plain = lammpsRun(2, "--config " + chargedGas(dir, 0) + set + (dir / "plain").string());
+  INFO(plain.output);
+  REQUIRE(plain.status == 0);
+  const Run often = lammpsRun(2, "--config " + chargedGas(dir, 7) + set + (dir / "often").string());
+  INFO(often.output);
+  REQUIRE(often.status == 0);
+  const md::Frame a = lastFrame(dir / "plain"), b = lastFrame(dir / "often");
+  REQUIRE(a.step == 75);  // outer steps of 4 x 0.003
+  REQUIRE(b.step == 75);
+  const FrameDifference d = difference(a, b);
+  INFO("relative differences after 10 checkpoints: x " << d.x << ", v " << d.v << ", q " << d.q);
+  CHECK(d.x < 1e-10);
+  CHECK(d.v < 1e-10);
+  CHECK(d.q < 1e-10);
+  const auto collisions = observable(dir / "plain", "collisions");
+  CHECK(collisions.value.back() > 50);
+  CHECK(observable(dir / "often", "collisions").value.back() == collisions.value.back());
+
+  // the total charge, to 1e-12 N max|q|, and every collision charged once (the final charges are
+  // the initial ones plus the logged exchanges), found at inner steps between outer boundaries too
+  const md::Frame init = md::readInitialStateLammps((dir / "plain" / "initial.data").string());
+  std::vector<double> q = init.charge;
+  double q_init = 0.0, q_fin = 0.0, max_q = 0.0;
+  for (double x : q) q_init += x;
+  const common::CsvTable coll = common::readCsv((dir / "plain" / "collisions.csv").string());
+  std::set<std::tuple<long, long, long>> seen;
+  int between = 0;
+  for (const auto& row : coll.rows) {
+    const long step = std::lround(row[coll.column("step")]);
+    const auto lo = static_cast<std::size_t>(row[coll.column("id_lo")]),
+               hi = static_cast<std::size_t>(row[coll.column("id_hi")]);
+    CHECK(seen.insert({step, static_cast<long>(lo), static_cast<long>(hi)}).second);
+    CHECK(step <= 300);
+    between += step % 4 != 0;
+    q[lo] += row[coll.column("dq_lo")];
+    q[hi] -= row[coll.column("dq_lo")];
+  }
+  CHECK(static_cast<double>(coll.rows.size()) == collisions.value.back());
+  CHECK(between > 0);
+  for (double x : a.charge) {
+    q_fin += x;
+    max_q = std::max(max_q, std::fabs(x));
+  }
+  CHECK(std::fabs(q_fin - q_init) <= 1e-12 * 500 * max_q);
+  int wrong = 0;
+  for (std::size_t i = 0; i < q.size(); ++i)
+    wrong += !(std::fabs(a.charge[i] - q[i]) <= 1e-12 * max_q);
+  CHECK(wrong == 0);
 }
 
 TEST_CASE("granagg-lammps checkpoints a gas in contact, from a granagg md frame, and restarts",
