@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Rewrites the golden reference states tests/data/backend/*.h5 (a dense neutral gas and a charged
-# gas with PPPM, multiple time stepping and charge exchange: forces of the initial state, state
-# and forces after a few hundred steps) with the CPU build, for tests/md/test_backend.cpp. That
-# test fails at any change of the trajectory, to the bit (a 1e-12 relative change of the Hertz
-# constant fails 9 of its assertions); run this only after an intended change, and say why in
-# the commit.
+# Rewrites the golden values tests/data/backend/*.toml (text: a dense neutral gas and a charged
+# gas with PPPM, multiple time stepping and charge exchange; forces and energies of the initial
+# state, state, forces and energies after a few hundred steps, one row per particle) with the
+# CPU build, for tests/md/test_backend.cpp. That test fails at any change of the trajectory, to
+# the bit (a 1e-12 relative change of the Hertz constant fails it); run this only after an
+# intended change, review `git diff tests/data/backend`, and say why in the commit.
 #
 #   usage: bash scripts/write_reference_states.sh [BUILD_DIR]   (default build)
 set -euo pipefail

@@ -3,28 +3,35 @@
 // CUDA build (scripts/gpu_check.sh). Two references:
 //   - a host brute-force sum of the contact law over all pairs (independent of the neighbour list,
 //     the cell sort and the device code), for the engine's contact forces;
-//   - reference files written by the CPU backend (tests/data/backend/*.h5, checkpoint format:
-//     the state and forces after a short run, the forces of the initial state as extra arrays),
-//     for the forces and a short trajectory of a dense neutral gas and a charged gas (PPPM,
-//     multiple time stepping, charge exchange). The CPU build must match them to the bit (it
-//     wrote them: a change there is a change of the trajectory, and needs a reason); the CUDA
-//     build to the tolerances below, which leave room for fused multiply-adds and cuFFT's
-//     round-off, not for a different algorithm.
+//   - golden values written by the CPU backend, as text a person can read and review as a diff
+//     (tests/data/backend/<case>.toml, in the manner of LAMMPS's force-style YAML files): the
+//     forces and energies of the initial state, and the state (unwrapped positions, velocities,
+//     charges), forces and energies after a short run, of a dense neutral gas and a charged gas
+//     (PPPM, multiple time stepping, charge exchange), with the case's tolerances. Reals are
+//     written with 17 significant digits, which read back to the same bits. The CPU build must
+//     match them to the bit (it wrote them: a change there is a change of the trajectory, and
+//     needs a reason); the CUDA build to the file's tolerances, which leave room for fused
+//     multiply-adds and cuFFT's round-off, not for a different algorithm.
 // Regenerate the files (CPU build only) after an intended change of the trajectory with
 //     bash scripts/write_reference_states.sh [BUILD_DIR]
+// (the test binary with GRANAGG_WRITE_BACKEND_REFERENCE=1), and review `git diff`.
 #include <catch2/catch.hpp>
+
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "common/Box.h"
 #include "md/config/MdConfig.h"
 #include "md/engine/Engine.h"
-#include "md/io/Checkpoint.h"
 #include "md/io/InitialState.h"
 #include "md/potentials/HertzViscoelastic.h"
 #include "md/potentials/SpringDashpot.h"
@@ -144,19 +151,38 @@ std::vector<double> slice(const std::vector<double>& v, std::size_t c, std::size
   return {v.begin() + c * n, v.begin() + (c + 1) * n};
 }
 
-/// A reference case: its engine, initial forces, and the state and forces after `steps` steps.
+/// The energies a reference case records (Observables, totals).
+struct Energies {
+  double kinetic = 0.0, elastic = 0.0, coulomb = 0.0;
+};
+
+Energies energiesOf(const Engine& e) {
+  const Observables o = e.observables();
+  return {o.kinetic_energy, o.elastic_energy, o.coulomb_energy};
+}
+
+/// A reference case's outcome: the initial forces and energies, and the state, forces and
+/// energies after `steps` steps.
 struct Outcome {
   std::vector<double> f0, f1;
+  Energies e0, e1;
   Frame end;
 };
 
-Outcome runCase(const MdConfig& c, const Frame& init, bool allow_contacts, std::int64_t steps) {
+Outcome runCase(const MdConfig& c, const Frame& init, bool allow_contacts, std::int64_t steps,
+                bool with_energies = false) {
   Engine e(c, init, allow_contacts);
   Outcome o;
   o.f0 = e.forces();
   e.run(steps);
   o.end = e.frame();
   o.f1 = e.forces();
+  if (with_energies) {
+    // after the state is taken (the observables may rebuild a list), and for the initial state
+    // from an engine of its own, so that the trajectory is the one without observables
+    o.e1 = energiesOf(e);
+    o.e0 = energiesOf(Engine(c, init, allow_contacts));
+  }
   return o;
 }
 
@@ -202,73 +228,213 @@ std::vector<ReferenceCase> referenceCases() {
 /// binary built on one machine and run on another: scripts/gpu_check.sh --bundle).
 std::string referencePath(const std::string& name) {
   const char* root = std::getenv("GRANAGG_TEST_SOURCE_DIR");
-  return std::string(root ? root : GRANAGG_SOURCE_DIR) + "/tests/data/backend/" + name + ".h5";
+  return std::string(root ? root : GRANAGG_SOURCE_DIR) + "/tests/data/backend/" + name + ".toml";
+}
+
+/// The CUDA build's bounds, per case (the CPU build must match to the bit). The GPU runs the
+/// same algorithm and summation order with different round-off (FMA contraction, cuFFT against
+/// FFTW). A relative 1e-15 in the positions changes the initial Hertz forces by ~1e-12 relative
+/// (F ~ xi^1.5 at overlaps xi ~ 0.03 d) and the state after these short runs by less than 100
+/// times itself (the last test case; measured 24 and 6.5 on the CPU). The bounds leave a factor
+/// >= 100 above that, and are far below any algorithmic difference (a missed contact changes a
+/// force by order 1, a PPPM mesh difference at accuracy 1e-4 by ~1e-4). Energies: relative, as
+/// the final forces.
+struct Tolerance {
+  double initial_forces = 1e-10;  ///< max |dF| / max |F|
+  double positions = 1e-9;        ///< max |dx| (d)
+  double velocities = 1e-8;       ///< max |dv| / max |v|
+  double charges = 1e-10;         ///< max |dq|
+  double forces = 1e-7;           ///< max |dF| / max |F| after the run
+  double energies = 1e-7;         ///< |dE| / max(|E|, kinetic energy)
+};
+
+/// A real with 17 significant digits (reads back to the same bits), always with a '.' or an
+/// exponent, so that TOML reads it as a float.
+std::string real(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  std::string t = buf;
+  if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
+  return t;
+}
+
+/// A tolerance: 3 significant digits.
+std::string bound(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
+std::string energiesText(const Energies& e) {
+  return "{ kinetic = " + real(e.kinetic) + ", elastic = " + real(e.elastic) +
+         ", coulomb = " + real(e.coulomb) + " }";
+}
+
+/// One row per particle id of the columns `cols` (each of size n), with a trailing "# id".
+std::string rowsText(const std::vector<const std::vector<double>*>& cols, std::size_t n) {
+  std::string t = "[\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    t += "  [";
+    for (std::size_t c = 0; c < cols.size(); ++c) t += (c ? ", " : "") + real((*cols[c])[i]);
+    t += "],  # " + std::to_string(i) + "\n";
+  }
+  return t + "]\n";
+}
+
+/// The text of a reference file.
+std::string referenceText(const ReferenceCase& rc, const Outcome& o) {
+  const std::size_t n = o.end.size();
+  const Tolerance tol;
+  const std::vector<double> f0x = slice(o.f0, 0, n), f0y = slice(o.f0, 1, n),
+                            f0z = slice(o.f0, 2, n), f1x = slice(o.f1, 0, n),
+                            f1y = slice(o.f1, 1, n), f1z = slice(o.f1, 2, n);
+  const std::vector<double> u = unwrapped(o.end);
+  const std::vector<double> ux = slice(u, 0, n), uy = slice(u, 1, n), uz = slice(u, 2, n);
+  const std::vector<double> q = o.end.charge.empty() ? std::vector<double>(n, 0.0) : o.end.charge;
+  std::ostringstream t;
+  t << "# Golden values of the CPU backend for tests/md/test_backend.cpp, case \"" << rc.name
+    << "\" (its\n# set-up: referenceCases() there). Written by\n"
+    << "#     bash scripts/write_reference_states.sh\n"
+    << "# after an intended change of the trajectory; review the change as a diff and say why in\n"
+    << "# the commit. Reals have 17 significant digits: they read back to the same bits, and the\n"
+    << "# CPU build must reproduce them exactly; the CUDA build within [tolerance].\n\n"
+    << "case = \"" << rc.name << "\"\n"
+    << "N = " << n << "\nsteps = " << rc.steps << "\n\n"
+    << "[tolerance]  # the CUDA build's bounds (test_backend.cpp, Tolerance)\n"
+    << "initial_forces = " << bound(tol.initial_forces) << "  # max |dF| / max |F|\n"
+    << "positions = " << bound(tol.positions) << "  # max |dx| (d)\n"
+    << "velocities = " << bound(tol.velocities) << "  # max |dv| / max |v|\n"
+    << "charges = " << bound(tol.charges) << "  # max |dq|\n"
+    << "forces = " << bound(tol.forces) << "  # after the run: max |dF| / max |F|\n"
+    << "energies = " << bound(tol.energies) << "  # |dE| / max(|E|, E_kin)\n\n"
+    << "[initial]  # the state given (step 0)\n"
+    << "energies = " << energiesText(o.e0) << "\n"
+    << "# per particle id: fx, fy, fz\n"
+    << "forces = " << rowsText({&f0x, &f0y, &f0z}, n) << "\n"
+    << "[final]  # after `steps` steps\n"
+    << "step = " << o.end.step << "\ntime = " << real(o.end.time) << "\n"
+    << "energies = " << energiesText(o.e1) << "\n"
+    << "# per particle id: x, y, z (unwrapped: x + image L), vx, vy, vz, q, fx, fy, fz\n"
+    << "particles = "
+    << rowsText({&ux, &uy, &uz, &o.end.vx, &o.end.vy, &o.end.vz, &q, &f1x, &f1y, &f1z}, n);
+  return t.str();
+}
+
+/// A reference file read back.
+struct Reference {
+  std::int64_t step = 0;
+  std::vector<double> f0, f1, x, v, q;  // x, y, z blocks as unwrapped() and velocities() give
+  Energies e0, e1;
+  Tolerance tol;
+};
+
+double number(const toml::node_view<const toml::node>& node, const std::string& what) {
+  const auto x = node.value<double>();
+  if (!x) FAIL("reference file: " << what << " is not a number");
+  return *x;
+}
+
+Energies readEnergies(const toml::node_view<const toml::node>& t, const std::string& what) {
+  return {number(t["kinetic"], what + ".kinetic"), number(t["elastic"], what + ".elastic"),
+          number(t["coulomb"], what + ".coulomb")};
+}
+
+/// Columns [first, first + count) of a per-particle table, as blocks of n values each.
+std::vector<double> columns(const toml::array& rows, std::size_t first, std::size_t count) {
+  const std::size_t n = rows.size();
+  std::vector<double> out(count * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const toml::array* row = rows[i].as_array();
+    if (!row || row->size() < first + count)
+      FAIL("reference file: row " << i << " has fewer than " << first + count << " values");
+    for (std::size_t c = 0; c < count; ++c)
+      out[c * n + i] = number(toml::node_view<const toml::node>(row->get(first + c)), "a value");
+  }
+  return out;
+}
+
+Reference readReference(const std::string& path) {
+  const toml::table t = toml::parse_file(path);
+  Reference r;
+  const auto* f0 = t["initial"]["forces"].as_array();
+  const auto* rows = t["final"]["particles"].as_array();
+  REQUIRE(f0);
+  REQUIRE(rows);
+  r.f0 = columns(*f0, 0, 3);
+  r.x = columns(*rows, 0, 3);
+  r.v = columns(*rows, 3, 3);
+  r.q = columns(*rows, 6, 1);
+  r.f1 = columns(*rows, 7, 3);
+  r.step = t["final"]["step"].value_or<std::int64_t>(-1);
+  r.e0 = readEnergies(t["initial"]["energies"], "initial.energies");
+  r.e1 = readEnergies(t["final"]["energies"], "final.energies");
+  const auto tol = t["tolerance"];
+  r.tol = {number(tol["initial_forces"], "tolerance.initial_forces"),
+           number(tol["positions"], "tolerance.positions"),
+           number(tol["velocities"], "tolerance.velocities"),
+           number(tol["charges"], "tolerance.charges"), number(tol["forces"], "tolerance.forces"),
+           number(tol["energies"], "tolerance.energies")};
+  return r;
+}
+
+/// The largest relative energy difference, against max(|E|, the kinetic energy).
+double energyDifference(const Energies& a, const Energies& b) {
+  const double scale = std::max(std::fabs(b.kinetic), 1e-300);
+  double d = 0.0;
+  for (auto m : {&Energies::kinetic, &Energies::elastic, &Energies::coulomb})
+    d = std::max(d, std::fabs(a.*m - b.*m) / std::max(std::fabs(b.*m), scale));
+  return d;
 }
 
 /// Compares an outcome with the CPU backend's reference file (or writes the file when
 /// GRANAGG_WRITE_BACKEND_REFERENCE is set, CPU build only).
-void checkAgainstReference(const std::string& name, const MdConfig& c, const Outcome& o) {
-  const std::string path = referencePath(name);
-  const std::size_t n = o.end.size();
+void checkAgainstReference(const ReferenceCase& rc, const Outcome& o) {
+  const std::string path = referencePath(rc.name);
   if (std::getenv("GRANAGG_WRITE_BACKEND_REFERENCE")) {
     REQUIRE_FALSE(CUDA_BUILD);  // the reference is the CPU backend's by definition
-    Checkpoint x;
-    x.state = o.end;
-    x.fx = slice(o.f1, 0, n);
-    x.fy = slice(o.f1, 1, n);
-    x.fz = slice(o.f1, 2, n);
-    x.dt = 1.0;  // unused by the comparison
-    x.run.seed = c.system.seed;
-    x.engine.arrays = {
-        {"f0x", slice(o.f0, 0, n)}, {"f0y", slice(o.f0, 1, n)}, {"f0z", slice(o.f0, 2, n)}};
-    writeCheckpoint(path, x);
+    std::ofstream(path) << referenceText(rc, o);
     WARN("wrote the reference " << path);
     return;
   }
-  const Checkpoint ref = readCheckpoint(path);
-  REQUIRE(ref.state.size() == n);
-  REQUIRE(ref.state.step == o.end.step);
-  std::vector<double> ref_f0 = ref.engine.arrays.at("f0x");
-  for (const char* k : {"f0y", "f0z"})
-    ref_f0.insert(ref_f0.end(), ref.engine.arrays.at(k).begin(), ref.engine.arrays.at(k).end());
-  std::vector<double> ref_f1 = ref.fx;
-  ref_f1.insert(ref_f1.end(), ref.fy.begin(), ref.fy.end());
-  ref_f1.insert(ref_f1.end(), ref.fz.begin(), ref.fz.end());
+  const Reference ref = readReference(path);
+  const std::size_t n = o.end.size();
+  REQUIRE(ref.x.size() == 3 * n);
+  REQUIRE(ref.step == o.end.step);
+  const std::vector<double> q = o.end.charge.empty() ? std::vector<double>(n, 0.0) : o.end.charge;
 
-  const double f0 = maxAbsDiff(o.f0, ref_f0) / maxAbs(ref_f0);
-  const double f1 = maxAbsDiff(o.f1, ref_f1) / maxAbs(ref_f1);
-  const double dx = maxAbsDiff(unwrapped(o.end), unwrapped(ref.state));
-  const double dv =
-      maxAbsDiff(velocities(o.end), velocities(ref.state)) / maxAbs(velocities(ref.state));
-  const double dq = maxAbsDiff(o.end.charge, ref.state.charge);
-  INFO(name << " against the CPU reference: initial forces " << f0 << ", forces after "
-            << o.end.step << " steps " << f1 << " (max |dF| / max |F|); positions " << dx
-            << " d; velocities " << dv << " (relative); charges " << dq);
+  const double f0 = maxAbsDiff(o.f0, ref.f0) / maxAbs(ref.f0);
+  const double f1 = maxAbsDiff(o.f1, ref.f1) / maxAbs(ref.f1);
+  const double dx = maxAbsDiff(unwrapped(o.end), ref.x);
+  const double dv = maxAbsDiff(velocities(o.end), ref.v) / maxAbs(ref.v);
+  const double dq = maxAbsDiff(q, ref.q);
+  const double de = std::max(energyDifference(o.e0, ref.e0), energyDifference(o.e1, ref.e1));
+  INFO(rc.name << " against the CPU reference: initial forces " << f0 << ", forces after "
+               << o.end.step << " steps " << f1 << " (max |dF| / max |F|); positions " << dx
+               << " d; velocities " << dv << " (relative); charges " << dq << "; energies " << de
+               << " (relative)");
   if (!CUDA_BUILD) {
-    // the build that wrote the reference: the same bits (positions, velocities, charges, forces)
+    // the build that wrote the reference: the same bits (positions, velocities, charges, forces,
+    // energies)
     CHECK(f0 == 0.0);
     CHECK(f1 == 0.0);
     CHECK(dx == 0.0);
     CHECK(dv == 0.0);
     CHECK(dq == 0.0);
+    CHECK(de == 0.0);
     return;
   }
-  // The GPU: the same algorithm and summation order, different round-off (FMA contraction, cuFFT
-  // against FFTW). A relative 1e-15 in the positions changes the initial Hertz forces by ~1e-12
-  // relative (F ~ xi^1.5 at overlaps xi ~ 0.03 d) and the state after these short runs by less
-  // than 100 times itself (next test case; measured 24 and 6.5 on the CPU). The bounds leave a
-  // factor >= 100 above that, and are far below any algorithmic difference (a missed contact
-  // changes a force by order 1, a PPPM mesh difference at accuracy 1e-4 by ~1e-4).
-  CHECK(f0 <= 1e-10);
-  CHECK(dx <= 1e-9);
-  CHECK(dv <= 1e-8);
-  CHECK(dq <= 1e-10);
-  CHECK(f1 <= 1e-7);
+  CHECK(f0 <= ref.tol.initial_forces);
+  CHECK(dx <= ref.tol.positions);
+  CHECK(dv <= ref.tol.velocities);
+  CHECK(dq <= ref.tol.charges);
+  CHECK(f1 <= ref.tol.forces);
+  CHECK(de <= ref.tol.energies);
 }
 
 }  // namespace
 
-TEST_CASE("engine contact forces equal a host brute-force sum over all pairs", "[md][backend]") {
+TEST_CASE("engine contact forces equal a host brute-force sum over all pairs",
+          "[md][backend][gpu]") {
   // 8^3 particles in a block wrapped around the box corner (every particle in contact with up to
   // 6 others, across faces, edges and the corner) plus 200 free ones; both contact laws.
   const Frame init = denseBlock(8, 200, 16.0, 3);
@@ -296,16 +462,16 @@ TEST_CASE("engine contact forces equal a host brute-force sum over all pairs", "
   }
 }
 
-TEST_CASE("forces and a short trajectory equal the CPU backend's reference", "[md][backend]") {
+TEST_CASE("forces and a short trajectory equal the CPU backend's reference", "[md][backend][gpu]") {
   for (const ReferenceCase& rc : referenceCases()) {
     INFO(rc.name);
-    checkAgainstReference(rc.name, rc.config,
-                          runCase(rc.config, rc.init, rc.allow_contacts, rc.steps));
+    checkAgainstReference(rc, runCase(rc.config, rc.init, rc.allow_contacts, rc.steps,
+                                      /*with_energies=*/true));
   }
 }
 
 TEST_CASE("the reference runs are short enough for a round-off difference to stay small",
-          "[md][backend]") {
+          "[md][backend][gpu]") {
   // The basis of the GPU tolerances above: perturb every coordinate by a relative 1e-15 (random
   // sign; the size of one rounding) and run each reference case again on this backend. Measured on
   // the CPU: the largest position difference grows 24-fold (dense gas, 300 steps) and 6.5-fold
