@@ -54,6 +54,52 @@ lmp_launch() {  # ranks -> the launcher words, one per line (none for 1 rank: a 
   fi
 }
 
+lmp_run() {  # DIR RANKS LOG INPUT [lmp words...] -> runs Debian's `lmp` on INPUT in DIR on RANKS
+  # MPI ranks (one OpenMP thread each), its screen output in DIR/LOG; on failure prints it, exits
+  local dir=$1 np=$2 log=$3 input=$4 launch
+  shift 4
+  mapfile -t launch < <(lmp_launch "$np")
+  (cd "$dir" && OMP_NUM_THREADS=1 "${launch[@]}" "$LMP" -in "$input" -log none -nocite -echo none \
+     "$@" > "$log" 2>&1) || { cat "$dir/$log" >&2; exit 1; }
+}
+
+granagg_model_toml() {  # N PHI STATE_CSV E D DT SKIN -> the [system] .. [charging] part of a
+  # `granagg md` configuration from a state file: Hertz contacts, a fixed time step and skin,
+  # charges fixed (`[charging]` is last, so that a caller can add keys to it)
+  cat <<EOF
+[system]
+N = $1
+phi = $2
+initial = "$3"
+[contact]
+model = "hertz"
+E = $4
+D = $5
+clamp = true
+[integrator]
+dt = $6
+[neighbor]
+skin = $7
+[charging]
+mode = "fixed"
+EOF
+}
+
+granagg_timing_toml() {  # T_END -> the [run] and [output] part of a timed `granagg md` run: no
+  # frames, no checkpoints, observables only at the end
+  cat <<EOF
+[run]
+t_end = $1
+[output]
+frames_per_decade = 0
+frame_interval = 0.0
+observable_interval = 1000000
+checkpoint_interval = 0
+checkpoint_wall_seconds = 0.0
+write_velocities = false
+EOF
+}
+
 granagg_loop_seconds() {  # PROFILE_CSV STEPS -> loop_s of `granagg md --profile` (checks steps)
   /usr/bin/python3 - "$PWD/scripts" "$1" "$2" <<'PY'
 import sys

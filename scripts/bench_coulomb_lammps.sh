@@ -192,38 +192,16 @@ fi
 # ---------------------------------------------------------------------------------------------
 granagg_time() {  # N steps threads [coulomb.every] -> wall seconds of the whole process
   local N=$1 n=$2 th=$3 every=${4:-8}
-  cat > "$TMP/g.toml" <<EOF
-[system]
-N = $N
-phi = $PHI
-initial = "$TMP/state_$N.csv"
-[contact]
-model = "hertz"
-E = $E
-D = $D
-clamp = true
-[integrator]
-dt = $DT
-[neighbor]
-skin = $SKIN
-[charging]
-mode = "fixed"
+  { granagg_model_toml "$N" "$PHI" "$TMP/state_$N.csv" "$E" "$D" "$DT" "$SKIN"
+    cat <<EOF
 initial = "file"
 [coulomb]
 K = $K
 method = "pppm"
 accuracy = $ACC
 every = $every
-[run]
-t_end = $(calc "$n * $DT")
-[output]
-frames_per_decade = 0
-frame_interval = 0.0
-observable_interval = 1000000
-checkpoint_interval = 0
-checkpoint_wall_seconds = 0.0
-write_velocities = false
 EOF
+    granagg_timing_toml "$(calc "$n * $DT")"; } > "$TMP/g.toml"
   local t0 t1
   t0=$(now)
   OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" \
@@ -255,12 +233,9 @@ PY
 
 lammps_time() {  # N n1 n2 ranks rc acc [respa] -> loop seconds of steps n1..n2
   local N=$1 n1=$2 n2=$3 np=$4 rc=$5 acc=$6 respa=${7:-1}
-  local launch
-  mapfile -t launch < <(lmp_launch "$np")
-  (cd "$TMP" && OMP_NUM_THREADS=1 "${launch[@]}" "$LMP" -in "$ROOT/scripts/lammps/charged.in" -log none -nocite -echo none \
-     -var data "$TMP/state_$N.data" -var rc "$rc" -var acc "$acc" -var K "$K" -var kn "$KN" -var gn "$GN" \
-     -var dt "$DT" -var skin "$SKIN" -var n1 "$n1" -var n2 "$n2" -var respa "$respa" > lmp.log 2>&1) \
-    || { cat "$TMP/lmp.log" >&2; exit 1; }
+  lmp_run "$TMP" "$np" lmp.log "$ROOT/scripts/lammps/charged.in" \
+    -var data "$TMP/state_$N.data" -var rc "$rc" -var acc "$acc" -var K "$K" -var kn "$KN" \
+    -var gn "$GN" -var dt "$DT" -var skin "$SKIN" -var n1 "$n1" -var n2 "$n2" -var respa "$respa"
   cp "$TMP/lmp.log" "$TMP/lmp_${N}_${np}_${rc}_${acc}$([ "$respa" = 1 ] || echo "_respa$respa").log"
   grep '^Loop time' "$TMP/lmp.log" | tail -n 1 | awk '{print $4}'
 }

@@ -194,10 +194,8 @@ plain_input() {  # case n1 n2 ranks -> $OUT/run/lmp_<case>/in.lammps: the input 
 }
 
 lmp_time() {  # case n1 n2 ranks -> the "Loop time" of `run n2-n1`
-  local c=$1 np=$4 dir=$OUT/run/lmp_$1 launch
-  mapfile -t launch < <(lmp_launch "$np")
-  (cd "$dir" && OMP_NUM_THREADS=1 "${launch[@]}" "$LMP" -in in.lammps -log none -nocite \
-     -echo none > "lmp_$np.log" 2>&1) || { cat "$dir/lmp_$np.log" >&2; exit 1; }
+  local c=$1 np=$4 dir=$OUT/run/lmp_$1
+  lmp_run "$dir" "$np" "lmp_$np.log" in.lammps
   lammps_loop_seconds "$dir/lmp_$np.log" 2
 }
 

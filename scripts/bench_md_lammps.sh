@@ -106,32 +106,9 @@ gen_state() {  # N -> $TMP/state_N.csv (granagg) and $TMP/state_N.data (LAMMPS):
 
 granagg_time() {  # N steps threads -> seconds of the MD loop (profile.csv's loop_s)
   local N=$1 n=$2 th=$3
-  cat > "$TMP/g.toml" <<EOF
-[system]
-N = $N
-phi = $PHI
-initial = "$TMP/state_$N.csv"
-[contact]
-model = "hertz"
-E = $E
-D = $D
-clamp = true
-[integrator]
-dt = $DT
-[neighbor]
-skin = $SKIN
-[charging]
-mode = "fixed"          # the neutral model, as in LAMMPS (no charge bookkeeping)
-[run]
-t_end = $(calc "$n * $DT")
-[output]
-frames_per_decade = 0
-frame_interval = 0.0
-observable_interval = 1000000
-checkpoint_interval = 0
-checkpoint_wall_seconds = 0.0
-write_velocities = false
-EOF
+  # the neutral model, as in LAMMPS (charges fixed: no charge bookkeeping)
+  { granagg_model_toml "$N" "$PHI" "$TMP/state_$N.csv" "$E" "$D" "$DT" "$SKIN"
+    granagg_timing_toml "$(calc "$n * $DT")"; } > "$TMP/g.toml"
   OMP_NUM_THREADS=$th "$G" md --config "$TMP/g.toml" --out "$TMP/gout" --force --threads "$th" \
     --profile > "$TMP/g.log" 2>&1 || { cat "$TMP/g.log" >&2; exit 1; }
   # the loop time and step count from profile.csv (machine-readable; the log is for people)
@@ -156,9 +133,7 @@ thermo          1000000
 run             $n1
 run             $((n2 - n1))
 EOF
-  local launch
-  mapfile -t launch < <(lmp_launch "$np")
-  (cd "$TMP" && OMP_NUM_THREADS=1 "${launch[@]}" "$LMP" -in bench.in -log none -nocite -echo none > lmp.log 2>&1) || { cat "$TMP/lmp.log" >&2; exit 1; }
+  lmp_run "$TMP" "$np" lmp.log bench.in
   cp "$TMP/lmp.log" "$TMP/lmp_$np.log"
   cp "$TMP/lmp.log" "$TMP/lmp_${np}_${fix//\//_}.log"
   grep '^Loop time' "$TMP/lmp.log" | tail -n 1 | awk '{print $4}'
