@@ -6,7 +6,8 @@
 #
 #   usage: bash scripts/validate.sh [--out DIR] [PART ...]
 #     DIR   default results/validate (reused: that is how the study resumes)
-#     PART  any of the parts below, in the order given; default: all, in this order
+#     PART  any of the parts below, in the order given; default: all but charged5paper (about 5 h
+#           on 2 cores: run it by name), in this order
 #
 # part       what                                                         cost on 2 cores (measured)
 # neutral    K = 0, N = 50016, 20 runs to t = 1000 (data/pair/validate-neutral.toml)   ~30 min
@@ -17,6 +18,9 @@
 # qscan      K = 5 with Q = 0.025 and 0.1, 2 runs each to t = 100 (else as charged5)   ~26 min
 # charged5big  K = 5 at the paper's N = 50016 (L = 70.1), 5 runs to t = 150 (else as
 #            charged5): the size dependence of the onset (issue 15 made it affordable) ~50 min
+# charged5paper  K = 5 at the paper's N = 50016 to the paper's t = 1000: 5 runs with new seeds
+#            (100-104), frames every 50 (else as charged5); the verdict's charged ensemble at the
+#            paper's size and time (issue 30)                                   ~1 h per run
 # fits       z and beta (fit-beta) over several windows, grid and particle clusters     ~1 min
 # sensitivity  grid spacing 1.5 / 2 / 3 d, threshold 3 / 4 / 5 centres per 2 d cell on the
 #            neutral and K = 5 ensembles (granagg analyze --no-particle), z over the windows  ~5 min
@@ -40,7 +44,8 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --out) OUT=$2; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | grep '^#' | sed -E 's/^# ?//'; exit 0 ;;
-    neutral|charged5|box|charged1|charged025|qscan|charged5big|fits|sensitivity|report)
+    neutral|charged5|box|charged1|charged025|qscan|charged5big|charged5paper|fits|sensitivity|\
+    report)
       PARTS+=("$1"); shift ;;
     *) echo "validate.sh: unknown part or option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -115,6 +120,23 @@ big_config() {
   echo "$f"
 }
 
+# The charged gas at the paper's size and time: validate-charged.toml with N = 50016, t = 1000,
+# frames every 50, seeds 100-104 (none shared with the other ensembles), the fit windows to 1000.
+paper_config() {
+  local f="$OUT/config/validate-charged-N50016-t1000.toml"
+  mkdir -p "$OUT/config"
+  sed -e "s/system.N=10000/system.N=50016/" -e "s/run.t_end=150/run.t_end=1000/" \
+      -e "s/^name = \"validate-charged\"/name = \"validate-charged-N50016-t1000\"/" \
+      -e "s/^seed = 1 .*/seed = 100/" \
+      -e 's/"--fit-window", "50", "150"/"--fit-window", "100", "1000"/' \
+      -e "s/^window = \[50.0, 150.0\]/window = [100.0, 1000.0]/" \
+      data/pair/validate-charged.toml > "$f"
+  grep -q "system.N=50016" "$f" && grep -q "run.t_end=1000" "$f" && grep -q "^seed = 100" "$f" \
+    && grep -q '"100", "1000"' "$f" && grep -q "^window = \[100.0, 1000.0\]" "$f" \
+    || { echo "validate.sh: could not write $f" >&2; exit 1; }
+  echo "$f"
+}
+
 # sensitivity NAME WINDOW0 WINDOW1: grid-cluster variants of the ensemble OUT/NAME
 sensitivity() {
   local name=$1 w0=$2 w1=$3 dir="$OUT/sensitivity/$1"
@@ -174,6 +196,7 @@ for part in "${PARTS[@]}"; do
     qscan)      pair charged-K5-Q0.025 --config "$(q_config 0.025)" --K 5
                 pair charged-K5-Q0.1 --config "$(q_config 0.1)" --K 5 ;;
     charged5big) pair charged-K5-N50016 --config "$(big_config)" --K 5 ;;
+    charged5paper) pair charged-K5-N50016-t1000 --config "$(paper_config)" --K 5 ;;
     fits)       fits neutral S_grid_mean "100 1000" "300 1000" "631 1000"
                 fits box S_grid_mean "100 1000" "631 1000"
                 for c in charged-K5 charged-K1 charged-K0.25 charged-K5-N50016; do
