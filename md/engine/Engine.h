@@ -91,13 +91,6 @@ class Engine : public RunEngine {
   /// next_frame_index), written atomically to checkpointPath(folder) = folder/checkpoint.h5
   /// (md::writeCheckpoint).
   void saveCheckpoint(const std::filesystem::path& folder, const RunFields& run_fields) override;
-  /// What else a bit-for-bit restart needs: the multiple-time-step state (the Coulomb force of
-  /// the last evaluation, its step and energy, the slow interval) and the resolved split.
-  EngineState engineState() const;
-  /// Restores a checkpointed state with its forces, collision counter and engineState() (same N).
-  void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions,
-               const EngineState& engine_state = {});
-
   Observables observables() const override;
   double dt() const override;
   std::int64_t step() const override;
@@ -106,10 +99,6 @@ class Engine : public RunEngine {
   std::size_t size() const override;
   /// Number of neighbour-list builds so far (diagnostics).
   std::int64_t neighborBuilds() const override;
-  /// Skins of the current contact list and Coulomb (PPPM real-space) list, 0 for none; they
-  /// follow the gas where neighbor.skin and coulomb.skin are "auto" (md/neighbor/Skin.h).
-  double contactListSkin() const;
-  double coulombListSkin() const;
   /// Times the phases of every following step (md/engine/PhaseTimer.h; `granagg md --profile`).
   /// Changes no result; on the CUDA backend each phase then waits for the device.
   void enableProfile(bool on) override;
@@ -142,6 +131,21 @@ class Engine : public RunEngine {
   static double chooseTimeStep(const MdConfig& config, std::string* reason = nullptr);
 
  private:
+  /// What else a bit-for-bit restart needs (checkpoint().engine): the multiple-time-step state
+  /// (the Coulomb force of the last evaluation, its step and energy, the slow interval) and the
+  /// resolved split.
+  EngineState engineState() const;
+  /// Restores a checkpointed state with its forces, collision counter and engineState() (same N):
+  /// the second half of Engine(config, checkpoint).
+  void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions,
+               const EngineState& engine_state);
+  /// Skins of the current contact list and Coulomb (PPPM real-space) list, 0 for none; they
+  /// follow the gas where neighbor.skin and coulomb.skin are "auto" (md/neighbor/Skin.h).
+  /// For tests only, through their probe (tests/EngineProbe.h).
+  double contactListSkin() const;
+  double coulombListSkin() const;
+  friend struct EngineProbe;
+
   struct Impl;
   std::unique_ptr<Impl> m_impl;
 };

@@ -16,6 +16,8 @@
 #include "md/neighbor/Skin.h"
 #include "meanfield/kinetic/Cooling.h"
 
+#include "EngineProbe.h"
+
 using namespace granagg;
 using namespace granagg::md;
 
@@ -298,7 +300,7 @@ TEST_CASE(
     CHECK(worst < sp.bound);
   }
   // (c) a restart at a step between Coulomb evaluations continues bit for bit (the last slow force
-  // travels with the checkpoint: Engine::engineState)
+  // travels with the checkpoint: Checkpoint::engine)
   {
     MdConfig c = chargedConfig(300, 5, 2.0, "pppm");
     c.charging.mode = "exchange";
@@ -311,9 +313,7 @@ TEST_CASE(
     Engine first(c, init);
     REQUIRE(first.coulombSetup()->every == 4);  // "auto" at the automatic dt = 0.00344
     first.run(203);                             // 203 = 50 x 4 + 3
-    const Frame mid = first.frame();
-    Engine resumed(c, mid, /*allow_contacts=*/true);
-    resumed.restore(mid, first.forces(), first.observables().collisions, first.engineState());
+    Engine resumed(c, first.checkpoint());
     resumed.run(200);
     const Frame a = one.frame(), b = resumed.frame();
     CHECK(a.x == b.x);
@@ -321,8 +321,9 @@ TEST_CASE(
     CHECK(a.charge == b.charge);
     // without the slow force the restart is refused (it cannot be reconstructed between
     // evaluations)
-    Engine bare(c, mid, true);
-    CHECK_THROWS_AS(bare.restore(mid, first.forces(), 0), std::invalid_argument);
+    Checkpoint bare = first.checkpoint();
+    for (const char* k : {"coulomb_fx", "coulomb_fy", "coulomb_fz"}) bare.engine.arrays.erase(k);
+    CHECK_THROWS_AS(Engine(c, bare), std::invalid_argument);
   }
 }
 
@@ -385,9 +386,7 @@ TEST_CASE(
     Engine first(c, init);
     first.run(503);
     const int k_mid = first.slowInterval();
-    const Frame mid = first.frame();
-    Engine resumed(c, mid, /*allow_contacts=*/true);
-    resumed.restore(mid, first.forces(), first.observables().collisions, first.engineState());
+    Engine resumed(c, first.checkpoint());
     CHECK(resumed.slowInterval() == k_mid);
     resumed.run(500);
     INFO("interval at the restart " << k_mid << " (base " << first.coulombSetup()->every
@@ -446,14 +445,14 @@ TEST_CASE("skins that follow a cold gas are short and change no bit", "[md][coul
   follows.run(600);
   stays.run(600);
   // the optimum for delta = dt max|u| (Skin.h) lies well inside the bounds here
-  INFO("skins " << follows.contactListSkin() << " and " << follows.coulombListSkin() << "; builds "
+  INFO("skins " << EngineProbe::contactListSkin(follows) << " and " << EngineProbe::coulombListSkin(follows) << "; builds "
                 << follows.neighborBuilds() << " against " << stays.neighborBuilds());
-  CHECK(follows.contactListSkin() > NEIGHBOR_SKIN_AUTO_MIN);
-  CHECK(follows.contactListSkin() < 0.2);
-  CHECK(follows.coulombListSkin() > COULOMB_SKIN_AUTO_MIN);
-  CHECK(follows.coulombListSkin() < 0.8);
-  CHECK(stays.contactListSkin() == 0.3);
-  CHECK(stays.coulombListSkin() == 0.8);
+  CHECK(EngineProbe::contactListSkin(follows) > NEIGHBOR_SKIN_AUTO_MIN);
+  CHECK(EngineProbe::contactListSkin(follows) < 0.2);
+  CHECK(EngineProbe::coulombListSkin(follows) > COULOMB_SKIN_AUTO_MIN);
+  CHECK(EngineProbe::coulombListSkin(follows) < 0.8);
+  CHECK(EngineProbe::contactListSkin(stays) == 0.3);
+  CHECK(EngineProbe::coulombListSkin(stays) == 0.8);
   CHECK(follows.neighborBuilds() > stays.neighborBuilds());
   const Frame a = follows.frame(), b = stays.frame();
   CHECK(a.x == b.x);
