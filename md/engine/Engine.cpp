@@ -755,11 +755,8 @@ Engine::Engine(const MdConfig& config, const Checkpoint& ck)
   // the Coulomb parameters first: restore() sizes the multiple-time-step state for them
   if (const auto design = e.reals.find("coulomb_sum_q2_design"); design != e.reals.end())
     useCoulombDesign(design->second);
-  std::vector<double> f = ck.fx;
-  f.insert(f.end(), ck.fy.begin(), ck.fy.end());
-  f.insert(f.end(), ck.fz.begin(), ck.fz.end());
   const auto collisions = e.ints.find("collisions");
-  restore(ck.state, f, collisions == e.ints.end() ? 0 : collisions->second, e);
+  restore(ck.state, ck.forces, collisions == e.ints.end() ? 0 : collisions->second, e);
 }
 
 void Engine::saveCheckpoint(const std::filesystem::path& folder, const RunFields& run_fields) {
@@ -771,11 +768,7 @@ void Engine::saveCheckpoint(const std::filesystem::path& folder, const RunFields
 Checkpoint Engine::checkpoint() const {
   Checkpoint ck;
   ck.state = frame(StateKind::Integrator);
-  const std::vector<double> f = forces(StateKind::Integrator);
-  const std::size_t N = size();
-  ck.fx.assign(f.begin(), f.begin() + N);
-  ck.fy.assign(f.begin() + N, f.begin() + 2 * N);
-  ck.fz.assign(f.begin() + 2 * N, f.end());
+  ck.forces = forces(StateKind::Integrator);
   ck.dt = dt();
   ck.engine = engineState();
   ck.engine.ints["collisions"] = m_impl->collisions;
@@ -829,7 +822,7 @@ Frame Engine::frame(StateKind kind) const {
   return f;
 }
 
-std::vector<double> Engine::forces(StateKind kind) const {
+Forces Engine::forces(StateKind kind) const {
   const Impl& d = *m_impl;
   DVec<double> comp[3];
   unpackVec3(d.p.force, comp[0], comp[1], comp[2]);
@@ -845,11 +838,7 @@ std::vector<double> Engine::forces(StateKind kind) const {
       f[a] = &g[a];
     }
   }
-  std::vector<double> out = toHostById(*f[0], d.p.id);
-  const auto fy = toHostById(*f[1], d.p.id), fz = toHostById(*f[2], d.p.id);
-  out.insert(out.end(), fy.begin(), fy.end());
-  out.insert(out.end(), fz.begin(), fz.end());
-  return out;
+  return {toHostById(*f[0], d.p.id), toHostById(*f[1], d.p.id), toHostById(*f[2], d.p.id)};
 }
 
 EngineState Engine::engineState() const {
@@ -869,17 +858,16 @@ EngineState Engine::engineState() const {
   return e;
 }
 
-void Engine::restore(const Frame& s, const std::vector<double>& forces, std::int64_t collisions,
+void Engine::restore(const Frame& s, const Forces& forces, std::int64_t collisions,
                      const EngineState& extra) {
   Impl& d = *m_impl;
   const std::size_t N = d.p.size();
-  if (s.size() != N || forces.size() != 3 * N || s.charge.size() != N || s.ix.size() != N)
+  if (s.size() != N || forces.x.size() != N || forces.y.size() != N || forces.z.size() != N ||
+      s.charge.size() != N || s.ix.size() != N)
     throw std::invalid_argument("checkpoint has " + std::to_string(s.size()) +
                                 " particles, the run " + std::to_string(N));
   d.upload(s);  // storage in id order again
-  packVec3(std::vector<double>(forces.begin(), forces.begin() + N),
-           std::vector<double>(forces.begin() + N, forces.begin() + 2 * N),
-           std::vector<double>(forces.begin() + 2 * N, forces.end()), d.p.force);
+  packVec3(forces.x, forces.y, forces.z, d.p.force);
   d.step = s.step;
   d.time = s.step * d.dt;
   d.collisions = collisions;

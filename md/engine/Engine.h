@@ -79,9 +79,9 @@ class Engine : public RunEngine {
 
   /// Host copy of the current state (wrapped positions, images, velocities, charges).
   Frame frame(StateKind kind = StateKind::Integrator) const override;
-  /// Forces of the current state, fx, fy, fz concatenated: the integrator's (a bit-for-bit restart
-  /// needs them) or the physical ones (output).
-  std::vector<double> forces(StateKind kind = StateKind::Integrator) const override;
+  /// Forces of the current state: the integrator's (a bit-for-bit restart needs them) or the
+  /// physical ones (output).
+  Forces forces(StateKind kind = StateKind::Integrator) const override;
   /// Everything the engine needs to continue bit for bit (Engine(config, checkpoint)): the
   /// integrator's state and forces, dt, the collision counter, the Coulomb parameters' design
   /// and the multiple-time-step state. The run's own fields (config_toml, seed, frame counters)
@@ -137,7 +137,7 @@ class Engine : public RunEngine {
   EngineState engineState() const;
   /// Restores a checkpointed state with its forces, collision counter and engineState() (same N):
   /// the second half of Engine(config, checkpoint).
-  void restore(const Frame& state, const std::vector<double>& forces, std::int64_t collisions,
+  void restore(const Frame& state, const Forces& forces, std::int64_t collisions,
                const EngineState& engine_state);
   /// Skins of the current contact list and Coulomb (PPPM real-space) list, 0 for none; they
   /// follow the gas where neighbor.skin and coulomb.skin are "auto" (md/neighbor/Skin.h).

@@ -89,8 +89,8 @@ class RunEngine {
   /// The state in particle-id order: wrapped positions with image counts, velocities, charges
   /// (collective; every particle on the writing rank, none elsewhere).
   virtual Frame frame(StateKind kind = StateKind::Integrator) const = 0;
-  /// Forces fx, fy, fz concatenated, in id order (collective; empty where !writesFiles()).
-  virtual std::vector<double> forces(StateKind kind = StateKind::Integrator) const = 0;
+  /// The forces, in id order (collective; empty where !writesFiles()).
+  virtual Forces forces(StateKind kind = StateKind::Integrator) const = 0;
   /// The observables of the current state (collective; the same on every rank).
   virtual Observables observables() const = 0;
   /// The Coulomb parameters in use, or null without Coulomb forces.

@@ -77,7 +77,8 @@ void writeFile(const std::string& file_path, const Checkpoint& e) {
     h5::writeAttribute(g.get(), "N", static_cast<std::int64_t>(n), c);
     const std::pair<const char*, const std::vector<double>*> reals[] = {
         {"x", &s.x},   {"y", &s.y},           {"z", &s.z},   {"vx", &s.vx}, {"vy", &s.vy},
-        {"vz", &s.vz}, {"charge", &s.charge}, {"fx", &e.fx}, {"fy", &e.fy}, {"fz", &e.fz}};
+        {"vz", &s.vz}, {"charge", &s.charge}, {"fx", &e.forces.x}, {"fy", &e.forces.y},
+        {"fz", &e.forces.z}};
     for (const auto& [name, v] : reals)
       writeArray(g.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v->data(), n, c);
     const std::pair<const char*, const std::vector<std::int32_t>*> ints[] = {
@@ -131,9 +132,9 @@ void validate(const Checkpoint& e) {
   need(s.ix.size(), "ix");
   need(s.iy.size(), "iy");
   need(s.iz.size(), "iz");
-  need(e.fx.size(), "fx");
-  need(e.fy.size(), "fy");
-  need(e.fz.size(), "fz");
+  need(e.forces.x.size(), "fx");
+  need(e.forces.y.size(), "fy");
+  need(e.forces.z.size(), "fz");
   if (!(s.box > 0.0) || !std::isfinite(s.box))
     throw std::invalid_argument("writeCheckpoint: the box edge must be positive and finite, got " +
                                 common::formatReal(s.box) + ".");
@@ -257,9 +258,9 @@ Checkpoint readCheckpoint(const std::string& path) {
     array("ix", H5T_NATIVE_INT32, s.ix);
     array("iy", H5T_NATIVE_INT32, s.iy);
     array("iz", H5T_NATIVE_INT32, s.iz);
-    array("fx", H5T_NATIVE_DOUBLE, e.fx);
-    array("fy", H5T_NATIVE_DOUBLE, e.fy);
-    array("fz", H5T_NATIVE_DOUBLE, e.fz);
+    array("fx", H5T_NATIVE_DOUBLE, e.forces.x);
+    array("fy", H5T_NATIVE_DOUBLE, e.forces.y);
+    array("fz", H5T_NATIVE_DOUBLE, e.forces.z);
   }
   {
     h5::Handle g = group("integrator");

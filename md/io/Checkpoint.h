@@ -56,7 +56,7 @@ struct Checkpoint {
   Frame state;  ///< full-precision particle state (positions wrapped, with images)
   /// Forces at the saved state (computed at the end of the last step), one per particle, in
   /// reduced units m d / t^2: velocity Verlet's first half-kick of the next step uses them.
-  std::vector<double> fx, fy, fz;
+  Forces forces;
   double dt = 0.0;     ///< integrator time step (reduced time units), > 0
   RunFields run;       ///< /run
   EngineState engine;  ///< /scalars/int, /scalars/real, /arrays

@@ -8,6 +8,15 @@
 
 namespace granagg::md {
 
+/// Per-particle forces by component, in id order (reduced units m d / t^2): the one type in which
+/// forces leave an engine (RunEngine::forces), travel in a checkpoint and reach the trajectory.
+struct Forces {
+  std::vector<double> x, y, z;
+  std::size_t size() const { return x.size(); }
+  bool empty() const { return x.empty(); }
+  bool operator==(const Forces& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+
 struct Frame {
   std::int64_t step = 0;
   double time = 0.0;
@@ -17,7 +26,7 @@ struct Frame {
   std::vector<double> charge;            ///< charges (zero for a neutral gas)
   std::vector<std::int32_t> ix, iy, iz;  ///< image counts
   /// per-particle forces (optional: filled for output with output.write_forces, else empty)
-  std::vector<double> fx, fy, fz;
+  Forces force;
   std::size_t size() const { return x.size(); }
 };
 

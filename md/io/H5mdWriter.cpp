@@ -518,9 +518,9 @@ void H5mdWriter::writeFrame(const Frame& f) {
   }
   if (!f.charge.empty()) need(f.charge.size(), "charge");
   if (m.forces) {
-    need(f.fx.size(), "fx");
-    need(f.fy.size(), "fy");
-    need(f.fz.size(), "fz");
+    need(f.force.x.size(), "force.x");
+    need(f.force.y.size(), "force.y");
+    need(f.force.z.size(), "force.z");
   }
   if (!(f.box > 0.0) || !std::isfinite(f.box))
     throw std::invalid_argument(where + "box edge must be positive and finite, got " +
@@ -559,9 +559,9 @@ void H5mdWriter::writeFrame(const Frame& f) {
   }
   if (m.forces) {
     for (std::size_t i = 0; i < N; ++i) {
-      xyz[3 * i] = f.fx[i];
-      xyz[3 * i + 1] = f.fy[i];
-      xyz[3 * i + 2] = f.fz[i];
+      xyz[3 * i] = f.force.x[i];
+      xyz[3 * i + 1] = f.force.y[i];
+      xyz[3 * i + 2] = f.force.z[i];
     }
     h5::writeRows(m.force.get(), row, 1, H5T_NATIVE_DOUBLE, xyz.data(), c + " force");
   }

@@ -73,7 +73,7 @@ class H5mdWriter {
   /// \param config_toml TOML text of the resolved configuration (/parameters/config_toml).
   /// \param overwrite   replace an existing file; otherwise std::invalid_argument names it.
   /// \param write_velocities  write particles/all/velocity (default true).
-  /// \param write_forces  write particles/all/force from Frame::fx, fy, fz (default false).
+  /// \param write_forces  write particles/all/force from Frame::force (default false).
   /// The XDMF sidecar is (re)written next to it regardless of `overwrite` (it holds no data).
   /// Throws std::invalid_argument for bad arguments, std::runtime_error if HDF5 fails.
   H5mdWriter(const std::string& path, std::size_t N,

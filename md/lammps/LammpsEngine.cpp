@@ -377,17 +377,19 @@ Frame LammpsEngine::frame(StateKind) const {
   return f;
 }
 
-std::vector<double> LammpsEngine::forces(StateKind) const {
+Forces LammpsEngine::forces(StateKind) const {
   const LAMMPS_NS::Atom* atom = m_lmp->atom;
   const auto rows = gather(3, [&](int i, double* row) {
     for (int k = 0; k < 3; ++k) row[k] = atom->f[i][k];
   });
   if (m_rank != 0) return {};
-  std::vector<double> f(3 * m_N);
+  Forces f;
+  std::vector<double>* comp[3] = {&f.x, &f.y, &f.z};
+  for (auto* c : comp) c->resize(m_N);
   for (std::size_t r = 0; r < m_N; ++r) {
     const double* row = &rows[r * 4];
     const auto id = static_cast<std::size_t>(row[0]) - 1;
-    for (std::size_t k = 0; k < 3; ++k) f[k * m_N + id] = row[1 + k];
+    for (std::size_t k = 0; k < 3; ++k) (*comp[k])[id] = row[1 + k];
   }
   return f;
 }

@@ -113,7 +113,7 @@ class LammpsEngine : public RunEngine {
   /// LAMMPS integrates every force at every step: both kinds are the same state.
   Frame frame(StateKind kind = StateKind::Integrator) const override;
   /// The total force on each particle at the current step (pair and k-space), on rank 0.
-  std::vector<double> forces(StateKind kind = StateKind::Integrator) const override;
+  Forces forces(StateKind kind = StateKind::Integrator) const override;
   Observables observables() const override;
   const CoulombSetup* coulombSetup() const override;
   /// LAMMPS's neighbour-list builds (Neighbor::ncalls).

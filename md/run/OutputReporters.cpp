@@ -37,14 +37,8 @@ std::vector<std::pair<std::string, double>> observableRow(const Observables& o) 
 /// (collective; empty on ranks that do not write).
 Frame outputFrame(const RunEngine& engine, const MdConfig& cfg) {
   Frame f = engine.frame(StateKind::Physical);
-  if (cfg.output.write_forces) {
-    const std::vector<double> all = engine.forces(StateKind::Physical);
-    const std::size_t N = engine.size();
-    if (all.size() != 3 * N) return f;  // a rank that does not write
-    f.fx.assign(all.begin(), all.begin() + N);
-    f.fy.assign(all.begin() + N, all.begin() + 2 * N);
-    f.fz.assign(all.begin() + 2 * N, all.end());
-  }
+  // (empty on a rank that does not write)
+  if (cfg.output.write_forces) f.force = engine.forces(StateKind::Physical);
   return f;
 }
 

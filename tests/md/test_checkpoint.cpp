@@ -49,13 +49,13 @@ Checkpoint makeCheckpoint(std::size_t n, unsigned seed) {
     s.ix.push_back(im(rng));
     s.iy.push_back(im(rng));
     s.iz.push_back(im(rng));
-    e.fx.push_back(v(rng) * 1e4);
-    e.fy.push_back(v(rng) * 1e4);
-    e.fz.push_back(v(rng) * 1e4);
+    e.forces.x.push_back(v(rng) * 1e4);
+    e.forces.y.push_back(v(rng) * 1e4);
+    e.forces.z.push_back(v(rng) * 1e4);
   }
   s.vx[0] = -0.0;
   s.vy[0] = std::numeric_limits<double>::denorm_min();
-  e.fz[0] = 1.7976931348623157e308;
+  e.forces.z[0] = 1.7976931348623157e308;
   e.dt = 1.0 / 3000.0;
   e.run.config_toml = "[input]\nversion = 1\n[system]\nN = " + std::to_string(n) + "\n";
   e.run.seed = 0xFFFFFFFFFFFFFFF1ULL;  // needs all 64 unsigned bits
@@ -73,7 +73,8 @@ bool sameCheckpoint(const Checkpoint& a, const Checkpoint& b) {
          sameBits(s.x, t.x) && sameBits(s.y, t.y) && sameBits(s.z, t.z) && sameBits(s.vx, t.vx) &&
          sameBits(s.vy, t.vy) && sameBits(s.vz, t.vz) && sameBits(s.charge, t.charge) &&
          sameBits(s.ix, t.ix) && sameBits(s.iy, t.iy) && sameBits(s.iz, t.iz) &&
-         sameBits(e.fx, f.fx) && sameBits(e.fy, f.fy) && sameBits(e.fz, f.fz) &&
+         sameBits(e.forces.x, f.forces.x) && sameBits(e.forces.y, f.forces.y) &&
+         sameBits(e.forces.z, f.forces.z) &&
          sameBits(e.dt, f.dt) && e.run.config_toml == f.run.config_toml &&
          e.run.seed == f.run.seed && e.run.frames_written == f.run.frames_written &&
          e.run.next_frame_index == f.run.next_frame_index && e.engine.ints == f.engine.ints &&
@@ -131,7 +132,7 @@ TEST_CASE("checkpoint arguments are validated", "[md][io]") {
   const std::string path = tempPath("invalid.h5");
   Checkpoint c = makeCheckpoint(10, 3);
   Checkpoint bad = c;
-  bad.fy.pop_back();
+  bad.forces.y.pop_back();
   CHECK_THROWS_WITH(writeCheckpoint(path, bad),
                     Catch::Contains("fy has 9 entries, expected N = 10"));
   bad = c;
