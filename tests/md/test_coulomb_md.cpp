@@ -450,8 +450,9 @@ TEST_CASE("skins that follow a cold gas are short and change no bit", "[md][coul
   follows.run(600);
   stays.run(600);
   // the optimum for delta = dt max|u| (Skin.h) lies well inside the bounds here
-  INFO("skins " << EngineProbe::contactListSkin(follows) << " and " << EngineProbe::coulombListSkin(follows) << "; builds "
-                << follows.neighborBuilds() << " against " << stays.neighborBuilds());
+  INFO("skins " << EngineProbe::contactListSkin(follows) << " and "
+                << EngineProbe::coulombListSkin(follows) << "; builds " << follows.neighborBuilds()
+                << " against " << stays.neighborBuilds());
   CHECK(EngineProbe::contactListSkin(follows) > NEIGHBOR_SKIN_AUTO_MIN);
   CHECK(EngineProbe::contactListSkin(follows) < 0.2);
   CHECK(EngineProbe::coulombListSkin(follows) > COULOMB_SKIN_AUTO_MIN);
