@@ -751,6 +751,13 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
 
 Engine::Engine(const MdConfig& config, const Checkpoint& ck)
     : Engine(withRecordedSplit(config, ck), ck.state, /*allow_contacts=*/true) {
+  // The time step the checkpoint was written at: the configuration must give the same one, or a
+  // build whose automatic step differs would continue the run silently on another.
+  if (ck.dt > 0.0 && ck.dt != m_impl->dt)
+    throw std::invalid_argument("integrator.dt: the checkpoint was written at dt = " +
+                                common::formatReal(ck.dt) + ", and its configuration now gives " +
+                                common::formatReal(m_impl->dt) +
+                                "; continue it with the granagg that wrote it");
   const EngineState& e = ck.engine;
   // the Coulomb parameters first: restore() sizes the multiple-time-step state for them
   if (const auto design = e.reals.find("coulomb_sum_q2_design"); design != e.reals.end())

@@ -66,7 +66,8 @@ class Engine : public RunEngine {
   /// Continues a checkpoint (checkpoint()) bit for bit: the state, forces, collision counter,
   /// Coulomb parameters and multiple-time-step state it holds, under `config` (the run's own
   /// configuration, as stored with the checkpoint; run.t_end may differ). Throws
-  /// std::invalid_argument if the checkpoint does not fit the configuration.
+  /// std::invalid_argument if the checkpoint does not fit the configuration (its particles, its
+  /// multiple-time-step state, or a time step other than the one it was written at).
   Engine(const MdConfig& config, const Checkpoint& checkpoint);
   ~Engine() override;
   Engine(const Engine&) = delete;

@@ -144,6 +144,10 @@ TEST_CASE("trajectories are identical with 1 and 2 threads and across a restart"
   Engine first(c, init);
   first.run(200);
   Engine resumed(c, first.checkpoint());
+  // a checkpoint written at another time step is refused, naming the key
+  Checkpoint other_dt = first.checkpoint();
+  other_dt.dt *= 2.0;
+  CHECK_THROWS_WITH(Engine(c, other_dt), Catch::StartsWith("integrator.dt: the checkpoint"));
   resumed.run(200);
   CHECK(identical(resumed.frame(), one.frame()));
   CHECK(resumed.observables().collisions == one.observables().collisions);
