@@ -579,17 +579,22 @@ struct Engine::Impl {
         ++shown;
       }
     msg << "; the time step dt = " << dt << " may be too large for these impacts";
-    const auto* hertz = std::get_if<Contact<HertzViscoelastic>>(&contact);
-    if (coulomb && hertz && worst == 2) {
-      // An attractive pair has an equilibrium overlap only if K |q_i q_j| / (1 - xi)^2 = E xi^{3/2}
-      // has a root: max over xi of E xi^{3/2} (1 - xi)^2 is 0.0916 E (at xi = 3/7).
-      const double hold = 0.0916 * hertz->params.E;
+    if (coulomb && worst == 2) {
+      // An attractive pair has an equilibrium overlap only up to the contact model's limit.
+      std::string how;
+      const double hold = std::visit(
+          [&how](const auto& m) {
+            return std::decay_t<decltype(m)>::Model::attractionLimit(m.params, how);
+          },
+          contact);
+      const char* model =
+          std::visit([](const auto& m) { return std::decay_t<decltype(m)>::Model::name; }, contact);
       double worst_qq = 0.0;
       for (std::size_t i = 0; i < bad.size(); ++i)
         if (bad[i] == 2) worst_qq = std::max(worst_qq, pos[i].w * pos[i].w);
-      msg << ", or an attractive Coulomb pair beyond what the Hertz contact can hold (K |q_i q_j| "
-             "> 0.0916 E = "
-          << hold << " has no equilibrium overlap; here K q^2 = " << cfg.coulomb.K * worst_qq
+      msg << ", or an attractive Coulomb pair beyond what the " << model
+          << " contact can hold (K |q_i q_j| > " << how << " = " << hold
+          << " has no equilibrium overlap; here K q^2 = " << cfg.coulomb.K * worst_qq
           << " for the largest flagged charge): lower charging.Q (here " << cfg.charging.Q
           << "; recommended: 0.05 at K = 5, docs/validation.md";
       char q[32];  // two digits: a value to type

@@ -5,7 +5,9 @@
 ///   - `Params` and the device-side physics: `normalForce(xi, xi_dot, params)`,
 ///     `elasticEnergy(xi, params)` (HD, called per pair by md/compute/ContactForce);
 ///   - `name`, the value of `contact.model` that selects it;
-///   - `fromConfig(ContactConfig, m_eff)` and `autoContactTime(params, v, m_eff, why)` (host).
+///   - `fromConfig(ContactConfig, m_eff)`, `autoContactTime(params, v, m_eff, why)` and
+///     `attractionLimit(params, how)`, the strongest Coulomb attraction a static contact
+///     balances, for the engine's message when oppositely charged pairs collapse (host).
 /// The engine holds a ContactModel and never names a model; md/compute/ContactForce dispatches
 /// on it with std::visit, which instantiates the force pass for every model in the list.
 /// Adding a model: its header, one entry in ContactModel below, a test in

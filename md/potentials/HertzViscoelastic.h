@@ -62,6 +62,14 @@ struct HertzViscoelastic {
     why = s.str();
     return tc;
   }
+  /// The strongest attraction a static contact balances (docs/model.md section 4): an attractive
+  /// Coulomb pair K |q_i q_j| / (1 - xi)^2 has an equilibrium overlap only if it is at most the
+  /// maximum over xi of E xi^{3/2} (1 - xi)^2, which is (3/7)^{3/2} (4/7)^2 E = 0.0916 E at
+  /// xi = 3/7; `how` says so.
+  static double attractionLimit(const Params& p, std::string& how) {
+    how = "max over xi of E xi^{3/2} (1 - xi)^2 = 0.0916 E";
+    return std::pow(3.0 / 7.0, 1.5) * (16.0 / 49.0) * p.E;
+  }
 };
 
 }  // namespace granagg::md

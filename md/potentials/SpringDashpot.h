@@ -64,6 +64,13 @@ struct SpringDashpot {
     why = s.str();
     return tc;
   }
+  /// The strongest attraction a static contact balances: the maximum over xi of
+  /// k xi (1 - xi)^2, which is 4 k / 27 at xi = 1/3 (HertzViscoelastic::attractionLimit); `how`
+  /// says so.
+  static double attractionLimit(const Params& p, std::string& how) {
+    how = "max over xi of k xi (1 - xi)^2 = 4 k / 27";
+    return 4.0 * p.k / 27.0;
+  }
 };
 
 }  // namespace granagg::md

@@ -14,6 +14,7 @@
 #include "md/engine/Engine.h"
 #include "md/io/InitialState.h"
 #include "md/neighbor/Skin.h"
+#include "md/potentials/ContactModels.h"
 #include "meanfield/kinetic/Cooling.h"
 
 #include "EngineProbe.h"
@@ -171,6 +172,61 @@ TEST_CASE(
   CHECK(overlap == Approx(lo).epsilon(1e-3));
   CHECK(max_overlap < 0.5);                   // stable at the default dt
   CHECK(e.observables().temperature < 1e-8);  // at rest
+}
+
+TEST_CASE("each contact model's attraction limit is the largest force (1 - xi)^2 of a static "
+          "contact, and a pair beyond it stops the run naming the model and the limit",
+          "[md][coulomb]") {
+  // The reference: the maximum over a fine grid of xi of F(xi, 0) (1 - xi)^2, the Coulomb
+  // attraction K |q_i q_j| / (1 - xi)^2 that a static overlap xi balances.
+  MdConfig c;
+  for (const std::string model : {"hertz", "spring_dashpot"}) {
+    c.contact.model = model;
+    const ContactModel m = makeContactModel(c.contact, 0.5);
+    std::string how;
+    const double limit = std::visit(
+        [&how](const auto& x) {
+          return std::decay_t<decltype(x)>::Model::attractionLimit(x.params, how);
+        },
+        m);
+    double grid_max = 0.0;
+    for (int k = 1; k < 100000; ++k) {
+      const double xi = k * 1e-5;
+      const double f = std::visit(
+          [xi](const auto& x) { return std::decay_t<decltype(x)>::Model::normalForce(xi, 0.0,
+                                                                                    x.params); },
+          m);
+      grid_max = std::max(grid_max, f * (1 - xi) * (1 - xi));
+    }
+    INFO(model << ": limit " << limit << " (" << how << "), grid maximum " << grid_max);
+    CHECK(limit == Approx(grid_max).epsilon(1e-8));
+    if (model == "hertz") CHECK(limit == Approx(0.0916 * c.contact.E).epsilon(1e-3));
+
+    // +-q released near contact with K q^2 at twice the limit: no equilibrium, the pair collapses
+    MdConfig r = c;
+    r.system.N = 2;
+    r.charging.mode = "fixed";
+    r.coulomb.K = 5.0;
+    r.coulomb.method = "ewald";
+    r.coulomb.accuracy = 1e-4;
+    Frame f;
+    f.box = 40.0;
+    f.x = {19.4, 20.6};
+    f.y = f.z = {20.0, 20.0};
+    f.vx = f.vy = f.vz = {0.0, 0.0};
+    const double q = std::sqrt(2.0 * limit / r.coulomb.K);
+    f.charge = {q, -q};
+    Engine e(r, f);
+    std::string message;
+    try {
+      for (int k = 0; k < 200; ++k) e.run(100);
+    } catch (const RunAborted& x) {
+      message = x.what();
+    }
+    INFO(message);
+    CHECK_THAT(message, Catch::Contains("beyond what the " + model + " contact can hold"));
+    CHECK_THAT(message, Catch::Contains(how));
+  }
 }
 
 TEST_CASE(
