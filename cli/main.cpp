@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
   cli::registerPairCommand(app, ctx);
 
   if (const std::string unknown = unknownSubcommand(app, argc, argv); !unknown.empty()) {
-    std::fprintf(stderr, "granagg: error: %s\n", unknown.c_str());
+    std::fprintf(stderr, "%s%s\n", common::ERROR_PREFIX, unknown.c_str());
     return 2;
   }
 
@@ -81,10 +81,10 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // One line, naming the option; exit status 2 for every kind of bad input.
-    std::fprintf(stderr, "granagg: error: %s (see --help)\n", e.what());
+    std::fprintf(stderr, "%s%s (see --help)\n", common::ERROR_PREFIX, e.what());
     return 2;
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "granagg: error: %s\n", e.what());
+    std::fprintf(stderr, "%s%s\n", common::ERROR_PREFIX, e.what());
     return 2;
   } catch (const std::filesystem::filesystem_error& e) {
     // Outputs are checked before the work (common/OutputPath.h); this is a write that failed

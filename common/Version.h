@@ -13,4 +13,7 @@ const char* gitCommit();
 inline std::string versionString() {
   return std::string("granagg ") + version() + " (" + gitCommit() + ")";
 }
+/// What the granagg executable puts before an error on stderr (cli/main.cpp), and what a program
+/// that runs it strips from its last line (study/PairStudy.cpp).
+inline constexpr const char* ERROR_PREFIX = "granagg: error: ";
 }  // namespace granagg::common

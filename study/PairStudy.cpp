@@ -559,7 +559,8 @@ void PairStudy::fitBeta() {
       // fit-beta's "these data cannot be fitted" (e.g. S(t) that does not grow in a short run): a
       // result to report, not a failure of the study.
       std::string why = lastLine(m_out / "logs" / ("fit-" + name + ".log"));
-      if (why.rfind("granagg: error: ", 0) == 0) why = why.substr(16);
+      const std::string prefix = common::ERROR_PREFIX;
+      if (why.rfind(prefix, 0) == 0) why = why.substr(prefix.size());
       m_fit_note[name] = "not possible for these data: " + why;
       say("fit " + name + ": not possible for these data (" + why + ")");
     } else {
