@@ -85,11 +85,14 @@ mode = "fixed"
 EOF
 }
 
-granagg_timing_toml() {  # T_END -> the [run] and [output] part of a timed `granagg md` run: no
-  # frames, no checkpoints, observables only at the end
+granagg_timing_toml() {  # T_END -> the [run] and [output] part of a timed `granagg md` run
+  printf '[run]\nt_end = %s\n' "$1"
+  granagg_output_toml
+}
+
+granagg_output_toml() {  # -> the [output] part of a timed `granagg md` run: no frames, no
+  # checkpoints, observables only at the end
   cat <<EOF
-[run]
-t_end = $1
 [output]
 frames_per_decade = 0
 frame_interval = 0.0

@@ -41,8 +41,7 @@ EWALD_MAX_STEP_S=${EWALD_MAX_STEP_S:-6}
 CSV=${CSV:-docs/img/ewald_pppm.csv}
 PNG=${PNG-docs/img/ewald_pppm.png}
 DT=0.002; PHI=0.076
-calc() { awk "BEGIN {printf \"%.10g\", $1}"; }
-now() { date +%s.%N; }
+. scripts/bench_common.sh   # calc, now, granagg_output_toml
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 
@@ -65,14 +64,8 @@ initial = "bipolar"
 [coulomb]
 K = $K
 accuracy = $ACC
-[output]
-frames_per_decade = 0
-frame_interval = 0.0
-observable_interval = 1000000
-checkpoint_interval = 0
-checkpoint_wall_seconds = 0.0
-write_velocities = false
 EOF
+granagg_output_toml >> "$TMP/base.toml"
 
 run_time() {  # method N steps -> wall seconds of the whole process; the set-up into $TMP/coul
   local t0 t1
