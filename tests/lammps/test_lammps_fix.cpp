@@ -8,11 +8,13 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -74,6 +76,47 @@ std::vector<double> state(LAMMPS_NS::LAMMPS* lmp) {
   return s;
 }
 
+/// x, v, q and the collision count after `commands`, then each of `runs` (LAMMPS commands).
+std::vector<double> stateAfter(const std::vector<std::string>& commands,
+                               const std::vector<std::string>& runs) {
+  auto lmp = newLammps();
+  for (const auto& cmd : commands) lmp->input->one(cmd);
+  for (const auto& r : runs) lmp->input->one(r);
+  return state(lmp.get());
+}
+
+/// The commands of a run continued from the restart file `file`: the same commands with
+/// read_restart for read_data, less what the restart file sets (units, atom style, box).
+std::vector<std::string> fromRestart(const std::vector<std::string>& commands,
+                                     const std::string& file) {
+  std::vector<std::string> out;
+  for (const auto& cmd : commands) {
+    if (cmd.rfind("units", 0) == 0 || cmd.rfind("atom_style", 0) == 0 ||
+        cmd.rfind("boundary", 0) == 0)
+      continue;
+    out.push_back(cmd.rfind("read_data", 0) == 0 ? "read_restart " + file : cmd);
+  }
+  return out;
+}
+
+/// "max|dx| max|dv| max|dq| max|q| collisions_a collisions_b" of two state() results, the
+/// positions compared by minimum image in a box of edge L (a setup wraps them into the box).
+std::string difference(const std::vector<double>& a, const std::vector<double>& b, double L) {
+  double dx = 0.0, dv = 0.0, dq = 0.0, qmax = 0.0;
+  for (std::size_t i = 0; i + 1 < a.size(); i += 7) {
+    for (int k = 0; k < 3; ++k) {
+      const double d = a[i + k] - b[i + k];
+      dx = std::max(dx, std::fabs(d - L * std::round(d / L)));
+      dv = std::max(dv, std::fabs(a[i + 3 + k] - b[i + 3 + k]));
+    }
+    dq = std::max(dq, std::fabs(a[i + 6] - b[i + 6]));
+    qmax = std::max(qmax, std::fabs(a[i + 6]));
+  }
+  std::ostringstream o;
+  o << dx << ' ' << dv << ' ' << dq << ' ' << qmax << ' ' << a.back() << ' ' << b.back() << '\n';
+  return o.str();
+}
+
 }  // namespace
 
 TEST_CASE("fix granagg/charging continues a run from a LAMMPS restart file as if uninterrupted",
@@ -90,44 +133,11 @@ TEST_CASE("fix granagg/charging continues a run from a LAMMPS restart file as if
     const md::Frame s = md::prepareInitialState(c);
     test::spit(dir + "/state.data", md::lammps::lammpsDataText(s));
     const auto in = md::lammps::translateConfig(c, s, dir + "/state.data");
-    std::vector<double> whole, continued;
-    {
-      auto lmp = newLammps();
-      for (const auto& cmd : in.commands) lmp->input->one(cmd);
-      lmp->input->one("run 200");
-      whole = state(lmp.get());
-    }
-    {
-      auto lmp = newLammps();
-      for (const auto& cmd : in.commands) lmp->input->one(cmd);
-      lmp->input->one("run 100");
-      lmp->input->one("write_restart " + dir + "/at100.restart");
-    }
-    {
-      // a new LAMMPS from the restart file: the same commands with read_restart for read_data,
-      // less what the restart file sets (units, atom style, box)
-      auto lmp = newLammps();
-      for (const auto& cmd : in.commands) {
-        if (cmd.rfind("units", 0) == 0 || cmd.rfind("atom_style", 0) == 0 ||
-            cmd.rfind("boundary", 0) == 0)
-          continue;
-        lmp->input->one(cmd.rfind("read_data", 0) == 0 ? "read_restart " + dir + "/at100.restart"
-                                                        : cmd);
-      }
-      lmp->input->one("run 100");
-      continued = state(lmp.get());
-    }
-    double dx = 0.0, dv = 0.0, dq = 0.0, qmax = 0.0;
-    for (std::size_t i = 0; i + 1 < whole.size(); i += 7) {
-      for (int k = 0; k < 3; ++k) {
-        dx = std::max(dx, std::fabs(whole[i + k] - continued[i + k]));
-        dv = std::max(dv, std::fabs(whole[i + 3 + k] - continued[i + 3 + k]));
-      }
-      dq = std::max(dq, std::fabs(whole[i + 6] - continued[i + 6]));
-      qmax = std::max(qmax, std::fabs(whole[i + 6]));
-    }
-    std::ofstream(out) << dx << ' ' << dv << ' ' << dq << ' ' << qmax << ' ' << whole.back()
-                       << ' ' << continued.back() << '\n';
+    const std::vector<double> whole = stateAfter(in.commands, {"run 200"});
+    stateAfter(in.commands, {"run 100", "write_restart " + dir + "/at100.restart"});
+    const std::vector<double> continued =
+        stateAfter(fromRestart(in.commands, dir + "/at100.restart"), {"run 100"});
+    std::ofstream(out) << difference(whole, continued, s.box);
     MPI_Finalize();
     return 0;
   });
@@ -167,53 +177,13 @@ TEST_CASE("fix granagg/charging under rRESPA: chunks and a restart continue the 
     const md::Frame s = md::prepareInitialState(c);
     test::spit(dir + "/state.data", md::lammps::lammpsDataText(s));
     const auto in = md::lammps::translateConfig(c, s, dir + "/state.data");
-    std::vector<double> whole, chunked, continued;
-    {
-      auto lmp = newLammps();
-      for (const auto& cmd : in.commands) lmp->input->one(cmd);
-      lmp->input->one("run 60");
-      whole = state(lmp.get());
-    }
-    {
-      auto lmp = newLammps();
-      for (const auto& cmd : in.commands) lmp->input->one(cmd);
-      for (int k = 0; k < 6; ++k) lmp->input->one("run 10 post no");
-      chunked = state(lmp.get());
-    }
-    {
-      auto lmp = newLammps();
-      for (const auto& cmd : in.commands) lmp->input->one(cmd);
-      lmp->input->one("run 30");
-      lmp->input->one("write_restart " + dir + "/at30.restart");
-    }
-    {
-      auto lmp = newLammps();
-      for (const auto& cmd : in.commands) {
-        if (cmd.rfind("units", 0) == 0 || cmd.rfind("atom_style", 0) == 0 ||
-            cmd.rfind("boundary", 0) == 0)
-          continue;
-        lmp->input->one(cmd.rfind("read_data", 0) == 0 ? "read_restart " + dir + "/at30.restart"
-                                                        : cmd);
-      }
-      lmp->input->one("run 30");
-      continued = state(lmp.get());
-    }
-    std::ofstream o(out);
-    for (const auto* other : {&chunked, &continued}) {
-      double dx = 0.0, dv = 0.0, dq = 0.0, qmax = 0.0;
-      for (std::size_t i = 0; i + 1 < whole.size(); i += 7) {
-        for (int k = 0; k < 3; ++k) {
-          // (a setup wraps the positions into the box: the minimum image of the difference)
-          const double d = whole[i + k] - (*other)[i + k];
-          dx = std::max(dx, std::fabs(d - s.box * std::round(d / s.box)));
-          dv = std::max(dv, std::fabs(whole[i + 3 + k] - (*other)[i + 3 + k]));
-        }
-        dq = std::max(dq, std::fabs(whole[i + 6] - (*other)[i + 6]));
-        qmax = std::max(qmax, std::fabs(whole[i + 6]));
-      }
-      o << dx << ' ' << dv << ' ' << dq << ' ' << qmax << ' ' << whole.back() << ' '
-        << other->back() << '\n';
-    }
+    const std::vector<double> whole = stateAfter(in.commands, {"run 60"});
+    const std::vector<double> chunked =
+        stateAfter(in.commands, std::vector<std::string>(6, "run 10 post no"));
+    stateAfter(in.commands, {"run 30", "write_restart " + dir + "/at30.restart"});
+    const std::vector<double> continued =
+        stateAfter(fromRestart(in.commands, dir + "/at30.restart"), {"run 30"});
+    std::ofstream(out) << difference(whole, chunked, s.box) << difference(whole, continued, s.box);
     MPI_Finalize();
     return 0;
   });

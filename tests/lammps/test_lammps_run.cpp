@@ -79,6 +79,28 @@ std::string twoBodyConfig(const fs::path& dir, const std::string& state, const s
                        "checkpoint_wall_seconds = 0.0\n");
 }
 
+/// The two-body state's collision, independently: the step at which the free drift x += dt u of
+/// both particles (fix nve/sphere's arithmetic; no force acts before the contact) first brings
+/// their distance below 1, and the approach speed there as the engine computes it
+/// (md/compute/ContactForce.cpp) from the velocities, which before the contact are the initial
+/// ones: xi' = -(v_0 - v_1).(r/|r|).
+struct Collision {
+  std::int64_t step = 0;
+  double xi_dot = 0.0;
+};
+Collision twoBodyCollision(double v, double dt) {
+  double x0 = 1.999, x1 = 3.001, rx = 0.0;
+  Collision c;
+  do {
+    x0 += dt * (0.5 * v);
+    x1 += dt * -(0.5 * v);
+    ++c.step;
+    rx = x0 - x1;
+  } while (!(rx * rx < 1.0));
+  c.xi_dot = -((0.5 * v - -(0.5 * v)) * (rx * (1.0 / std::sqrt(rx * rx))));
+  return c;
+}
+
 }  // namespace
 
 TEST_CASE("granagg-lammps exchanges at a collision exactly the charge of ChargeExchange",
@@ -93,21 +115,7 @@ TEST_CASE("granagg-lammps exchanges at a collision exactly the charge of ChargeE
   INFO(r.output);
   REQUIRE(r.status == 0);
 
-  // the step of the collision, independently: the free drift x += dt u of both particles (fix
-  // nve/sphere's arithmetic; no force acts before the contact) until their distance is below 1
-  double x0 = 1.999, x1 = 3.001;
-  std::int64_t step = 0;
-  double rx = 0.0;
-  do {
-    x0 += dt * (0.5 * v);
-    x1 += dt * -(0.5 * v);
-    ++step;
-    rx = x0 - x1;
-  } while (!(rx * rx < 1.0));
-  // the approach speed as the engine computes it (md/compute/ContactForce.cpp) from the velocities,
-  // which before the contact are the initial ones: xi' = -(v_0 - v_1).(r/|r|)
-  const double r_len = std::sqrt(rx * rx);
-  const double xi_dot = -((0.5 * v - -(0.5 * v)) * (rx * (1.0 / r_len)));
+  const auto [step, xi_dot] = twoBodyCollision(v, dt);
   md::ChargeExchange::Params p;
   p.seed = 987654321;
   const double dq0 = md::ChargeExchange::transferTo(p, step, 0, 1, xi_dot);
@@ -163,17 +171,8 @@ TEST_CASE("granagg-lammps under rRESPA exchanges at the inner step of a collisio
 
   // the free drift with LAMMPS's inner step (the outer timestep 4 dt divided by 4); the charges
   // are 0 before the contact, so no force acts
-  const double inner = 4 * dt / 4;
-  double x0 = 1.999, x1 = 3.001, rx = 0.0;
-  std::int64_t step = 0;
-  do {
-    x0 += inner * (0.5 * v);
-    x1 += inner * -(0.5 * v);
-    ++step;
-    rx = x0 - x1;
-  } while (!(rx * rx < 1.0));
+  const auto [step, xi_dot] = twoBodyCollision(v, 4 * dt / 4);
   CHECK(step % 4 != 0);  // an inner step between outer boundaries
-  const double xi_dot = -((0.5 * v - -(0.5 * v)) * (rx * (1.0 / std::sqrt(rx * rx))));
   md::ChargeExchange::Params p;
   p.seed = 987654321;
   const double dq0 = md::ChargeExchange::transferTo(p, step, 0, 1, xi_dot);
