@@ -597,14 +597,20 @@ void PairStudy::pythonStage(const std::string& stage, const std::string& script,
   m_timing[stage] = std::chrono::duration<double>(clock::now() - t0).count();
 }
 
-/// The figures (scripts/plot_figures.py) and report.html (scripts/make_report.py, which reads
-/// summary.json): Python from Debian.
-void PairStudy::figures() {
+/// The figures (scripts/plot_figures.py), then the summary, written once, then report.html
+/// (scripts/make_report.py), which is made from that summary and so comes after it: the
+/// summary says so, and the report's outcome is in pair.log and the printed summary. Python
+/// from Debian.
+void PairStudy::figuresAndReport() {
   if (m_a.no_figures) {
     m_status["figures"] = m_status["report"] = "skipped (--no-figures)";
+    writeSummary();
     return;
   }
   pythonStage("figures", "plot_figures.py", m_out / "figures");
+  m_status["report"] =
+      "made from this summary after it (report.html; its outcome: pair.log and the printed "
+      "summary)";
   writeSummary();
   pythonStage("report", "make_report.py", m_out / "report.html");
 }
@@ -636,9 +642,7 @@ void PairStudy::run() {
   meanField();
   fitBeta();
   m_status["md"] = "done";
-  writeSummary();
-  figures();
-  writeSummary();
+  figuresAndReport();  // with the summary, written once
   printSummary();
   if (m_failures > 0)
     throw std::runtime_error(std::to_string(m_failures) + " post-processing step(s) failed (see " +
