@@ -124,7 +124,7 @@ class PairStudy {
   void fitBeta();
   void pythonStage(const std::string& stage, const std::string& script,
                    const std::filesystem::path& made);
-  void figuresAndReport();  /// the figures, the summary (once) and report.html
+  void figuresAndReport();  ///< the figures, the summary (once) and report.html
   void writeSummary();
   void printSummary();
   double seconds() const { return std::chrono::duration<double>(clock::now() - m_start).count(); }
