@@ -427,6 +427,16 @@ int PairStudy::runStep(const std::string& label, std::vector<std::string> argv,
   return rc;
 }
 
+int PairStudy::runStageStep(const StageStep& step) {
+  if (!step.redo && stageDone(step.marker, step.spec) && fs::exists(step.made))
+    return STEP_SKIPPED;
+  fs::remove(step.marker);
+  if (!step.clear.empty()) fs::remove_all(step.clear);
+  const int rc = runStep(step.label, step.argv, step.logname, step.quiet_failure);
+  if (rc == 0) writeText(step.marker, step.spec);
+  return rc;
+}
+
 void PairStudy::analyse() {
   const auto t0 = clock::now();
   for (double K : m_c.K) {
@@ -442,15 +452,12 @@ void PairStudy::analyse() {
     argv.insert(argv.end(), m_c.analysis_args.begin(), m_c.analysis_args.end());
     for (const auto& x : m_c.analysis_args) spec += " " + x;
     spec += "\n";
-    if (!m_changed_k.count(name) && stageDone(marker, spec) && fs::exists(dir / "S_t.csv")) {
-      say("analysis " + name + ": up to date, skipped", false);
-      continue;
-    }
-    fs::remove(marker);
-    fs::remove_all(dir);
     argv.insert(argv.end(), {"--out", dir.string(), "--threads", std::to_string(m_cores), "-q"});
-    if (runStep("analysis " + name, argv, "analyze-" + name) == 0) {
-      writeText(marker, spec);
+    const int rc = runStageStep({"analysis " + name, "analyze-" + name, argv, spec, marker,
+                                 dir / "S_t.csv", dir, m_changed_k.count(name) > 0});
+    if (rc == STEP_SKIPPED) {
+      say("analysis " + name + ": up to date, skipped", false);
+    } else if (rc == 0) {
       m_changed_k.insert(name);
       say("analysis " + name + ": done (" + dir.string() + ")");
     } else {
@@ -495,25 +502,20 @@ void PairStudy::meanField() {
                    {"kinetic", "charging", "--kappa", formatReal(kappa)}});
   int ok = 0;
   for (const Step& s : steps) {
-    const fs::path out = dir / s.file, marker = dir / (s.file + ".done");
+    const fs::path out = dir / s.file;
     std::string spec;
     for (const auto& x : s.args) spec += x + " ";
     spec += "\n";
-    if (stageDone(marker, spec) && fs::exists(out)) {
-      ++ok;
-      continue;
-    }
-    fs::remove(marker);
     std::vector<std::string> argv{m_s.exe};
     argv.insert(argv.end(), s.args.begin(), s.args.end());
     argv.insert(argv.end(), {"--out", out.string(), "--force"});
     if (s.args[0] == "smol" && s.args[1] != "zbeta") argv.push_back("-q");
-    if (runStep(s.label, argv, "meanfield") == 0) {
-      writeText(marker, spec);
+    const int rc =
+        runStageStep({s.label, "meanfield", argv, spec, dir / (s.file + ".done"), out, {}});
+    if (rc == 0 || rc == STEP_SKIPPED)
       ++ok;
-    } else {
+    else
       ++m_failures;
-    }
   }
   m_status["meanfield"] =
       ok == static_cast<int>(steps.size()) ? "done" : "failed (see logs/meanfield.log)";
@@ -541,18 +543,15 @@ void PairStudy::fitBeta() {
                   {"--window", formatReal(m_c.fit_window[0]), formatReal(m_c.fit_window[1])});
     const std::string spec = joinCommand(std::vector<std::string>(argv.begin() + 1, argv.end())) +
                              " " + readText(m_out / "analysis" / (name + ".done"));
-    if (!m_changed_k.count(name) && stageDone(marker, spec) && fs::exists(dir / "fit_beta.json")) {
-      ++ok;
-      say("fit " + name + ": up to date, skipped", false);
-      continue;
-    }
-    fs::remove(marker);
-    fs::remove_all(dir);
     fs::create_directories(dir.parent_path());
     argv.insert(argv.end(), {"--out", dir.string(), "-q"});
-    const int rc = runStep("fit " + name, argv, "fit-" + name, /*quiet_failure=*/true);
-    if (rc == 0) {
-      writeText(marker, spec);
+    const int rc = runStageStep({"fit " + name, "fit-" + name, argv, spec, marker,
+                                 dir / "fit_beta.json", dir, m_changed_k.count(name) > 0,
+                                 /*quiet_failure=*/true});
+    if (rc == STEP_SKIPPED) {
+      ++ok;
+      say("fit " + name + ": up to date, skipped", false);
+    } else if (rc == 0) {
       ++ok;
       say("fit " + name + ": done (" + dir.string() + ")");
     } else if (rc == 2) {

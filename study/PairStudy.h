@@ -119,6 +119,21 @@ class PairStudy {
   std::string runLastLine(const RunJob& j) const;
   int runStep(const std::string& label, std::vector<std::string> argv, const std::string& logname,
               bool quiet_failure = false);
+  /// One resumable step of a post-processing stage (analyse, mean field, fit): one command whose
+  /// marker file holds the step's spec once it has run. A step is skipped when its marker holds
+  /// `spec` and `made` exists, unless `redo` (an input changed); otherwise `clear` is removed,
+  /// the command run (runStep) and on success the marker written.
+  struct StageStep {
+    std::string label, logname;
+    std::vector<std::string> argv;
+    std::string spec;
+    std::filesystem::path marker, made, clear;
+    bool redo = false;
+    bool quiet_failure = false;
+  };
+  /// Runs `step` as StageStep says; returns its exit status, or STEP_SKIPPED.
+  int runStageStep(const StageStep& step);
+  static constexpr int STEP_SKIPPED = -1;
   void analyse();
   void meanField();
   void fitBeta();
