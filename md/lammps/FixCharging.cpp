@@ -240,6 +240,12 @@ void FixCharging::setup_pre_reverse(int /*eflag*/, int /*vflag*/) {
   }
   for (int i = nlocal; i < nall; ++i)
     for (int k = 0; k < 3; ++k) f[i][k] = 0.0;
+  // The reverse communication above also moved the ghosts' torques (atom_style sphere), which
+  // LAMMPS's own would add again: zeroed too. (They are zero with this model, which has no
+  // tangential force, but the fix must not rely on that.)
+  if (!m_restore_forces && m_setup_level == 0 && atom->torque_flag)
+    for (int i = nlocal; i < nall; ++i)
+      for (int k = 0; k < 3; ++k) atom->torque[i][k] = 0.0;
   if (m_setup_level == 1) {
     m_restore_forces = true;  // both levels kept: every later setup restores them
     restart_reset = 0;
