@@ -13,7 +13,9 @@ would detect (80 % power at the 5 % level, about 2.8 standard errors of the diff
 relative to the reference mean.
 Needs Debian's python3-numpy and python3-scipy (/usr/bin/python3).
 """
+import glob
 import os
+import re
 import sys
 
 import numpy as np
@@ -99,3 +101,100 @@ def welch(x, ref, observables, times):
                          DETECTABLE_SE * se / abs(ym) if ym != 0 else np.nan, tstat, p,
                          int(xn), int(yn)))
     return rows, (pmin, nsig, m, m > 0 and pmin >= 0.05 / m)
+
+
+def runs_of(folder):
+    """{seed: run folder} of the run<seed> folders in FOLDER."""
+    out = {}
+    for d in glob.glob(os.path.join(folder, "run*")):
+        m = re.fullmatch(r"run(\d+)", os.path.basename(d))
+        if m and os.path.isdir(d):
+            out[int(m.group(1))] = d
+    return out
+
+
+def run_status(folder):
+    """(finished runs, unfinished runs, mean wall seconds of the finished ones) of the run<seed>
+    folders in FOLDER (a finished run has a file `done` holding its wall seconds)."""
+    done, wall = 0, []
+    runs = runs_of(folder)
+    for d in runs.values():
+        f = os.path.join(d, "done")
+        if os.path.exists(f):
+            done += 1
+            wall.append(float(open(f).read()))
+    return done, len(runs) - done, (np.mean(wall) if wall else np.nan)
+
+
+def write_comparison(top, title, names, labels, nruns, rows, verdict, status, notes=""):
+    """TOP/comparison.csv and TOP/comparison.md of welch()'s rows for ensemble names[1] against
+    names[0] (the reference), with each ensemble's run status (run_status) and NOTES (markdown)
+    after the run table. Returns the markdown text."""
+    pmin, nsig, m, same = verdict
+    ref, x = names
+    with open(os.path.join(top, "comparison.csv"), "w") as f:
+        f.write(f"# {title}; Welch's t test per observable and time\n")
+        f.write("# runs analysed: " + ", ".join(f"{e} {nruns[e]}" for e in names) + "\n")
+        f.write(f"# tests {m}, p < 0.05: {nsig}, smallest p {pmin:.4g}, Bonferroni 0.05/m: "
+                f"{'indistinguishable' if same else 'DIFFERS'}\n")
+        f.write(f"observable,t,{x}_mean,{ref}_mean,{x}_sd,{ref}_sd,rel_diff,rel_detectable,"
+                f"t_stat,p,{x}_runs,{ref}_runs\n")
+        for r in rows:
+            f.write("%s,%g,%.6g,%.6g,%.4g,%.4g,%.4g,%.4g,%.3f,%.4g,%d,%d\n" % r)
+    md = os.path.join(top, "comparison.md")
+    with open(md, "w") as f:
+        f.write("| ensemble | runs finished | runs unfinished | wall per finished run (s) |\n"
+                "|---|---|---|---|\n")
+        for e in names:
+            d, u, w = status[e]
+            f.write(f"| {labels[e]} | {d} | {u} | {'-' if np.isnan(w) else f'{w:.0f}'} |\n")
+        f.write(notes)
+        f.write(f"\n**Verdict ({m} tests, Bonferroni 0.05/{m} = {0.05 / max(m, 1):.2g}): "
+                f"{'indistinguishable' if same else 'DIFFERS'}**; {nsig} p values below 0.05, "
+                f"the smallest {pmin:.3g}.\n")
+        f.write(f"\n| observable | t | {labels[x]} | {labels[ref]} | rel. difference "
+                f"| detectable (80 % power) | p | runs ({x}, {ref}) |\n"
+                "|---|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            f.write(f"| {r[0]} | {r[1]:g} | {r[2]:.4g} | {r[3]:.4g} | {100 * r[6]:+.2f} % "
+                    f"| {100 * r[7]:.2f} % | {r[9]:.2g} | {r[10]}, {r[11]} |\n")
+    return open(md).read()
+
+
+def part_arguments(args, who, doc):
+    """(PARTDIR, times, docs name or None) of a two-ensemble comparison's command line
+    `PARTDIR --times "A B C" [--docs NAME]`; prints DOC for -h and exits (2 for bad input)."""
+    if not args or args[0] in ("-h", "--help"):
+        print(doc)
+        sys.exit(0 if args else 2)
+    if "--times" not in args or args.index("--times") + 1 >= len(args):
+        print(f"{who}: --times needs the comparison times, e.g. --times '50 100 150'")
+        sys.exit(2)
+    try:
+        times = tuple(float(t) for t in args[args.index("--times") + 1].replace(",", " ").split())
+    except ValueError:
+        print(f"{who}: --times takes numbers, e.g. --times '50 100 150'")
+        sys.exit(2)
+    docs = None
+    if "--docs" in args:
+        k = args.index("--docs")
+        if k + 1 >= len(args) or not re.fullmatch(r"[a-z0-9_]+", args[k + 1]):
+            print(f"{who}: --docs needs a name of [a-z0-9_]")
+            sys.exit(2)
+        docs = args[k + 1]
+    return args[0], times, docs
+
+
+def load_ensembles(top, names, times, who):
+    """({name: ensemble_stats}, {name: runs}) of TOP/NAME/analysis for each name, runs that
+    stopped early left out per time; exits 1 unless every ensemble is analysed."""
+    data, nruns = {}, {}
+    for e in names:
+        v, n = per_run_values(os.path.join(top, e, "analysis"), times, missing="nan", who=who)
+        if v is not None:
+            data[e], nruns[e] = ensemble_stats(v, n), n
+    if len(data) < len(names):
+        print(f"{who}: {top} has no analysed ensemble of each of {', '.join(names)} yet "
+              f"(analysed: {', '.join(data) or 'none'})")
+        sys.exit(1)
+    return data, nruns

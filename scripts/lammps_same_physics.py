@@ -17,9 +17,7 @@ out of that time's statistics; the table gives the run counts.
     --docs NAME  also copy the table to docs/validation/lammps_same_physics_NAME.{csv,md}
 Writes PARTDIR/comparison.csv and PARTDIR/comparison.md and prints the latter.
 """
-import glob
 import os
-import re
 import shutil
 import sys
 
@@ -30,16 +28,6 @@ import ensemble_welch as ew  # noqa: E402
 
 ENGINES = ("md", "lammps")
 LABELS = {"md": "granagg md", "lammps": "granagg-lammps"}
-
-
-def runs_of(folder):
-    """{seed: run folder} of an engine's folder."""
-    out = {}
-    for d in glob.glob(os.path.join(folder, "run*")):
-        m = re.fullmatch(r"run(\d+)", os.path.basename(d))
-        if m and os.path.isdir(d):
-            out[int(m.group(1))] = d
-    return out
 
 
 def first_frame(run):
@@ -59,7 +47,7 @@ def first_frame(run):
 def initial_state_check(top):
     """Per seed run by both engines: the largest difference of frame 0's positions, velocities
     and charges (0 when granagg-lammps built the identical state)."""
-    md, lmp = runs_of(os.path.join(top, "md")), runs_of(os.path.join(top, "lammps"))
+    md, lmp = ew.runs_of(os.path.join(top, "md")), ew.runs_of(os.path.join(top, "lammps"))
     out = []
     for seed in sorted(set(md) & set(lmp)):
         a, b = first_frame(md[seed]), first_frame(lmp[seed])
@@ -73,90 +61,25 @@ def initial_state_check(top):
     return out
 
 
-def run_status(folder):
-    """(finished runs, unfinished runs, mean wall seconds of the finished ones) of an engine."""
-    done, wall = 0, []
-    runs = runs_of(folder)
-    for d in runs.values():
-        f = os.path.join(d, "done")
-        if os.path.exists(f):
-            done += 1
-            wall.append(float(open(f).read()))
-    return done, len(runs) - done, (np.mean(wall) if wall else np.nan)
-
-
 def main():
-    args = sys.argv[1:]
-    if not args or args[0] in ("-h", "--help"):
-        print(__doc__)
-        return 0 if args else 2
-    top = args[0]
-    if "--times" not in args or args.index("--times") + 1 >= len(args):
-        print("lammps_same_physics.py: --times needs the comparison times, e.g. "
-              "--times '50 100 150'")
-        return 2
-    try:
-        times = tuple(float(t) for t in args[args.index("--times") + 1].replace(",", " ").split())
-    except ValueError:
-        print("lammps_same_physics.py: --times takes numbers, e.g. --times '50 100 150'")
-        return 2
-    docs = None
-    if "--docs" in args:
-        k = args.index("--docs")
-        if k + 1 >= len(args) or not re.fullmatch(r"[a-z0-9_]+", args[k + 1]):
-            print("lammps_same_physics.py: --docs needs a name of [a-z0-9_]")
-            return 2
-        docs = args[k + 1]
-    data, nruns = {}, {}
-    for e in ENGINES:
-        v, n = ew.per_run_values(os.path.join(top, e, "analysis"), times, missing="nan",
-                                 who="lammps_same_physics.py")
-        if v is not None:
-            data[e], nruns[e] = ew.ensemble_stats(v, n), n
-    if len(data) < 2:
-        print(f"lammps_same_physics.py: {top} has no analysed ensemble of both engines yet "
-              f"(analysed: {', '.join(data) or 'none'})")
-        return 1
+    top, times, docs = ew.part_arguments(sys.argv[1:], "lammps_same_physics.py", __doc__)
+    data, nruns = ew.load_ensembles(top, ENGINES, times, "lammps_same_physics.py")
     rows, (pmin, nsig, m, same) = ew.welch(data["lammps"], data["md"], ew.OBSERVABLES, times)
     init = initial_state_check(top)
-    status = {e: run_status(os.path.join(top, e)) for e in ENGINES}
+    status = {e: ew.run_status(os.path.join(top, e)) for e in ENGINES}
     part = os.path.basename(os.path.normpath(top))
-
-    csv = os.path.join(top, "comparison.csv")
-    with open(csv, "w") as f:
-        f.write(f"# scripts/lammps_same_physics.py: part {part}, granagg-lammps ensemble against "
-                "granagg md's; Welch's t test per observable and time\n")
-        f.write("# runs analysed: " + ", ".join(f"{e} {nruns[e]}" for e in ENGINES) + "\n")
-        f.write(f"# tests {m}, p < 0.05: {nsig}, smallest p {pmin:.4g}, Bonferroni 0.05/m: "
-                f"{'indistinguishable' if same else 'DIFFERS'}\n")
-        f.write("observable,t,lammps_mean,md_mean,lammps_sd,md_sd,rel_diff,rel_detectable,"
-                "t_stat,p,lammps_runs,md_runs\n")
-        for r in rows:
-            f.write("%s,%g,%.6g,%.6g,%.4g,%.4g,%.4g,%.4g,%.3f,%.4g,%d,%d\n" % r)
-
-    md = os.path.join(top, "comparison.md")
-    with open(md, "w") as f:
-        f.write("| engine | runs finished | runs unfinished | wall per finished run (s) |\n"
-                "|---|---|---|---|\n")
-        for e in ENGINES:
-            d, u, w = status[e]
-            f.write(f"| {LABELS[e]} | {d} | {u} | {'-' if np.isnan(w) else f'{w:.0f}'} |\n")
-        if init:
-            worst = np.nanmax([r[2:] for r in init], axis=0)
-            f.write(f"\nInitial states (frame 0, {len(init)} seeds run by both engines, N = "
-                    f"{init[0][1]}): largest difference in x {worst[0]:.3g}, in v {worst[1]:.3g}, "
-                    f"in q {worst[2]:.3g}"
-                    f"{' (identical)' if np.all(np.nan_to_num(worst, nan=1.0) == 0) else ''}.\n")
-        f.write(f"\n**Verdict ({m} tests, Bonferroni 0.05/{m} = {0.05 / max(m, 1):.2g}): "
-                f"{'indistinguishable' if same else 'DIFFERS'}**; {nsig} p values below 0.05, "
-                f"the smallest {pmin:.3g}.\n")
-        f.write("\n| observable | t | granagg-lammps | granagg md | rel. difference "
-                "| detectable (80 % power) | p | runs (lammps, md) |\n"
-                "|---|---|---|---|---|---|---|---|\n")
-        for r in rows:
-            f.write(f"| {r[0]} | {r[1]:g} | {r[2]:.4g} | {r[3]:.4g} | {100 * r[6]:+.2f} % "
-                    f"| {100 * r[7]:.2f} % | {r[9]:.2g} | {r[10]}, {r[11]} |\n")
-    print(open(md).read())
+    notes = ""
+    if init:
+        worst = np.nanmax([r[2:] for r in init], axis=0)
+        notes = (f"\nInitial states (frame 0, {len(init)} seeds run by both engines, N = "
+                 f"{init[0][1]}): largest difference in x {worst[0]:.3g}, in v {worst[1]:.3g}, "
+                 f"in q {worst[2]:.3g}"
+                 f"{' (identical)' if np.all(np.nan_to_num(worst, nan=1.0) == 0) else ''}.\n")
+    text = ew.write_comparison(
+        top, f"scripts/lammps_same_physics.py: part {part}, granagg-lammps ensemble against "
+        "granagg md's", ENGINES, LABELS, nruns, rows, (pmin, nsig, m, same), status, notes)
+    csv, md = os.path.join(top, "comparison.csv"), os.path.join(top, "comparison.md")
+    print(text)
     if docs:
         os.makedirs("docs/validation", exist_ok=True)
         shutil.copy(csv, f"docs/validation/lammps_same_physics_{docs}.csv")

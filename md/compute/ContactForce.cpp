@@ -8,6 +8,7 @@
 #include <variant>
 
 #include <thrust/for_each.h>
+#include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
@@ -18,6 +19,7 @@
 #include "md/engine/Launch.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/potentials/ContactModels.h"
+#include "md/potentials/ImpactSpeed.h"
 
 namespace granagg::md {
 
@@ -402,6 +404,41 @@ struct MaxOverlapOf {
   HD double operator()(int i) const { return s(i).max_overlap; }
 };
 
+/// Largest v_pair^2 (md/potentials/ImpactSpeed.h) of particle i's listed pairs.
+template <class Potential>
+struct PairImpactSpeed2Of {
+  const Scalar4* pos;
+  const Vec3* vel;
+  const int *rows, *counts;
+  int cap;
+  common::Box box;
+  typename Potential::Params params;
+  double coulomb_K, m_eff;
+  HD double operator()(int i) const {
+    double best = 0.0;
+    const int* row = rows + static_cast<long>(i) * cap;
+    const Scalar4 ri = pos[i];
+    const Vec3 vi = vel[i];
+    for (int k = 0; k < counts[i]; ++k) {
+      const int j = row[k];
+      const Scalar4 rj = pos[j];
+      const Vec3 vj = vel[j];
+      const double rx = box.minimumImageWrapped(ri.x - rj.x),
+                   ry = box.minimumImageWrapped(ri.y - rj.y),
+                   rz = box.minimumImageWrapped(ri.z - rj.z);
+      const double r = sqrt(rx * rx + ry * ry + rz * rz);
+      if (!(r > 0.0)) continue;
+      // closing rate -(v_i - v_j) . r_ij / r
+      const double approach =
+          -((vi.x - vj.x) * rx + (vi.y - vj.y) * ry + (vi.z - vj.z) * rz) / r;
+      const double v2 =
+          pairImpactSpeed2<Potential>(r, approach, coulomb_K * ri.w * rj.w, params, m_eff);
+      best = v2 > best ? v2 : best;
+    }
+    return best;
+  }
+};
+
 }  // namespace
 
 template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING, bool ADVANCE = false>
@@ -570,6 +607,21 @@ ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, con
       [&](const auto& c) {
         using Model = typename std::decay_t<decltype(c)>::Model;
         return contactSummaryOf<Model>(p, nl, box, c.params);
+      },
+      model);
+}
+
+double maxPairImpactSpeed2(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                           const ContactModel& model, double coulomb_K, double m_eff) {
+  const int N = static_cast<int>(p.size());
+  return std::visit(
+      [&](const auto& c) {
+        using Model = typename std::decay_t<decltype(c)>::Model;
+        const PairImpactSpeed2Of<Model> f{raw(p.pos), raw(p.vel), nl.rows(), nl.counts(),
+                                          nl.capacity(), box, c.params, coulomb_K, m_eff};
+        return thrust::transform_reduce(thrust::counting_iterator<int>(0),
+                                        thrust::counting_iterator<int>(N), f, 0.0,
+                                        thrust::maximum<double>());
       },
       model);
 }

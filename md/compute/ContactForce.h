@@ -146,6 +146,12 @@ struct ContactSummary {
 };
 ContactSummary contactSummary(const ParticleData& p, const NeighborList& nl, const common::Box& box,
                               const ContactModel& model);
+/// The largest v_pair^2 over the pairs of the list (md/potentials/ImpactSpeed.h): the adaptive
+/// time step's pair criterion, from the positions, the charges and the velocities p.vel (at full
+/// step: call between steps). `coulomb_K` is K (0 without Coulomb forces). A maximum is exact,
+/// so the result does not depend on the thread count or the storage order.
+double maxPairImpactSpeed2(const ParticleData& p, const NeighborList& nl, const common::Box& box,
+                           const ContactModel& model, double coulomb_K, double m_eff);
 /// Largest overlap of each particle (storage order), for error messages.
 void maxOverlapPerParticle(const ParticleData& p, const NeighborList& nl, const common::Box& box,
                            const ContactModel& model, DVec<double>& out);

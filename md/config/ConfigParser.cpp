@@ -315,6 +315,13 @@ std::string assign(const Key& key, const std::string& full, const toml::node& no
       return full + " must be a non-negative integer" + got;
     }
   } else if (auto r = std::get_if<RealRef>(&key.ref)) {
+    const bool time_step = full == "integrator.dt";
+    if (time_step) config.integrator.adaptive = false;
+    if (auto s = node.as_string(); s && time_step && s->get() == "adaptive") {
+      (*r)(config) = 0.0;  // starts at the "auto" step
+      config.integrator.adaptive = true;
+      return "";
+    }
     double x = 0.0;
     if (auto v = node.as_floating_point()) {
       x = v->get();
@@ -324,12 +331,15 @@ std::string assign(const Key& key, const std::string& full, const toml::node& no
       (*r)(config) = 0.0;
       return "";
     } else {
-      return full + (key.auto_allowed ? " must be a number or \"auto\"" : " must be a number") +
-             got;
+      const char* what = time_step            ? " must be a number, \"auto\" or \"adaptive\""
+                         : key.auto_allowed ? " must be a number or \"auto\""
+                                            : " must be a number";
+      return full + what + got;
     }
     // Zero is how "auto" is stored, so an explicit value must be positive.
     if (key.auto_allowed && !(x > 0.0))
-      return full + " = " + common::formatReal(x) + " is invalid: must be > 0 or \"auto\"";
+      return full + " = " + common::formatReal(x) + " is invalid: must be > 0" +
+             (time_step ? ", \"auto\" or \"adaptive\"" : " or \"auto\"");
     (*r)(config) = x;
   } else if (auto r = std::get_if<BoolRef>(&key.ref)) {
     auto v = node.as_boolean();
@@ -487,6 +497,8 @@ std::string valueText(const Key& key, const MdConfig& config, bool toml) {
   }
   if (auto r = std::get_if<RealRef>(&key.ref)) {
     const double x = (*r)(c);
+    if (&(*r)(c) == &c.integrator.dt && c.integrator.adaptive)
+      return toml ? "\"adaptive\"" : "adaptive";
     if (key.auto_allowed && x == 0.0) return toml ? "\"auto\"" : "auto";
     return toml ? tomlReal(x) : common::formatReal(x);
   }
@@ -548,7 +560,7 @@ void validateConfig(const MdConfig& c) {
 
   const IntegratorConfig& g = c.integrator;
   if (!(g.dt >= 0.0 && finite(g.dt)))
-    invalid("integrator.dt", formatReal(g.dt), "be > 0 or \"auto\"");
+    invalid("integrator.dt", formatReal(g.dt), "be > 0, \"auto\" or \"adaptive\"");
   if (!(g.steps_per_contact >= 5.0 && finite(g.steps_per_contact)))
     invalid("integrator.steps_per_contact", formatReal(g.steps_per_contact), "be >= 5 and finite");
   if (!(g.impact_speed_max >= 0.0 && finite(g.impact_speed_max)))

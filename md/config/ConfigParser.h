@@ -50,7 +50,8 @@ MdConfig parseConfigFile(const std::string& path, const std::vector<std::string>
 /// - Every section and key is optional (defaults of MdConfig.h); unknown ones are errors that list
 ///   the known keys. `[input] version` defaults to 1 and no other version is accepted.
 /// - Integer keys need TOML integers; real keys accept integers or floats; `integrator.dt` and
-///   `integrator.impact_speed_max` accept "auto" (stored as 0.0) or a number > 0.
+///   `integrator.impact_speed_max` accept "auto" (stored as 0.0) or a number > 0, and
+///   `integrator.dt` also "adaptive" (stored as 0.0 with IntegratorConfig::adaptive).
 /// - Each override is "section.key=value", applied after the file in the given order. The value is
 ///   read as a TOML value (2000, 0.1, 1e-3, true, "text"); a value that is not valid TOML, such as
 ///   a bare word (auto, spring_dashpot, data/start.csv), is taken as a string, and string keys
@@ -69,14 +70,15 @@ double boxLength(const SystemConfig& system);
 
 /// The complete configuration as TOML text: every section and key, in the order of
 /// docs/config.md, reals with round-trip precision, "auto" where integrator.dt or
-/// integrator.impact_speed_max is 0. parseConfigString(toToml(c), ...) gives back exactly c
-/// (for any c that passes validateConfig).
+/// integrator.impact_speed_max is 0 ("adaptive" for an adaptive dt). parseConfigString(toToml(c),
+/// ...) gives back exactly c (for any c that passes validateConfig).
 std::string toToml(const MdConfig& config);
 
 /// The configuration as ("section.key", value) pairs in the order of toToml, for provenance
 /// (CSV headers, HDF5 attributes): integers in decimal, reals via common::formatReal (shortest
 /// round-trip form), booleans "true"/"false", strings unquoted, "auto" for a zero
-/// integrator.dt or integrator.impact_speed_max. Includes "input.version".
+/// integrator.dt or integrator.impact_speed_max ("adaptive" for an adaptive dt). Includes
+/// "input.version".
 std::vector<std::pair<std::string, std::string>> flatten(const MdConfig& config);
 
 }  // namespace granagg::md

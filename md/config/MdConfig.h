@@ -11,13 +11,13 @@
 ///     [system]      N, phi, seed, temperature, initial ("random" or a CSV, H5MD or LAMMPS data
 ///                   file path), initial_max_overlap ("auto" or a number)
 ///     [contact]     model ("hertz" | "spring_dashpot"), E, D, clamp, stiffness, restitution
-///     [integrator]  dt ("auto" or a number), steps_per_contact, impact_speed_max ("auto" or
-///     number) [neighbor]    skin [charging]    mode ("exchange" | "fixed"), initial ("neutral" |
-///     "monopolar" | "bipolar" | "file"),
-///                   q0, Q, kappa, psi1_min, psi1_max, psi2_fraction
+///     [integrator]  dt ("auto", "adaptive" or a number), steps_per_contact, impact_speed_max
+///                   ("auto" or a number)
+///     [neighbor]    skin
+///     [charging]    mode ("exchange" | "fixed"), initial ("neutral" | "monopolar" | "bipolar" |
+///                   "file"), q0, Q, kappa, psi1_min, psi1_max, psi2_fraction
 ///     [coulomb]     K, method ("pppm" | "ewald"), accuracy, r_cut, mesh, order ("auto" or
-///     numbers),
-///                   every, every_max, skin, r_fast
+///                   numbers), every, every_max, skin, r_fast
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
 ///                   checkpoint_wall_seconds, write_velocities, write_forces
@@ -56,6 +56,9 @@ struct ContactConfig {
 
 struct IntegratorConfig {
   double dt = 0.0;                  ///< time step; 0 means "auto" (from the contact time)
+  /// integrator.dt = "adaptive" (dt then 0): the step follows the cooling gas (md/engine/Engine.h,
+  /// "Adaptive time step"); it starts at the "auto" step
+  bool adaptive = false;
   double steps_per_contact = 50.0;  ///< auto dt = contact time of the fastest impact / this
   /// fastest expected impact speed for auto dt; 0 means "auto": the normal relative speed exceeded
   /// by a fraction 1e-6 of collisions in a Maxwellian gas at the initial temperature,

@@ -13,6 +13,7 @@
 #include <thrust/copy.h>
 #include <thrust/execution_policy.h>
 #include <thrust/fill.h>
+#include <thrust/for_each.h>
 #include <thrust/functional.h>
 #include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -62,6 +63,12 @@ double impactSpeedMax(const MdConfig& c) {
   if (c.integrator.impact_speed_max > 0.0) return c.integrator.impact_speed_max;
   return std::sqrt(4.0 * c.system.temperature * std::log(1e6));
 }
+// integrator.dt = "adaptive" (Engine::adaptiveTimeStep): the margin on the fastest listed pair's
+// impact speed (it may still gain speed before the next choice of the step; a speed margin m
+// shortens the step by m^{1/5} only, 4.6 % here), and the largest step, in "auto" steps (a
+// frozen gas, v -> 0, would otherwise ask for an infinite step)
+constexpr double ADAPTIVE_PAIR_MARGIN = 1.25;
+constexpr double ADAPTIVE_DT_GROWTH_MAX = 10.0;
 // coulomb.every = "auto": time between evaluations of the slow Coulomb part (Engine::coulombEvery)
 constexpr double SLOW_INTERVAL = 0.016;
 // coulomb.every_max = "auto": the slow interval grows to at most this many times coulomb.every
@@ -140,6 +147,16 @@ struct CombineCharges {
                       a.abs_max > b.abs_max ? a.abs_max : b.abs_max};
   }
 };
+struct AddScaled {  // a[i] += c (x, y, z)[i]
+  Vec3* a;
+  const double *x, *y, *z;
+  double c;
+  HD void operator()(int i) const {
+    a[i].x += c * x[i];
+    a[i].y += c * y[i];
+    a[i].z += c * z[i];
+  }
+};
 struct Axpy {  // v + a f
   double a;
   HD double operator()(double v, double f) const { return v + a * f; }
@@ -183,10 +200,18 @@ struct Engine::Impl {
   DVec<Scalar4> scratch4;
   DVec<Vec3> scratch3;
   double dt = 0.0;
+  double dt_auto = 0.0;  // the "auto" step (Engine::chooseTimeStep): the adaptive step's reference
   std::int64_t step = 0;
   double time = 0.0;
+  // time = time_origin + (step - step_origin) dt: the step and time of the last change of dt
+  // (0, 0 for a fixed step), so that t carries no round-off accumulated over steps
+  double time_origin = 0.0;
+  std::int64_t step_origin = 0;
   std::int64_t collisions = 0;
   bool close_pending = false;  // v holds u = v(t - dt/2): the closing kick is still to apply
+  // no step taken since the state was given at full step (construction): the slow force's weight
+  // at this step is an opening half only (changeTimeStep)
+  bool fresh_start = true;
   double drift_since_build =
       0.0;                // sum over steps of dt * max |u| (+ rounding): bounds every displacement
   bool exchange = false;  // collisional charging on (charging.mode = "exchange")
@@ -200,7 +225,14 @@ struct Engine::Impl {
   // the slow interval that follows the gas (coulomb.every_max > every): between every_base and
   // every_cap steps, chosen at each evaluation (chooseEvery); fixed: every_cap = every_base
   int every_base = 1, every_cap = 1;
-  int every_prev = 1;                 // the interval that ended at the last evaluation
+  // the interval that ended at the last evaluation, in steps of the current dt (not a whole
+  // number after a change of dt: setTimeStep)
+  double every_prev = 1.0;
+  // every_base and every_cap in time units at the "auto" step: with an adaptive step the slow
+  // interval keeps these lengths in time (setTimeStep)
+  double slow_base_time = 0.0, slow_cap_time = 0.0;
+  // the step at which the time step changes next (Engine::setTimeStep; -1: none planned)
+  std::int64_t slow_interval_end = -1;
   std::int64_t slow_evaluations = 0;  // in this process (Engine::slowEvaluations)
   CoulombSetup csetup;
   std::unique_ptr<Pppm> pppm;
@@ -378,12 +410,18 @@ struct Engine::Impl {
   /// PPPM real space into coulomb_ext_energy): PPPM real space over nl_coul plus the mesh part, or
   /// everything for plain Ewald (host, O(N^2) real space).
   void evaluateCoulomb() {
-    const std::size_t N = p.size();
     // the interval that ends here (a fresh start has none: its impulse opens an interval only)
-    every_prev = kspace_step < 0 ? -1 : static_cast<int>(step - kspace_step);
+    every_prev = kspace_step < 0 ? -1.0 : static_cast<double>(step - kspace_step);
     kspace_step = step;
     every = chooseEvery();
     if (every_prev < 0) every_prev = every;
+    evaluateSlowForce();
+  }
+
+  /// The slow Coulomb force of the current positions into ext_f* and coulomb_ext_energy
+  /// (evaluateCoulomb without the interval's bookkeeping).
+  void evaluateSlowForce() {
+    const std::size_t N = p.size();
     ++slow_evaluations;
     if (pppm) {
       {
@@ -409,13 +447,21 @@ struct Engine::Impl {
   /// (integrator.impact_speed_max) moves in every_base steps, within [every_base, every_cap].
   /// A maximum is exact, so the choice does not depend on the thread count; it reads only the
   /// drift velocities, which a checkpoint restores to the bit.
+  /// An interval never reaches past the next change of the time step (slow_interval_end), so
+  /// that the change falls on an evaluation (changeTimeStep).
   int chooseEvery() const {
-    if (every_cap <= every_base) return every_base;
-    const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0,
-                                               thrust::maximum<double>());
-    const double v_rel = 2.0 * std::sqrt(u2);
-    const double k = v_rel > 0.0 ? std::floor(every_base * impactSpeedMax(cfg) / v_rel) : every_cap;
-    return static_cast<int>(std::min<double>(every_cap, std::max<double>(every_base, k)));
+    int k = every_base;
+    if (every_cap > every_base) {
+      const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0,
+                                                 thrust::maximum<double>());
+      const double v_rel = 2.0 * std::sqrt(u2);
+      const double kk =
+          v_rel > 0.0 ? std::floor(every_base * impactSpeedMax(cfg) / v_rel) : every_cap;
+      k = static_cast<int>(std::min<double>(every_cap, std::max<double>(every_base, kk)));
+    }
+    if (slow_interval_end > step)
+      k = static_cast<int>(std::min<std::int64_t>(k, slow_interval_end - step));
+    return k;
   }
 
   /// Weight of the Coulomb force in the force of step `at` (Engine.h): at an evaluation step the
@@ -426,7 +472,7 @@ struct Engine::Impl {
   /// halves by the mean is the impulse integrator with a varying outer step, to the bit.
   double slowWeight(std::int64_t at) const {
     if (at != kspace_step) return 0.0;
-    return 0.5 * (static_cast<double>(every_prev) + static_cast<double>(every));
+    return 0.5 * (every_prev + static_cast<double>(every));
   }
 
   /// \param slow_weight weight of ext_f* in this step's force (0: not added)
@@ -441,9 +487,9 @@ struct Engine::Impl {
       st.ext_fy = raw(ext_fy);
       st.ext_fz = raw(ext_fz);
       st.ext_force_scale = slow_weight;
-      // f_old holds prev_weight ext (ContactStep); with k = 1 both weights are 1 and f_old's
-      // Coulomb part is the trend itself
-      st.ext_predict_scale = every > 1 ? 0.5 * dt_taken * (slow_weight - prev_weight) : 0.0;
+      // f_old holds prev_weight ext (ContactStep); with k = 1 both weights are 1 (the term
+      // vanishes) and f_old's Coulomb part is the trend itself
+      st.ext_predict_scale = 0.5 * dt_taken * (slow_weight - prev_weight);
       st.fast = fast_switch;
       st.coulomb_K = cfg.coulomb.K;
       if (!fast_table.empty())
@@ -451,6 +497,98 @@ struct Engine::Impl {
             pairTable(raw(fast_table), fast_switch.r2 * fast_switch.r2, FAST_PAIR_TABLE_INTERVALS);
     }
     return st;
+  }
+
+  /// a += c ext_f, per slot (a: the velocities or the forces).
+  void addSlow(DVec<Vec3>& a, double c) {
+    if (c == 0.0) return;
+    thrust::for_each(thrust::counting_iterator<int>(0),
+                     thrust::counting_iterator<int>(static_cast<int>(a.size())),
+                     AddScaled{raw(a), raw(ext_fx), raw(ext_fy), raw(ext_fz), c});
+  }
+  void kickSlow(double c) { addSlow(p.vel, c); }
+  void addSlowForce(double c) { addSlow(p.force, c); }
+
+  /// The slow interval's bounds in steps of the current dt, from their lengths in time
+  /// (slow_base_time, slow_cap_time): an adaptive step keeps the slow part's schedule in time.
+  void slowBoundsForStep() {
+    if (!coulomb || every_cap <= 1) return;
+    every_base = std::max(1, static_cast<int>(std::floor(slow_base_time / dt + 1e-9)));
+    every_cap = std::max(every_base, static_cast<int>(std::floor(slow_cap_time / dt + 1e-9)));
+  }
+
+  /// Continues with the step dt_new from this step on (between steps: v at full step), until
+  /// the step next_change (-1: not known). The contact forces need nothing: velocity Verlet with
+  /// a step that changes between steps closes with dt_old / 2 and opens with dt_new / 2. The slow
+  /// Coulomb impulse does (Engine.h). Its intervals never reach past an announced change
+  /// (chooseEvery), so a change announced by the one before falls on an evaluation: Verlet-I
+  /// with a varying outer step, exact. The evaluation's closing half, (dt_old / 2) w_old F,
+  /// is taken back; the interval that ended here, in steps of dt_new, and the next one, chosen at
+  /// dt_new, give the new weight w; and (dt_new / 2) w F is applied, as finishStep would have
+  /// had the last step been one of dt_new. A change that cuts an interval (j > 0 steps after its
+  /// evaluation; only where the change was not announced) ends it here: the excess of its
+  /// opening half, (k - j)/2 dt_old F_e, is taken back from the velocities and the slow force is
+  /// evaluated here, but the positions of those j steps keep the excess, an error of first order
+  /// in it (md::Simulation always announces the next change). Momentum is kept to round-off
+  /// (every impulse is of a force that sums to zero).
+  void changeTimeStep(double dt_new, std::int64_t next_change) {
+    const double dt_old = dt;
+    slow_interval_end = next_change;
+    if (coulomb && kspace_step >= 0) {  // (< 0: the next force pass evaluates afresh)
+      const std::int64_t j = step - kspace_step;
+      double tau_prev = 0.0, w_old = 0.0;
+      if (fresh_start) {  // (j = 0) the opening half alone, never applied to v: a fresh opening
+        dt = dt_new;
+        slowBoundsForStep();
+        w_old = slowWeight(step);
+        every = chooseEvery();
+        every_prev = every;
+        addSlowForce(slowWeight(step) - w_old);
+        time_origin = time;
+        step_origin = step;
+        return;
+      }
+      double taken_back = 0.0;  // the closing half already in v, per unit F at this step
+      if (j > 0) {
+        kickSlow(-0.5 * static_cast<double>(every - j) * dt_old);
+        tau_prev = static_cast<double>(j) * dt_old;
+        if (nl_coul && nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build))
+          rebuildList(true);
+        evaluateSlowForce();
+      } else {
+        w_old = slowWeight(step);
+        taken_back = 0.5 * dt_old * w_old;
+        tau_prev = every_prev * dt_old;
+      }
+      dt = dt_new;
+      slowBoundsForStep();
+      kspace_step = step;
+      if (j > 0 || dt_new != dt_old) every_prev = tau_prev / dt_new;
+      every = chooseEvery();
+      const double w = slowWeight(step);
+      // (one kick: nothing at all when neither the step nor the interval changed)
+      kickSlow(0.5 * dt_new * w - taken_back);
+      addSlowForce(w - w_old);
+    }
+    dt = dt_new;
+    slowBoundsForStep();
+    time_origin = time;
+    step_origin = step;
+  }
+
+  /// The granular temperature T_g = (1/3N) sum (v - <v>)^2 of the integrator's velocities (sums
+  /// in id order, as Engine::observables).
+  double temperature() const {
+    const std::size_t N = p.size();
+    DVec<double> vx, vy, vz;
+    unpackVec3(p.vel, vx, vy, vz);
+    DVec<VelocitySums> per_slot(N);
+    thrust::transform(thrust::counting_iterator<int>(0),
+                      thrust::counting_iterator<int>(static_cast<int>(N)), per_slot.begin(),
+                      VelocitySumsOf{raw(vx), raw(vy), raw(vz)});
+    const VelocitySums vs = reduceById(per_slot, p.id, VelocitySums{}, CombineVelocitySums{});
+    const double p2 = vs.p[0] * vs.p[0] + vs.p[1] * vs.p[1] + vs.p[2] * vs.p[2];
+    return (vs.v2 - p2 / N) / (3.0 * N);
   }
 
   /// Forces of the current positions into p.f (state as in ContactForce.h; dt_taken = 0 for a
@@ -616,8 +754,9 @@ struct Engine::Impl {
     drift_since_build += moved;
     drift_since_coul_build += moved;
     u_max_last = std::sqrt(max_u2);
+    fresh_start = false;
     ++step;
-    time = step * dt;  // no accumulated round-off in t
+    time = time_origin + static_cast<double>(step - step_origin) * dt;
   }
 
   /// [Previous closing kick +] opening kick + drift (VelocityVerlet.h).
@@ -673,6 +812,45 @@ double Engine::chooseTimeStep(const MdConfig& c, std::string* reason) {
 
 double Engine::impactSpeedMax(const MdConfig& config) { return md::impactSpeedMax(config); }
 
+double Engine::adaptiveTimeStep(std::string* reason) const {
+  const Impl& d = *m_impl;
+  const double T = std::max(0.0, d.temperature());
+  // the "auto" rule's tail speed at the current temperature (impactSpeedMax scales as sqrt(T))
+  const double v_tail = md::impactSpeedMax(d.cfg) * std::sqrt(T / d.cfg.system.temperature);
+  const double v_pair = std::sqrt(maxPairImpactSpeed2(d.p, d.nl, d.box, d.contact,
+                                                      d.coulomb ? d.cfg.coulomb.K : 0.0, M_EFF));
+  const double v = std::max(v_tail, ADAPTIVE_PAIR_MARGIN * v_pair);
+  std::string model_why;
+  const double tc = std::visit(
+      [&](const auto& m) {
+        using Model = typename std::decay_t<decltype(m)>::Model;
+        return Model::autoContactTime(m.params, v, M_EFF, model_why);
+      },
+      d.contact);
+  const double dt_cap = ADAPTIVE_DT_GROWTH_MAX * d.dt_auto;
+  const double dt = std::min(tc / d.cfg.integrator.steps_per_contact, dt_cap);
+  if (reason) {
+    std::ostringstream why;
+    why << "adaptive: " << model_why << " / " << d.cfg.integrator.steps_per_contact
+        << " steps per contact (the larger of the T_g tail speed " << v_tail << " and "
+        << ADAPTIVE_PAIR_MARGIN << " x the fastest listed pair's impact speed " << v_pair << ")";
+    if (dt == dt_cap) why << ", capped at " << ADAPTIVE_DT_GROWTH_MAX << " x the auto step";
+    *reason = why.str();
+  }
+  return dt;
+}
+
+void Engine::setTimeStep(double dt, std::int64_t next_change) {
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    throw std::invalid_argument("Engine::setTimeStep: dt must be positive and finite");
+  Impl& d = *m_impl;
+  // (the same step: only an evaluation at this step re-chooses its interval for the new end)
+  if (dt != d.dt || (d.coulomb && d.kspace_step == d.step))
+    d.changeTimeStep(dt, next_change);
+  else
+    d.slow_interval_end = next_change;
+}
+
 int Engine::coulombEvery(const MdConfig& c, double dt) {
   // multiple time stepping with PPPM only: the plain-Ewald reference has no fast/slow split
   if (c.coulomb.method != "pppm") return 1;
@@ -696,13 +874,16 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
     throw std::invalid_argument("initial state: box edge must be positive.");
   d.box.L = init.box;
   d.contact = makeContactModel(config.contact, M_EFF);
-  d.dt = chooseTimeStep(config);
-  d.every = d.every_prev = d.every_base = d.every_cap = coulombEvery(config, d.dt);
+  d.dt = d.dt_auto = chooseTimeStep(config);
+  d.every = d.every_base = d.every_cap = coulombEvery(config, d.dt);
+  d.every_prev = d.every;
   if (d.every_base > 1) {
     const int cap = config.coulomb.every_max > 0 ? config.coulomb.every_max
                                                  : SLOW_INTERVAL_GROWTH * d.every_base;
     d.every_cap = std::max(d.every_base, cap);
   }
+  d.slow_base_time = d.every_base * d.dt;
+  d.slow_cap_time = d.every_cap * d.dt;
 
   Frame f = init;
   if (f.charge.size() != N) f.charge.assign(N, 0.0);
@@ -756,17 +937,32 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
 
 Engine::Engine(const MdConfig& config, const Checkpoint& ck)
     : Engine(withRecordedSplit(config, ck), ck.state, /*allow_contacts=*/true) {
-  // The time step the checkpoint was written at: the configuration must give the same one, or a
-  // build whose automatic step differs would continue the run silently on another.
-  if (ck.dt > 0.0 && ck.dt != m_impl->dt)
-    throw std::invalid_argument("integrator.dt: the checkpoint was written at dt = " +
-                                common::formatReal(ck.dt) + ", and its configuration now gives " +
-                                common::formatReal(m_impl->dt) +
-                                "; continue it with the granagg that wrote it");
   const EngineState& e = ck.engine;
-  // the Coulomb parameters first: restore() sizes the multiple-time-step state for them
+  Impl& d = *m_impl;
+  // The Coulomb parameters first, designed for the "auto" step's slow interval as in the run that
+  // wrote it: restore() sizes the multiple-time-step state for them.
   if (const auto design = e.reals.find("coulomb_sum_q2_design"); design != e.reals.end())
     useCoulombDesign(design->second);
+  if (config.integrator.adaptive) {
+    // the step in force when it was written, and where it took effect (changeTimeStep)
+    const auto t0 = e.reals.find("time_origin");
+    const auto s0 = e.ints.find("step_origin");
+    if (!(ck.dt > 0.0 && std::isfinite(ck.dt)) || t0 == e.reals.end() || s0 == e.ints.end())
+      throw std::invalid_argument(
+          "integrator.dt = \"adaptive\": the checkpoint lacks the time step in force (dt, "
+          "time_origin, step_origin)");
+    d.dt = ck.dt;
+    d.time_origin = t0->second;
+    d.step_origin = s0->second;
+    d.slowBoundsForStep();
+  } else if (ck.dt > 0.0 && ck.dt != d.dt) {
+    // a fixed step: the configuration must give the step the checkpoint was written at, or a
+    // build whose automatic step differs would continue the run silently on another
+    throw std::invalid_argument("integrator.dt: the checkpoint was written at dt = " +
+                                common::formatReal(ck.dt) + ", and its configuration now gives " +
+                                common::formatReal(d.dt) +
+                                "; continue it with the granagg that wrote it");
+  }
   const auto collisions = e.ints.find("collisions");
   restore(ck.state, ck.forces, collisions == e.ints.end() ? 0 : collisions->second, e);
 }
@@ -856,13 +1052,19 @@ Forces Engine::forces(StateKind kind) const {
 EngineState Engine::engineState() const {
   const Impl& d = *m_impl;
   EngineState e;
+  if (d.cfg.integrator.adaptive) {
+    e.reals["time_origin"] = d.time_origin;
+    e.ints["step_origin"] = d.step_origin;
+    e.ints["fresh_start"] = d.fresh_start ? 1 : 0;  // (a checkpoint before the first step)
+  }
   if (!d.coulomb) return e;
   e.arrays["coulomb_fx"] = toHostById(d.ext_fx, d.p.id);
   e.arrays["coulomb_fy"] = toHostById(d.ext_fy, d.p.id);
   e.arrays["coulomb_fz"] = toHostById(d.ext_fz, d.p.id);
   e.ints["coulomb_eval_step"] = d.kspace_step;
   e.ints["coulomb_every"] = d.every;  // the slow interval in force and the one before it
-  e.ints["coulomb_every_prev"] = d.every_prev;
+  e.ints["coulomb_every_prev"] = static_cast<std::int64_t>(d.every_prev);
+  e.reals["coulomb_every_prev"] = d.every_prev;  // (not whole after a change of dt)
   e.reals["coulomb_energy_ext"] = d.coulomb_ext_energy;
   // the split as resolved (withRecordedSplit): a restart keeps it whatever "auto" means then
   e.reals["coulomb_r_fast"] = d.csetup.r_fast;
@@ -881,9 +1083,12 @@ void Engine::restore(const Frame& s, const Forces& forces, std::int64_t collisio
   d.upload(s);  // storage in id order again
   packVec3(forces.x, forces.y, forces.z, d.p.force);
   d.step = s.step;
-  d.time = s.step * d.dt;
+  d.time = d.time_origin + static_cast<double>(s.step - d.step_origin) * d.dt;
   d.collisions = collisions;
   d.close_pending = false;
+  // v(t) holds the closing half of the last step's impulse, unless no step was taken yet
+  const auto fresh = extra.ints.find("fresh_start");
+  d.fresh_start = fresh != extra.ints.end() && fresh->second != 0;
   if (d.coulomb) {
     // the Coulomb force of the last evaluation: the impulse integrator uses it until the next one
     const auto fx = extra.arrays.find("coulomb_fx"), fy = extra.arrays.find("coulomb_fy"),
@@ -903,13 +1108,15 @@ void Engine::restore(const Frame& s, const Forces& forces, std::int64_t collisio
       d.coulomb_ext_energy = en->second;
       const auto k = extra.ints.find("coulomb_every"), kp = extra.ints.find("coulomb_every_prev");
       if (k != extra.ints.end() && kp != extra.ints.end()) {
-        if (k->second < d.every_base || k->second > d.every_cap || kp->second < 1)
+        if (k->second < 1 || k->second > d.every_cap || kp->second < 0)
           throw std::invalid_argument("checkpoint: slow Coulomb interval " +
                                       std::to_string(k->second) + " outside this run's " +
                                       std::to_string(d.every_base) + ".." +
                                       std::to_string(d.every_cap));
         d.every = static_cast<int>(k->second);
-        d.every_prev = static_cast<int>(kp->second);
+        const auto kp_real = extra.reals.find("coulomb_every_prev");
+        d.every_prev = kp_real != extra.reals.end() ? kp_real->second
+                                                    : static_cast<double>(kp->second);
       }  // (older checkpoints: a fixed interval, as configured)
     } else if (d.every == 1) {
       d.kspace_step = -1;  // evaluated afresh at the next step, as every step

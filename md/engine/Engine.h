@@ -37,6 +37,16 @@
 /// then (k_before + k_after)/2 dt F_C: half closes the interval that ends, half opens the next
 /// (Verlet-I with a varying outer step; both halves act at one instant, so the drift velocities
 /// are exactly those of the split halves).
+///
+/// Adaptive time step (integrator.dt = "adaptive"; md::Simulation chooses when): the step may
+/// change between run() calls. Velocity Verlet then closes the last step with dt_old / 2 and
+/// opens the next with dt_new / 2. The slow Coulomb part keeps its schedule in time: its
+/// interval bounds are the "auto" step's, in time units. A change is announced by the one before
+/// (setTimeStep's next_change), no slow interval reaches past it, and so each change falls on an
+/// evaluation (Impl::changeTimeStep): the impulse integrator with a varying outer step, as
+/// above. The step and time of the last change are part of the state, so that
+/// t = t_change + (step - step_change) dt carries no round-off accumulated over steps and a
+/// checkpoint continues to the bit.
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -128,6 +138,16 @@ class Engine : public RunEngine {
   /// The fastest impact the time step resolves (integrator.impact_speed_max, or "auto": exceeded
   /// by a fraction 1e-6 of collisions in a Maxwellian gas at the initial temperature).
   static double impactSpeedMax(const MdConfig& config);
+  /// integrator.dt = "adaptive": the step that the gas as it is now needs (md/potentials/
+  /// ImpactSpeed.h): the "auto" rule (steps_per_contact steps per contact of the fastest impact)
+  /// at the larger of the tail speed of the current T_g and 1.25 times the fastest impact a listed
+  /// pair can make, at most 10 "auto" steps; `reason` says which. Reads the state only.
+  double adaptiveTimeStep(std::string* reason = nullptr) const override;
+  /// Continues with step `dt` (between run() calls; Engine.h, "Adaptive time step") until the
+  /// step `next_change`, where the next change will be (-1: not known; a change there is then
+  /// not exact for the slow Coulomb part).
+  void setTimeStep(double dt, std::int64_t next_change) override;
+  bool adaptsTimeStep() const override { return true; }
   /// The time step chosen for a configuration (fixed, or auto from the contact time) and why.
   static double chooseTimeStep(const MdConfig& config, std::string* reason = nullptr);
 

@@ -81,6 +81,15 @@ class RunEngine {
   virtual double dt() const = 0;
   /// Why dt is what it is, where the engine says more than Engine::chooseTimeStep (empty: that).
   virtual std::string dtReason() const { return {}; }
+  /// integrator.dt = "adaptive" (md::Engine): whether this engine can change its step between
+  /// chunks; the step the gas needs now (`reason` says why); and the change itself (between
+  /// run() calls), in force until the step `next_change` where the next change will be.
+  /// md::Simulation refuses the setting for an engine that cannot.
+  virtual bool adaptsTimeStep() const { return false; }
+  virtual double adaptiveTimeStep(std::string* /*reason*/ = nullptr) const { return dt(); }
+  virtual void setTimeStep(double /*dt*/, std::int64_t /*next_change*/) {
+    throw std::logic_error("this engine cannot change its time step");
+  }
   /// The edge L of the periodic cube.
   virtual double box() const = 0;
   /// The number of particles N (on every rank).

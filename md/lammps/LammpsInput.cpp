@@ -43,6 +43,9 @@ double lammpsSkin(const MdConfig& c, double dt) {
 }  // namespace
 
 void checkLammpsCanRun(const MdConfig& c) {
+  if (c.integrator.adaptive)
+    cannot("integrator.dt", "\"adaptive\"",
+           "the adaptive step is granagg md's; use \"auto\" or a number");
   if (c.coulomb.K > 0.0) {
     const CoulombConfig& cc = c.coulomb;
     if (cc.method != "pppm")

@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The observables as /granagg/observables stores them (docs/model.md section 10).
-std::vector<std::pair<std::string, double>> observableRow(const Observables& o) {
+std::vector<std::pair<std::string, double>> observableRow(const Observables& o, double dt) {
   return {{"temperature", o.temperature},
           {"kinetic_energy", o.kinetic_energy},
           {"elastic_energy", o.elastic_energy},
@@ -30,7 +30,8 @@ std::vector<std::pair<std::string, double>> observableRow(const Observables& o) 
           {"mean_abs_charge", o.mean_abs_charge},
           {"max_abs_charge", o.max_abs_charge},
           {"coulomb_energy", o.coulomb_energy},
-          {"max_overlap", o.max_overlap}};
+          {"max_overlap", o.max_overlap},
+          {"dt", dt}};
 }
 
 /// The frame to write: the physical state, with its per-particle forces when output.write_forces
@@ -91,7 +92,7 @@ void TrajectoryReporter::create(const std::vector<std::pair<std::string, std::st
     m_writer = std::make_unique<H5mdWriter>(m_file.string(), m_engine.size(), params, config_toml,
                                             overwrite, m_cfg.output.write_velocities,
                                             m_cfg.output.write_forces);
-    m_writer->writeObservables(o.step, o.time, observableRow(o));
+    m_writer->writeObservables(o.step, o.time, observableRow(o, m_engine.dt()));
     m_writer->writeFrame(f);
     watch();
   }
@@ -112,6 +113,12 @@ void TrajectoryReporter::reopen(double t_end, const std::string& command_line,
   watch();
 }
 
+void TrajectoryReporter::addFrameStep(std::int64_t step) {
+  if (!m_frame_steps.empty() && step <= m_frame_steps.back())
+    throw std::logic_error("TrajectoryReporter::addFrameStep: frame steps must increase");
+  m_frame_steps.push_back(step);
+}
+
 std::int64_t TrajectoryReporter::nextStep(const Simulation&) const {
   const std::int64_t every = m_cfg.output.observable_interval;
   std::int64_t next = (m_engine.step() / every + 1) * every;
@@ -124,7 +131,7 @@ void TrajectoryReporter::report(const Simulation& sim) {
   const std::int64_t step = m_engine.step();
   const Observables& o = sim.lastObservables();
   if (m_writer && (step % m_cfg.output.observable_interval == 0 || step == m_last_step))
-    m_writer->writeObservables(o.step, o.time, observableRow(o));
+    m_writer->writeObservables(o.step, o.time, observableRow(o, m_engine.dt()));
   if (m_next_frame < m_frame_steps.size() && step == m_frame_steps[m_next_frame]) {
     writeFrame();
     ++m_next_frame;

@@ -32,8 +32,9 @@ std::vector<std::pair<std::string, std::string>> trajectoryParameters(
     const MdConfig& cfg, const RunEngine& engine, const std::string& command_line,
     const std::string& dt_reason);
 
-/// traj.h5: the observables every output.observable_interval steps and at the run's last step,
-/// the frames at `frame_steps` (Simulation::frameSteps). Between chunks it checks that the file
+/// traj.h5: the observables (with the step dt in force) every output.observable_interval steps
+/// and at the run's last step, the frames at `frame_steps` (Simulation::frameSteps; with an
+/// adaptive step, addFrameStep). Between chunks it checks that the file
 /// is still the one it writes; after closing, that it reads back whole. A trajectory changed
 /// behind the run's back (removed, replaced, truncated by another program; other granagg commands
 /// are kept out by the folder lock) stops the run with std::runtime_error: a run never reports
@@ -53,6 +54,11 @@ class TrajectoryReporter : public Reporter {
   /// Opens the file of a resumed run at the engine's step and records who continued it, from
   /// where, to where (/granagg/restarts).
   void reopen(double t_end, const std::string& command_line, const std::string& version);
+
+  /// An adaptive step (Simulation): the frames and the last step become known epoch by epoch.
+  /// `step` is after every frame step so far.
+  void addFrameStep(std::int64_t step);
+  void setLastStep(std::int64_t step) { m_last_step = step; }
 
   std::int64_t nextStep(const Simulation& sim) const override;
   /// Checks the file, then writes the observables and the frame that fall on this step.

@@ -29,13 +29,18 @@ std::vector<std::string> runStartLines(const Simulation& sim) {
   out.push_back(printfString("md: N = %d, phi = %g, box L = %.6g, contact model %s, seed %llu",
                              cfg.system.N, cfg.system.phi, e.box(), cfg.contact.model.c_str(),
                              static_cast<unsigned long long>(cfg.system.seed)));
-  const double t_last = static_cast<double>(sim.lastStep()) * e.dt();
-  std::string ends;
-  if (t_last != cfg.run.t_end)  // time = step * dt: the run ends on the step nearest t_end
-    ends = printfString(" (ends at t = %.6g, the whole step nearest t_end)", t_last);
-  out.push_back(printfString("md: dt = %.6g (%s); %lld steps to t_end = %g%s", e.dt(),
-                             sim.dtReason().c_str(), static_cast<long long>(sim.lastStep()),
-                             cfg.run.t_end, ends.c_str()));
+  if (cfg.integrator.adaptive) {
+    out.push_back(printfString("md: dt = %.6g now, %s; to t_end = %g", e.dt(),
+                               sim.dtReason().c_str(), cfg.run.t_end));
+  } else {
+    const double t_last = static_cast<double>(sim.lastStep()) * e.dt();
+    std::string ends;
+    if (t_last != cfg.run.t_end)  // time = step * dt: the run ends on the step nearest t_end
+      ends = printfString(" (ends at t = %.6g, the whole step nearest t_end)", t_last);
+    out.push_back(printfString("md: dt = %.6g (%s); %lld steps to t_end = %g%s", e.dt(),
+                               sim.dtReason().c_str(), static_cast<long long>(sim.lastStep()),
+                               cfg.run.t_end, ends.c_str()));
+  }
   if (const CoulombSetup* cs = e.coulombSetup()) {
     const std::string mesh = cs->method == "pppm" ? "mesh " + std::to_string(cs->mesh) +
                                                         "^3, order " + std::to_string(cs->order)

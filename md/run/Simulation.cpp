@@ -20,14 +20,68 @@
 namespace granagg::md {
 namespace fs = std::filesystem;
 
+namespace {
+// integrator.dt = "adaptive": the step is re-chosen at every frame time and at these many
+// log-spaced times per decade (from t = 0.01). A gas cooling as Haff's law, T ~ t^-2, changes
+// its Hertz step (~ T^{-1/10}) by 2.3 % between two of them.
+constexpr int ADAPT_PER_DECADE = 20;
+}  // namespace
+
+/// integrator.dt = "adaptive": the times at which the step may change (the ends of its epochs),
+/// each marked if a frame falls on it: the frame times (output.frames_per_decade and
+/// output.frame_interval, as frameSteps), ADAPT_PER_DECADE log-spaced times and run.t_end, with
+/// times closer than half the "auto" step merged (t_end kept exact). Within an epoch the step
+/// is constant and divides it into whole steps, so frames fall on their times.
+struct EpochTimes {
+  std::vector<double> t;
+  std::vector<char> frame;
+
+  EpochTimes(const MdConfig& c, double dt_auto) {
+    std::vector<std::pair<double, char>> all;
+    const double t_end = c.run.t_end;
+    const double t0 = std::max(0.01, dt_auto);
+    if (c.output.frames_per_decade > 0) {
+      const double k = std::pow(10.0, 1.0 / c.output.frames_per_decade);
+      for (double t = t0; t < t_end * (1 + 1e-12); t *= k) all.emplace_back(t, 1);
+    }
+    if (c.output.frame_interval > 0.0)
+      for (double t = c.output.frame_interval; t < t_end * (1 + 1e-12);
+           t += c.output.frame_interval)
+        all.emplace_back(t, 1);
+    const double k = std::pow(10.0, 1.0 / ADAPT_PER_DECADE);
+    for (double t = 0.01; t < t_end; t *= k) all.emplace_back(t, 0);
+    all.emplace_back(t_end, 1);
+    std::sort(all.begin(), all.end());
+    for (const auto& [time, is_frame] : all) {
+      const double at = std::min(time, t_end);
+      if (!t.empty() && at - t.back() < 0.5 * dt_auto) {  // one epoch end for both
+        frame.back() = static_cast<char>(frame.back() | is_frame);
+        if (at == t_end) t.back() = t_end;
+        continue;
+      }
+      if (at <= 0.0) continue;
+      t.push_back(at);
+      frame.push_back(is_frame);
+    }
+  }
+  /// Index of the first epoch end after `time` (beyond `tol`); t.size() if none.
+  std::size_t after(double time, double tol) const {
+    return static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), time + tol) - t.begin());
+  }
+};
+
 struct Simulation::Impl {
   MdConfig cfg;
   fs::path out;
   RunOptions options;
   bool resumed = false;
   std::string dt_reason;
-  std::int64_t last = 0;
+  std::int64_t last = 0;  // adaptive dt: -1 until the last epoch is planned
   std::unique_ptr<RunEngine> engine;
+  // integrator.dt = "adaptive": the epochs (EpochTimes) and the step where the current one ends
+  // (-1: to be planned at the next chunk)
+  std::unique_ptr<EpochTimes> epochs;
+  std::int64_t epoch_end = -1;
   // the run's outputs (md/run/OutputReporters.h), called before the user's reporters
   std::unique_ptr<TrajectoryReporter> trajectory;
   std::unique_ptr<CheckpointReporter> checkpoints;
@@ -46,10 +100,23 @@ struct Simulation::Impl {
              std::int64_t checkpoint_step) {
     engine = std::move(e);
     engine->enableProfile(options.profile);
-    Engine::chooseTimeStep(cfg, &dt_reason);
+    const double dt_auto = Engine::chooseTimeStep(cfg, &dt_reason);
     if (std::string why = engine->dtReason(); !why.empty()) dt_reason = std::move(why);
-    last = static_cast<std::int64_t>(std::llround(cfg.run.t_end / engine->dt()));
-    std::vector<std::int64_t> frames = Simulation::frameSteps(cfg, engine->dt(), last);
+    std::vector<std::int64_t> frames;
+    if (cfg.integrator.adaptive) {
+      if (!engine->adaptsTimeStep())
+        throw std::invalid_argument(
+            "integrator.dt = \"adaptive\" needs granagg's own engine (granagg md); this engine "
+            "runs a fixed step: use \"auto\" or a number");
+      dt_reason = "adaptive, from the auto step (" + dt_reason +
+                  "); chosen again at every epoch (observable dt)";
+      epochs = std::make_unique<EpochTimes>(cfg, dt_auto);
+      last = -1;
+      continueEpoch();  // frames and the last step of a resumed epoch; a new one is planned
+    } else {
+      last = static_cast<std::int64_t>(std::llround(cfg.run.t_end / engine->dt()));
+      frames = Simulation::frameSteps(cfg, engine->dt(), last);
+    }
     const auto next_frame = static_cast<std::size_t>(
         std::upper_bound(frames.begin(), frames.end(), engine->step()) - frames.begin());
     trajectory = std::make_unique<TrajectoryReporter>(*engine, cfg, trajectoryFile(),
@@ -57,7 +124,53 @@ struct Simulation::Impl {
                                                       frames_written, last);
     checkpoints =
         std::make_unique<CheckpointReporter>(*engine, cfg, out, *trajectory, checkpoint_step);
+    if (epoch_end > engine->step()) scheduleEpochEnd(epochs->after(engine->time(), tolerance()));
   }
+
+  /// Times closer than this are the same epoch end (a step apart at the least).
+  double tolerance() const { return 1e-6 * engine->dt(); }
+
+  /// The epoch a resumed engine is in: its dt divides the rest of the epoch into whole steps.
+  /// At an epoch end (or at t = 0) the next epoch is planned by the first chunk instead.
+  void continueEpoch() {
+    const double t = engine->time(), tol = tolerance();
+    const std::size_t i = epochs->after(t, tol);
+    const bool at_end = i > 0 && std::abs(epochs->t[i - 1] - t) <= tol;
+    if (i == epochs->t.size()) {  // at run.t_end: nothing left
+      last = engine->step();
+      return;
+    }
+    // (not a whole number of steps: a run continued to a later run.t_end, whose epochs differ:
+    // a new epoch starts here)
+    const double steps = (epochs->t[i] - t) / engine->dt();
+    const bool whole = std::abs(steps - std::round(steps)) <= 1e-6 * std::max(1.0, steps);
+    epoch_end = (t <= tol || at_end || !whole) ? -1 : engine->step() + std::llround(steps);
+    // the slow Coulomb intervals end at the epoch's end, as in the run that wrote the checkpoint
+    if (epoch_end > 0) engine->setTimeStep(engine->dt(), epoch_end);
+  }
+  /// The trajectory's frame and last step for the epoch that ends at epochs->t[i], at epoch_end.
+  void scheduleEpochEnd(std::size_t i) {
+    if (epochs->frame[i]) trajectory->addFrameStep(epoch_end);
+    if (i + 1 == epochs->t.size()) {
+      last = epoch_end;
+      trajectory->setLastStep(last);
+    }
+  }
+  /// Chooses the step of the next epoch from the gas (RunEngine::adaptiveTimeStep): the whole
+  /// number of steps that fills the epoch at no more than that step.
+  void planEpoch() {
+    const double t = engine->time();
+    const std::size_t i = epochs->after(t, tolerance());
+    const double span = epochs->t[i] - t;
+    const double want = engine->adaptiveTimeStep();
+    const auto n =
+        std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(span / want - 1e-9)));
+    epoch_end = engine->step() + n;
+    engine->setTimeStep(span / static_cast<double>(n), epoch_end);
+    scheduleEpochEnd(i);
+  }
+  /// The run has reached run.t_end.
+  bool atEnd() const { return last >= 0 && engine->step() >= last; }
 };
 
 namespace {
@@ -222,12 +335,14 @@ Simulation Simulation::resumeWith(const fs::path& out, const std::vector<std::st
   if (!folder_checked)
     onWritingRank(e,
                   [&] { common::FolderLock::checkAvailable(out, options.overwrite, "--restart"); });
-  if (d->last < e.step())  // (equal: a finished run; run() has nothing to do)
+  const bool before_checkpoint =
+      d->epochs ? d->cfg.run.t_end < e.time() - d->tolerance() : d->last < e.step();
+  if (before_checkpoint)  // (equal: a finished run; run() has nothing to do)
     throw std::invalid_argument(
         "run.t_end = " + common::formatReal(d->cfg.run.t_end) + " lies before the checkpoint in " +
         out.string() + " (t = " + common::formatReal(e.time()) + ", step " +
         std::to_string(e.step()) + "): give a later --set run.t_end=... to run further");
-  if (d->last == e.step()) {  // finished: nothing to open
+  if (d->atEnd()) {  // finished: nothing to open
     d->at_end = true;
     d->frames_at_end = run_fields.frames_written;
     return Simulation(std::move(d));
@@ -266,8 +381,9 @@ RunSummary Simulation::run() {
     return engine.anyRank(d.options.stop != nullptr && *d.options.stop != 0);
   };
   try {
-    while (engine.step() < d.last && !stopRequested()) {
-      std::int64_t target = d.last;
+    while (!d.atEnd() && !stopRequested()) {
+      if (d.epochs && engine.step() >= d.epoch_end) d.planEpoch();
+      std::int64_t target = d.epochs ? d.epoch_end : d.last;
       for (const Reporter* r : all)
         if (const std::int64_t s = r->nextStep(*this); s > engine.step())
           target = std::min(target, s);
@@ -290,7 +406,7 @@ RunSummary Simulation::run() {
   s.steps = engine.step() - first_step;
   s.neighbor_builds = engine.neighborBuilds() - first_builds;
   s.slow_evaluations = engine.slowEvaluations() - first_slow;
-  s.stopped = engine.step() < d.last;
+  s.stopped = !d.atEnd();
   s.observables = s.steps > 0 ? d.observables : engine.observables();
   d.trajectory->check();
   d.checkpoints->save();

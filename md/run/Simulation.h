@@ -130,7 +130,8 @@ class Simulation {
   std::filesystem::path checkpointPath() const;
   /// Why dt is what it is ("auto: elastic Hertz contact time ..." or "fixed").
   const std::string& dtReason() const;
-  /// The step at which the run ends (run.t_end / dt, rounded).
+  /// The step at which the run ends (run.t_end / dt, rounded); with an adaptive step, known
+  /// only once the last epoch is planned (-1 before).
   std::int64_t lastStep() const;
   /// True if this Simulation continues a checkpoint.
   bool resumed() const;

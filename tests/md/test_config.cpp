@@ -52,6 +52,7 @@ void requireSame(const MdConfig& a, const MdConfig& b) {
   CHECK(a.contact.stiffness == b.contact.stiffness);
   CHECK(a.contact.restitution == b.contact.restitution);
   CHECK(a.integrator.dt == b.integrator.dt);
+  CHECK(a.integrator.adaptive == b.integrator.adaptive);
   CHECK(a.integrator.steps_per_contact == b.integrator.steps_per_contact);
   CHECK(a.integrator.impact_speed_max == b.integrator.impact_speed_max);
   CHECK(a.neighbor.skin == b.neighbor.skin);
@@ -163,9 +164,10 @@ TEST_CASE("bad configs are rejected with the key and the allowed range", "[md][c
       {"contact.restitution", "1.1", [](MdConfig& c) { c.contact.restitution = 1.1; },
        "contact.restitution = 1.1 is invalid: must lie in (0, 1]"},
       {"integrator.dt", "-0.001", [](MdConfig& c) { c.integrator.dt = -0.001; },
-       "integrator.dt = -0.001 is invalid: must be > 0 or \"auto\""},
+       "integrator.dt = -0.001 is invalid: must be > 0, \"auto\" or \"adaptive\""},
       // 0 is how "auto" is stored: fine on the struct, an error when written explicitly.
-      {"integrator.dt", "0", nullptr, "integrator.dt = 0 is invalid: must be > 0 or \"auto\""},
+      {"integrator.dt", "0", nullptr,
+       "integrator.dt = 0 is invalid: must be > 0, \"auto\" or \"adaptive\""},
       {"integrator.impact_speed_max", "0.0", nullptr,
        "integrator.impact_speed_max = 0 is invalid: must be > 0 or \"auto\""},
       {"integrator.impact_speed_max", "-2", [](MdConfig& c) { c.integrator.impact_speed_max = -2; },
@@ -247,7 +249,7 @@ TEST_CASE("values of the wrong type name the key and the expected type", "[md][c
        "t.toml:2:9: contact.clamp must be a boolean (true or false), got integer 1"},
       {"[contact]\nE = [1, 2]\n", "t.toml:2:5: contact.E must be a number, got an array"},
       {"[integrator]\ndt = \"fast\"\n",
-       "t.toml:2:6: integrator.dt must be a number or \"auto\", got string \"fast\""},
+       "t.toml:2:6: integrator.dt must be a number, \"auto\" or \"adaptive\", got string \"fast\""},
       {"[input]\nversion = \"1\"\n",
        "t.toml:2:11: input.version must be an integer, got string \"1\""},
       {"system = 3\n", "t.toml:1:1: 'system' must be a table ([system]), got integer 3"},
@@ -364,9 +366,11 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
        "--set contact.clamp=yes: contact.clamp must be a boolean (true or false), got string "
        "\"yes\""},
       {"integrator.dt=0",
-       "--set integrator.dt=0: integrator.dt = 0 is invalid: must be > 0 or \"auto\""},
+       "--set integrator.dt=0: integrator.dt = 0 is invalid: must be > 0, \"auto\" or "
+       "\"adaptive\""},
       {"integrator.dt=Auto",
-       "--set integrator.dt=Auto: integrator.dt must be a number or \"auto\", got string \"Auto\""},
+       "--set integrator.dt=Auto: integrator.dt must be a number, \"auto\" or \"adaptive\", "
+       "got string \"Auto\""},
       {"system.phi=0.7", "--set system.phi=0.7: system.phi = 0.7 is invalid: must lie in (0, 0.6)"},
       {"contact.model=hooke", "--set contact.model=hooke: contact.model = \"hooke\" is invalid"},
       {"charging.mode=static", "--set charging.mode=static: charging.mode = \"static\" is invalid"},
@@ -406,6 +410,18 @@ TEST_CASE("toToml round-trips exactly through parseConfigString", "[md][config]"
     const MdConfig back = parseConfigString(text, "stored");
     requireSame(back, c);
     CHECK(toToml(back) == text);
+  }
+  SECTION("integrator.dt = \"adaptive\", and a later value that replaces it") {
+    const MdConfig c = parseConfigString("[integrator]\ndt = \"adaptive\"\n", "a.toml");
+    CHECK(c.integrator.adaptive);
+    CHECK(c.integrator.dt == 0.0);  // it starts at the "auto" step
+    const std::string text = toToml(c);
+    CHECK(text.find("dt = \"adaptive\"\n") != std::string::npos);
+    requireSame(parseConfigString(text, "stored"), c);
+    const MdConfig fixed = parseConfigString(text, "stored", {"integrator.dt=0.001"});
+    CHECK_FALSE(fixed.integrator.adaptive);
+    CHECK(fixed.integrator.dt == 0.001);
+    CHECK_FALSE(parseConfigString(text, "stored", {"integrator.dt=auto"}).integrator.adaptive);
   }
   SECTION("every key changed, awkward values") {
     MdConfig c;
