@@ -9,9 +9,11 @@
 # the one-off change of switching the damping off) and its largest excursion, both relative to
 # the initial kinetic energy, and compares them with what the dissipative gas loses.
 #
-#   usage: bash scripts/cold_drift.sh [--out DIR] [--dt DT] STATE CAP [CAP ...]
+#   usage: bash scripts/cold_drift.sh [--out DIR] [--dt DT] [--adaptive] STATE CAP [CAP ...]
 #     DIR    default results/cold_drift (a folder per cap; existing ones are redone)
 #     DT     time units to run (default 30: 8733 steps at the paper preset's dt)
+#     --adaptive  the copies continue on integrator.dt = "adaptive" (docs/model.md section 6)
+#            instead of the state's step; the folders are then cap<CAP>-adaptive
 #     STATE  run folder with checkpoint.h5 and traj.h5 (the cold state)
 #     CAP    values of coulomb.every_max (steps), e.g. 16 32 64
 # Environment: GRANAGG_BIN (default build/bin/granagg), THREADS (default 1; the caps run 2 at
@@ -23,10 +25,12 @@ G=${GRANAGG_BIN:-build/bin/granagg}
 PY=/usr/bin/python3
 OUT=results/cold_drift
 DT=30
+RULE=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) OUT=$2; shift 2 ;;
     --dt) DT=$2; shift 2 ;;
+    --adaptive) RULE=adaptive; shift ;;
     -h|--help) sed -n '2,/^{/p' "$0" | grep '^#' | sed -E 's/^# ?//'; exit 0 ;;
     *) break ;;
   esac
@@ -46,19 +50,22 @@ a = h5py.File(sys.argv[1] + '/checkpoint.h5', 'r')['state'].attrs
 print(repr(float(a['time'])), int(a['step']))" "$STATE")
 T1=$(awk "BEGIN {print $T0 + $DT}")
 run_cap() {
-  local cap=$1 dir="$OUT/cap$1"
+  local cap=$1 dir="$OUT/cap$1${RULE:+-$RULE}"
   rm -rf "$dir"
   cp -r "$STATE" "$dir"
   rm -f "$dir/profile.csv"
   # the stored configuration is the one a restart runs with: edit it in the copy
-  "$PY" - "$dir/checkpoint.h5" "$cap" <<'EOF'
+  "$PY" - "$dir/checkpoint.h5" "$cap" "$RULE" <<'EOF'
 import re, sys
 import h5py
 with h5py.File(sys.argv[1], "r+") as f:
     t = f["run/config_toml"][()]
     t = t.decode() if isinstance(t, bytes) else t
-    for key, value in (("D", "0.0"), ("mode", '"fixed"'), ("every_max", sys.argv[2]),
-                       ("observable_interval", "10")):
+    keys = [("D", "0.0"), ("mode", '"fixed"'), ("every_max", sys.argv[2]),
+            ("observable_interval", "10")]
+    if sys.argv[3]:
+        keys.append(("dt", '"%s"' % sys.argv[3]))
+    for key, value in keys:
         t, n = re.subn(r"(?m)^%s = .*$" % key, "%s = %s" % (key, value), t)
         if n != 1:
             raise SystemExit("cold_drift.sh: the stored configuration has no single key " + key)
@@ -69,8 +76,8 @@ EOF
   echo "cap $cap: $(tail -n 2 "$dir.log" | head -n 1)"
 }
 export -f run_cap
-export G PY OUT STATE T1
+export G PY OUT STATE T1 RULE
 printf '%s\n' "$@" | xargs -P 2 -I{} bash -c 'run_cap {}'
-"$PY" scripts/cold_drift.py "$OUT" "$S0" "$@"
+"$PY" scripts/cold_drift.py "$OUT" "$S0" ${RULE:+--suffix "-$RULE"} "$@"
 exit 0
 }

@@ -944,16 +944,16 @@ Engine::Engine(const MdConfig& config, const Checkpoint& ck)
   if (const auto design = e.reals.find("coulomb_sum_q2_design"); design != e.reals.end())
     useCoulombDesign(design->second);
   if (config.integrator.adaptive) {
-    // the step in force when it was written, and where it took effect (changeTimeStep)
+    // the step in force when it was written, and where it took effect (changeTimeStep); a
+    // checkpoint of a fixed step (no change recorded: t = step dt) continues adaptively from it
+    if (!(ck.dt > 0.0 && std::isfinite(ck.dt)))
+      throw std::invalid_argument(
+          "integrator.dt = \"adaptive\": the checkpoint lacks the time step in force (dt)");
     const auto t0 = e.reals.find("time_origin");
     const auto s0 = e.ints.find("step_origin");
-    if (!(ck.dt > 0.0 && std::isfinite(ck.dt)) || t0 == e.reals.end() || s0 == e.ints.end())
-      throw std::invalid_argument(
-          "integrator.dt = \"adaptive\": the checkpoint lacks the time step in force (dt, "
-          "time_origin, step_origin)");
     d.dt = ck.dt;
-    d.time_origin = t0->second;
-    d.step_origin = s0->second;
+    d.time_origin = t0 != e.reals.end() ? t0->second : 0.0;
+    d.step_origin = s0 != e.ints.end() ? s0->second : 0;
     d.slowBoundsForStep();
   } else if (ck.dt > 0.0 && ck.dt != d.dt) {
     // a fixed step: the configuration must give the step the checkpoint was written at, or a
