@@ -93,6 +93,7 @@ struct RealEnergyFunctor {
   int cap;
   common::Box box;
   double K, alpha, rc2;
+  PairTable table;  // erfc(alpha r) / r, or null
   HD double operator()(int i) const {
     const Scalar4 ri = pos[i];
     const int id_i = id[i];
@@ -106,7 +107,11 @@ struct RealEnergyFunctor {
                    ry = box.minimumImageWrapped(ri.y - rj.y),
                    rz = box.minimumImageWrapped(ri.z - rj.z);
       const double r2 = rx * rx + ry * ry + rz * rz;
-      if (r2 < rc2) e += ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);
+      if (!(r2 < rc2)) continue;
+      if (table.data && r2 >= ENERGY_TABLE_R2_MIN)
+        e += K * ri.w * rj.w * table(r2);
+      else
+        e += ewaldRealEnergy(ri.w * rj.w, sqrt(r2), alpha, K);
     }
     return e;
   }
@@ -147,7 +152,8 @@ double coulombRealEnergy(const ParticleData& p, const NeighborList& nl, const co
   thrust::transform(thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(N),
                     per_slot.begin(),
                     RealEnergyFunctor{raw(p.pos), nl.rows(), nl.counts(), raw(p.id), nl.capacity(),
-                                      box, prm.K, prm.alpha, prm.r_cut * prm.r_cut});
+                                      box, prm.K, prm.alpha, prm.r_cut * prm.r_cut,
+                                      prm.energy_table});
   return reduceById(per_slot, p.id, 0.0, thrust::plus<double>());  // restart: same bits
 }
 

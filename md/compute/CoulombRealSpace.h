@@ -24,6 +24,9 @@ struct CoulombRealParams {
   RealSpaceSwitch fast{};
   /// The slow force over r tabulated on [0, r_cut^2] (slowPairTableValues), or null: computed
   PairTable table{};
+  /// coulombRealEnergy: erfc(alpha r) / r tabulated on [0, r_cut^2] (energyPairTableValues),
+  /// used from r^2 = ENERGY_TABLE_R2_MIN on, or null: libm's erfc for every pair
+  PairTable energy_table{};
 };
 
 /// Real-space forces (their slow part, see CoulombRealParams::fast) of the current positions and

@@ -11,6 +11,7 @@
 ///
 /// Units: reduced (d = 1); K = l_B / d is the coupling constant (force between two unit charges
 /// at unit distance), charges in units of q_ref, energies in T0, forces in T0 / d.
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -112,6 +113,11 @@ struct PairTable {
 /// force is smooth everywhere; the fast one is steep (1 / r^3) at deep overlaps.
 constexpr int SLOW_PAIR_TABLE_INTERVALS = 256;
 constexpr int FAST_PAIR_TABLE_INTERVALS = 512;
+/// The observables' real-space energy (energyPairTableValues): erfc(alpha r) / r is steep at short
+/// range, so its table has more intervals (32 KiB) and serves pairs from ENERGY_TABLE_R2_MIN on,
+/// an overlap of 0.6 (the default run.max_overlap); closer pairs take libm's erfc.
+constexpr int ENERGY_PAIR_TABLE_INTERVALS = 2048;
+constexpr double ENERGY_TABLE_R2_MIN = 0.16;
 
 /// The fast pair force of the split divided by K q_i q_j and by r: S(r) / r^3, held at its value at
 /// r = 0.3 below that (no pair gets that close: an overlap of 0.7 aborts a run long before).
@@ -148,6 +154,18 @@ inline std::vector<double> fastPairTableValues(const RealSpaceSwitch& sw,
                                                int n = FAST_PAIR_TABLE_INTERVALS) {
   return pairTableValues([&](double r2) { return fastPairForceOverR(std::sqrt(r2), sw); },
                          sw.r2 * sw.r2, n);
+}
+/// Table of the real-space pair energy over K q_i q_j, erfc(alpha r) / r, on [0, r2_max]. It is
+/// held at its value at r^2 = ENERGY_TABLE_R2_MIN / 4 below that, well below where it is used,
+/// so that the cubics it serves interpolate the smooth function.
+inline std::vector<double> energyPairTableValues(double alpha, double r2_max,
+                                                 int n = ENERGY_PAIR_TABLE_INTERVALS) {
+  return pairTableValues(
+      [&](double r2) {
+        const double r = std::sqrt(std::max(r2, 0.25 * ENERGY_TABLE_R2_MIN));
+        return std::erfc(alpha * r) / r;
+      },
+      r2_max, n);
 }
 /// Table of slowPairForceOverR on [0, r2_max].
 inline std::vector<double> slowPairTableValues(double alpha, const RealSpaceSwitch& sw,

@@ -239,8 +239,9 @@ struct Engine::Impl {
   std::unique_ptr<EwaldReference> ewald;
   std::unique_ptr<NeighborList> nl_coul;  // pppm: reaches r_cut + coulomb.skin
   RealSpaceSwitch fast_switch{};  // pppm with every > 1: the real space within r_fast is fast
-  DVec<double> slow_table,
-      fast_table;  // ... and the slow and fast pair forces tabulated (PairTable)
+  // ... and the slow and fast pair forces tabulated (PairTable), and the pair energy for the
+  // observables
+  DVec<double> slow_table, fast_table, energy_table;
   double drift_since_coul_build = 0.0;  // as drift_since_build, for nl_coul
   DVec<double> ext_fx, ext_fy, ext_fz;  // the Coulomb force at the last evaluation, per slot
   double coulomb_ext_energy = 0.0;      // pppm: mesh + self + background; ewald: everything
@@ -367,12 +368,15 @@ struct Engine::Impl {
     nl_coul.reset();
     slow_table.clear();
     fast_table.clear();
+    energy_table.clear();
     if (cc.method == "pppm") {
       pppm = std::make_unique<Pppm>(d.pppm, L, cc.K);
       pppm->setPhaseTimer(&timer);
       nl_coul = std::make_unique<NeighborList>(d.pppm.r_cut, d.coulomb_skin);
       coulomb_skin_cap = d.coulomb_skin;
       coulomb_skin_follows = d.coulomb_skin_follows;
+      const auto e = energyPairTableValues(d.pppm.alpha, d.pppm.r_cut * d.pppm.r_cut);
+      energy_table.assign(e.begin(), e.end());
       if (fast_switch.r2 > 0.0) {
         const auto t = slowPairTableValues(d.pppm.alpha, fast_switch, d.pppm.r_cut * d.pppm.r_cut);
         slow_table.assign(t.begin(), t.end());
@@ -394,6 +398,9 @@ struct Engine::Impl {
     if (!slow_table.empty())
       prm.table =
           pairTable(raw(slow_table), csetup.r_cut * csetup.r_cut, SLOW_PAIR_TABLE_INTERVALS);
+    if (!energy_table.empty())
+      prm.energy_table =
+          pairTable(raw(energy_table), csetup.r_cut * csetup.r_cut, ENERGY_PAIR_TABLE_INTERVALS);
     return prm;
   }
 

@@ -273,6 +273,21 @@ TEST_CASE(
   CHECK(worst_slow < 2e-8);
   CHECK(worst_fast < 6e-6);        // the steep 1/r^2 at an overlap of 0.4 (deeper aborts a run)
   CHECK(worst_fast_apart < 4e-8);  // pairs not in contact
+  // the observables' pair energy (ENERGY_PAIR_TABLE_INTERVALS), relative to erfc(alpha r) / r,
+  // from the deepest overlap it serves (0.6) and for pairs not in contact
+  const auto energy = energyPairTableValues(alpha, rc * rc);
+  const PairTable te = pairTable(energy.data(), rc * rc, ENERGY_PAIR_TABLE_INTERVALS);
+  double worst_energy = 0.0, worst_energy_apart = 0.0;
+  for (double r = std::sqrt(ENERGY_TABLE_R2_MIN); r < rc; r += 0.00113) {
+    const double exact = std::erfc(alpha * r) / r;
+    const double e = std::fabs(te(r * r) - exact) / exact;
+    worst_energy = std::max(worst_energy, e);
+    if (r >= 1.0) worst_energy_apart = std::max(worst_energy_apart, e);
+  }
+  INFO("largest relative table energy error: " << worst_energy << " (from r = 1: "
+                                               << worst_energy_apart << ")");
+  CHECK(worst_energy < 5e-7);  // measured 1.4e-7 and 1.7e-10
+  CHECK(worst_energy_apart < 1e-9);
   // the tables are continuous: the cubic of each interval ends where the next begins
   for (const auto* t : {&slow, &fast}) {
     const int n = static_cast<int>(t->size() / 4) - 1;
