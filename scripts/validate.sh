@@ -13,6 +13,9 @@
 # neutral    K = 0, N = 50016, 20 runs to t = 1000 (data/pair/validate-neutral.toml)   ~30 min
 # charged5   K = 5, N = 1e4, Q = 0.05, 5 runs to t = 150 (validate-charged.toml)      ~52 min
 # box        K = 0, N = 400128 (L = 140), 1 run to t = 1000 (validate-box.toml)      ~45 min
+# box3000    K = 0, N = 400128 (L = 140) to t = 3000 on the adaptive time step: 2 runs with new
+#            seeds (102-103), frames every 50 (else as box): the large box past the paper's time
+#            (issue 30); also issue 29's L = 140 benchmark (the md log times each run)
 # charged1   K = 1, as charged5                                                       ~52 min
 # charged025 K = 0.25, as charged5                                                    ~52 min
 # qscan      K = 5 with Q = 0.025 and 0.1, 2 runs each to t = 100 (else as charged5)   ~26 min
@@ -44,8 +47,8 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --out) OUT=$2; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | grep '^#' | sed -E 's/^# ?//'; exit 0 ;;
-    neutral|charged5|box|charged1|charged025|qscan|charged5big|charged5paper|fits|sensitivity|\
-    report)
+    neutral|charged5|box|box3000|charged1|charged025|qscan|charged5big|charged5paper|fits|\
+    sensitivity|report)
       PARTS+=("$1"); shift ;;
     *) echo "validate.sh: unknown part or option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -120,6 +123,26 @@ big_config() {
   echo "$f"
 }
 
+# The neutral gas in the large box to t = 3000: validate-box.toml with 2 runs, seeds 102-103,
+# t_end 3000 on the adaptive time step, the fit windows to 3000.
+box3000_config() {
+  local f="$OUT/config/validate-box-t3000.toml"
+  mkdir -p "$OUT/config"
+  local more='"run.t_end=3000", "integrator.dt=adaptive"'
+  sed -e "s/\"output.frame_interval=50\"]/\"output.frame_interval=50\", $more]/" \
+      -e "s/^name = \"validate-box\"/name = \"validate-box-t3000\"/" \
+      -e "s/^runs = 1 .*/runs = 2/" -e "s/^seed = 101 .*/seed = 102/" \
+      -e 's/"--fit-window", "100", "1000"/"--fit-window", "100", "3000"/' \
+      -e "s/^window = \[100.0, 1000.0\]/window = [100.0, 3000.0]/" \
+      data/pair/validate-box.toml > "$f"
+  grep -q "run.t_end=3000" "$f" && grep -q "integrator.dt=adaptive" "$f" \
+    && grep -q "^runs = 2" "$f" \
+    && grep -q "^seed = 102" "$f" && grep -q '"100", "3000"' "$f" \
+    && grep -q "^window = \[100.0, 3000.0\]" "$f" \
+    || { echo "validate.sh: could not write $f" >&2; exit 1; }
+  echo "$f"
+}
+
 # The charged gas at the paper's size and time: validate-charged.toml with N = 50016, t = 1000,
 # frames every 50, seeds 100-104 (none shared with the other ensembles), the fit windows to 1000.
 paper_config() {
@@ -191,6 +214,7 @@ for part in "${PARTS[@]}"; do
     neutral)    pair neutral --preset validate-neutral ;;
     charged5)   pair charged-K5 --preset validate-charged --K 5 ;;
     box)        pair box --preset validate-box ;;
+    box3000)    pair box-t3000 --config "$(box3000_config)" ;;
     charged1)   pair charged-K1 --preset validate-charged --K 1 ;;
     charged025) pair charged-K0.25 --preset validate-charged --K 0.25 ;;
     qscan)      pair charged-K5-Q0.025 --config "$(q_config 0.025)" --K 5

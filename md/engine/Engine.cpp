@@ -551,8 +551,7 @@ struct Engine::Impl {
         every = chooseEvery();
         every_prev = every;
         addSlowForce(slowWeight(step) - w_old);
-        time_origin = time;
-        step_origin = step;
+        moveTimeOrigin(dt_old);
         return;
       }
       double taken_back = 0.0;  // the closing half already in v, per unit F at this step
@@ -579,6 +578,14 @@ struct Engine::Impl {
     }
     dt = dt_new;
     slowBoundsForStep();
+    moveTimeOrigin(dt_old);
+  }
+
+  /// After a change of dt: t counts from here. (The same step keeps its origin, so that a run
+  /// resumed within an epoch, which re-announces the epoch's end, keeps the uninterrupted run's
+  /// times to the bit.)
+  void moveTimeOrigin(double dt_old) {
+    if (dt == dt_old) return;
     time_origin = time;
     step_origin = step;
   }

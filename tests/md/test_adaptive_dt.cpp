@@ -263,23 +263,20 @@ TEST_CASE("adaptive dt: frames on their times, the end at t_end, restarts to the
       const auto px = ra.readObservable("momentum_x");
       for (double p : px.value) CHECK(std::fabs(p) < 1e-10);
     }
-    // (c) stopped twice (once within an epoch, once at a frame's epoch end) and resumed: the
-    // same frames and observables to the bit
+    // (c) stopped five times (within epochs, at observable and checkpoint steps, at a frame's
+    // epoch end) and resumed: the same frames and observables to the bit, times included
     volatile std::sig_atomic_t stop = 0;
     RunOptions stopping = opt;
     stopping.stop = &stop;
-    {
-      Simulation b = Simulation::start(cfg, dir / "b", stopping);
-      b.addReporter(std::make_shared<StopAt>(3.3, &stop));
+    bool first = true;
+    for (double t_stop : {0.02, 3.3, 5.05, 7.5, 9.9}) {
+      Simulation b = first ? Simulation::start(cfg, dir / "b", stopping)
+                           : Simulation::resume(dir / "b", {}, stopping);
+      first = false;
+      b.addReporter(std::make_shared<StopAt>(t_stop, &stop));
       CHECK(b.run().stopped);
+      stop = 0;
     }
-    stop = 0;
-    {
-      Simulation b = Simulation::resume(dir / "b", {}, stopping);
-      b.addReporter(std::make_shared<StopAt>(7.5, &stop));
-      CHECK(b.run().stopped);
-    }
-    stop = 0;
     Simulation::resume(dir / "b", {}, opt).run();
     const H5mdReader rb((dir / "b" / "traj.h5").string());
     // b's extra frames: those it wrote where it stopped
@@ -296,6 +293,13 @@ TEST_CASE("adaptive dt: frames on their times, the end at t_end, restarts to the
     }
     const auto dt_b = rb.readObservable("dt");
     CHECK(dt_b.value.back() == dt.value.back());
+    for (std::size_t k = 0; k < dt.step.size(); ++k) {  // (b also sampled where it stopped)
+      const auto at = std::find(dt_b.step.begin(), dt_b.step.end(), dt.step[k]);
+      REQUIRE(at != dt_b.step.end());
+      const auto kb = static_cast<std::size_t>(at - dt_b.step.begin());
+      CHECK(test::sameBits(dt.time[k], dt_b.time[kb]));
+      CHECK(test::sameBits(dt.value[k], dt_b.value[kb]));
+    }
     if (std::getenv("GRANAGG_KEEP_TEST_FILES") == nullptr) fs::remove_all(dir);
   }
 }
