@@ -10,6 +10,9 @@
 #   environment: SIZES="10000 100000"  STEPS_10000="200 2000"  STEPS_100000="100 500"
 #                DT=0.002  SKIN=0.3  REPEATS=3  THREADS="1 2"  LMP_RANKS="1 2"  SKIP_TWO_BODY=1 (skip the mapping check)
 #                LMP_FIXES="nve nve/sphere" (LAMMPS integrators timed; the ratio is against the fastest)
+#                PAPER_SCALE=1: also the paper-scale neutral run end to end (N = 50016 to t = 1000,
+#                `--preset paper`, seed 1, 2 threads), on the fixed "auto" step and on
+#                integrator.dt = "adaptive", interleaved, the fastest of REPEATS each (~5 min)
 #
 # Installs Debian's `lammps` (29 Sep 2021 stable, binary lmp) if it is missing; builds nothing.
 #
@@ -214,4 +217,38 @@ printf '%s\n' "${ROWS[@]}"
 echo
 printf '%s\n' "${NOTES[@]}"
 echo
+# ---------------------------------------------------------------------------------------------
+# The paper-scale neutral run, end to end (wall time of `granagg md` from start to exit, output
+# included): the fixed step against the adaptive one, interleaved
+if [ -n "${PAPER_SCALE:-}" ]; then
+  declare -A PW PS
+  for rep in $(seq 1 "$REPEATS"); do
+    for rule in auto adaptive; do
+      rm -rf "$TMP/paper_$rule"
+      t0=$(now)
+      "$G" md --preset paper --seed 1 --threads 2 --set integrator.dt=$rule \
+        --out "$TMP/paper_$rule" -q
+      w=$(calc "$(now) - $t0")
+      PW[$rule]="${PW[$rule]:-} $w"
+      PS[$rule]=$(/usr/bin/python3 -c "import h5py, sys; f = h5py.File(sys.argv[1], 'r'); \
+print(int(f['granagg/observables/dt/step'][-1]))" "$TMP/paper_$rule/traj.h5")
+    done
+  done
+  echo "Paper-scale neutral run (--preset paper: N = 50016, t = 1000, seed 1, 2 threads), end to"
+  echo "end, the fastest of $REPEATS interleaved repeats"
+  echo
+  echo "| time step | steps | wall s (fastest) | range | speed-up |"
+  echo "|---|---|---|---|---|"
+  # shellcheck disable=SC2086
+  fixed=$(mins ${PW[auto]})
+  for rule in auto adaptive; do
+    # shellcheck disable=SC2086
+    best=$(mins ${PW[$rule]})
+    # shellcheck disable=SC2086
+    printf '| %s | %s | %.1f | %s | %.2f |\n' "$rule" "${PS[$rule]}" "$best" \
+      "$(range ${PW[$rule]})" "$(calc "$fixed / $best")"
+  done
+  echo
+fi
+
 echo "Load at end: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -40,6 +40,7 @@
 #include "md/engine/Launch.h"
 #include "md/engine/ParticleData.h"
 #include "md/engine/PhaseTimer.h"
+#include "md/integrate/SlowSchedule.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/neighbor/NeighborList.h"
 #include "md/neighbor/Skin.h"
@@ -221,18 +222,9 @@ struct Engine::Impl {
   // (Engine.h), evaluated every coulomb.every steps into ext_f*: PPPM's real space over its own
   // neighbour list nl_coul plus its mesh part, or a whole plain-Ewald evaluation
   bool coulomb = false;
-  int every = 1;  // steps from the last evaluation to the next
-  // the slow interval that follows the gas (coulomb.every_max > every): between every_base and
-  // every_cap steps, chosen at each evaluation (chooseEvery); fixed: every_cap = every_base
-  int every_base = 1, every_cap = 1;
-  // the interval that ended at the last evaluation, in steps of the current dt (not a whole
-  // number after a change of dt: setTimeStep)
-  double every_prev = 1.0;
-  // every_base and every_cap in time units at the "auto" step: with an adaptive step the slow
-  // interval keeps these lengths in time (setTimeStep)
-  double slow_base_time = 0.0, slow_cap_time = 0.0;
-  // the step at which the time step changes next (Engine::setTimeStep; -1: none planned)
-  std::int64_t slow_interval_end = -1;
+  // when the slow force was evaluated and is next due (md/integrate/SlowSchedule.h); the next
+  // interval is chosen at each evaluation (chooseEvery)
+  SlowSchedule slow;
   std::int64_t slow_evaluations = 0;  // in this process (Engine::slowEvaluations)
   CoulombSetup csetup;
   std::unique_ptr<Pppm> pppm;
@@ -245,7 +237,6 @@ struct Engine::Impl {
   double drift_since_coul_build = 0.0;  // as drift_since_build, for nl_coul
   DVec<double> ext_fx, ext_fy, ext_fz;  // the Coulomb force at the last evaluation, per slot
   double coulomb_ext_energy = 0.0;      // pppm: mesh + self + background; ewald: everything
-  std::int64_t kspace_step = -1;        // step of the last Coulomb evaluation (-1: none yet)
   ContactModel contact;  // the contact model and its parameters (md/potentials/ContactModels.h)
   PhaseTimer timer;      // Engine::enableProfile
 
@@ -347,7 +338,7 @@ struct Engine::Impl {
       nl.setSkin(followingSkin(fast_switch.r2, delta, CONTACT_LIST_BUILD_OVER_USE,
                                NEIGHBOR_SKIN_AUTO_MIN, cfg.neighbor.skinCap()));
     if (coulomb_list && nl_coul && coulomb_skin_follows)
-      nl_coul->setSkin(followingSkin(csetup.r_cut, every * delta, COULOMB_LIST_BUILD_OVER_USE,
+      nl_coul->setSkin(followingSkin(csetup.r_cut, slow.every * delta, COULOMB_LIST_BUILD_OVER_USE,
                                      COULOMB_SKIN_AUTO_MIN, coulomb_skin_cap));
   }
 
@@ -360,7 +351,8 @@ struct Engine::Impl {
     const CoulombConfig& cc = cfg.coulomb;
     const std::size_t N = p.size();
     const double L = box.L, skin = cfg.neighbor.skinCap();
-    const CoulombDesign d = designCoulomb(cc, N, L, skin, every_base, every_cap, sum_q2_design);
+    const CoulombDesign d =
+        designCoulomb(cc, N, L, skin, slow.design_base, slow.design_cap, sum_q2_design);
     csetup = d.setup;
     fast_switch = d.fast_switch;
     pppm.reset();
@@ -390,7 +382,7 @@ struct Engine::Impl {
     nl.keepPairs(d.contact_list_keeps_pairs);
     contact_skin_follows = cfg.neighbor.skin == 0.0 && fast_switch.r2 > 0.0;
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(N, 0.0);
-    kspace_step = -1;
+    slow.eval_step = -1;
   }
 
   CoulombRealParams realParams() const {
@@ -418,10 +410,10 @@ struct Engine::Impl {
   /// everything for plain Ewald (host, O(N^2) real space).
   void evaluateCoulomb() {
     // the interval that ends here (a fresh start has none: its impulse opens an interval only)
-    every_prev = kspace_step < 0 ? -1.0 : static_cast<double>(step - kspace_step);
-    kspace_step = step;
-    every = chooseEvery();
-    if (every_prev < 0) every_prev = every;
+    slow.every_prev = slow.eval_step < 0 ? -1.0 : static_cast<double>(step - slow.eval_step);
+    slow.eval_step = step;
+    slow.every = chooseEvery();
+    if (slow.every_prev < 0) slow.every_prev = slow.every;
     evaluateSlowForce();
   }
 
@@ -457,30 +449,16 @@ struct Engine::Impl {
   /// An interval never reaches past the next change of the time step (slow_interval_end), so
   /// that the change falls on an evaluation (changeTimeStep).
   int chooseEvery() const {
-    int k = every_base;
-    if (every_cap > every_base) {
-      const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0,
-                                                 thrust::maximum<double>());
-      const double v_rel = 2.0 * std::sqrt(u2);
-      const double kk =
-          v_rel > 0.0 ? std::floor(every_base * impactSpeedMax(cfg) / v_rel) : every_cap;
-      k = static_cast<int>(std::min<double>(every_cap, std::max<double>(every_base, kk)));
-    }
-    if (slow_interval_end > step)
-      k = static_cast<int>(std::min<std::int64_t>(k, slow_interval_end - step));
-    return k;
+    if (!slow.follows()) return slow.clamp(slow.every_base, step);
+    const double u2 = thrust::transform_reduce(p.vel.begin(), p.vel.end(), Speed2{}, 0.0,
+                                               thrust::maximum<double>());
+    const double v_rel = 2.0 * std::sqrt(u2);
+    return slow.clamp(
+        v_rel > 0.0 ? std::floor(slow.every_base * impactSpeedMax(cfg) / v_rel) : slow.every_cap,
+        step);
   }
 
-  /// Weight of the Coulomb force in the force of step `at` (Engine.h): at an evaluation step the
-  /// mean of the interval that ends there and the one that starts (k when the interval is fixed:
-  /// the impulse k dt F, half closing each interval and half opening the next; a fresh start has
-  /// only the opening half); 0 between evaluations; 1 at every step when k = 1. The two halves
-  /// act at the same instant, so only their sum reaches the drift velocities: weighting both
-  /// halves by the mean is the impulse integrator with a varying outer step, to the bit.
-  double slowWeight(std::int64_t at) const {
-    if (at != kspace_step) return 0.0;
-    return 0.5 * (every_prev + static_cast<double>(every));
-  }
+  double slowWeight(std::int64_t at) const { return slow.weight(at); }
 
   /// \param slow_weight weight of ext_f* in this step's force (0: not added)
   ContactStep makeStep(double dt_taken, double slow_weight, double prev_weight) const {
@@ -516,12 +494,9 @@ struct Engine::Impl {
   void kickSlow(double c) { addSlow(p.vel, c); }
   void addSlowForce(double c) { addSlow(p.force, c); }
 
-  /// The slow interval's bounds in steps of the current dt, from their lengths in time
-  /// (slow_base_time, slow_cap_time): an adaptive step keeps the slow part's schedule in time.
+  /// The slow interval's bounds in steps of the current dt (SlowSchedule::boundsFor).
   void slowBoundsForStep() {
-    if (!coulomb || every_cap <= 1) return;
-    every_base = std::max(1, static_cast<int>(std::floor(slow_base_time / dt + 1e-9)));
-    every_cap = std::max(every_base, static_cast<int>(std::floor(slow_cap_time / dt + 1e-9)));
+    if (coulomb) slow.boundsFor(dt);
   }
 
   /// Continues with the step dt_new from this step on (between steps: v at full step), until
@@ -540,23 +515,23 @@ struct Engine::Impl {
   /// (every impulse is of a force that sums to zero).
   void changeTimeStep(double dt_new, std::int64_t next_change) {
     const double dt_old = dt;
-    slow_interval_end = next_change;
-    if (coulomb && kspace_step >= 0) {  // (< 0: the next force pass evaluates afresh)
-      const std::int64_t j = step - kspace_step;
+    slow.interval_end = next_change;
+    if (coulomb && slow.eval_step >= 0) {  // (< 0: the next force pass evaluates afresh)
+      const std::int64_t j = step - slow.eval_step;
       double tau_prev = 0.0, w_old = 0.0;
       if (fresh_start) {  // (j = 0) the opening half alone, never applied to v: a fresh opening
         dt = dt_new;
         slowBoundsForStep();
         w_old = slowWeight(step);
-        every = chooseEvery();
-        every_prev = every;
+        slow.every = chooseEvery();
+        slow.every_prev = slow.every;
         addSlowForce(slowWeight(step) - w_old);
         moveTimeOrigin(dt_old);
         return;
       }
       double taken_back = 0.0;  // the closing half already in v, per unit F at this step
       if (j > 0) {
-        kickSlow(-0.5 * static_cast<double>(every - j) * dt_old);
+        kickSlow(-0.5 * static_cast<double>(slow.every - j) * dt_old);
         tau_prev = static_cast<double>(j) * dt_old;
         if (nl_coul && nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build))
           rebuildList(true);
@@ -564,13 +539,13 @@ struct Engine::Impl {
       } else {
         w_old = slowWeight(step);
         taken_back = 0.5 * dt_old * w_old;
-        tau_prev = every_prev * dt_old;
+        tau_prev = slow.every_prev * dt_old;
       }
       dt = dt_new;
       slowBoundsForStep();
-      kspace_step = step;
-      if (j > 0 || dt_new != dt_old) every_prev = tau_prev / dt_new;
-      every = chooseEvery();
+      slow.eval_step = step;
+      if (j > 0 || dt_new != dt_old) slow.every_prev = tau_prev / dt_new;
+      slow.every = chooseEvery();
       const double w = slowWeight(step);
       // (one kick: nothing at all when neither the step nor the interval changed)
       kickSlow(0.5 * dt_new * w - taken_back);
@@ -614,14 +589,14 @@ struct Engine::Impl {
   void computeForces(double dt_taken, bool advance = false) {
     // Displacements since the last build are at most the sum of dt max|u| over the steps (a
     // rigorous bound that needs no stored reference positions).
-    const bool slow = coulomb && (kspace_step < 0 || step - kspace_step >= every);
+    const bool slow_due = coulomb && (slow.eval_step < 0 || step - slow.eval_step >= slow.every);
     const double prev_weight = coulomb ? slowWeight(step - 1) : 0.0;
-    if (slow && nl_coul &&
+    if (slow_due && nl_coul &&
         nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build))
       rebuildList(true);
     else if (nl.needsRebuild(p, drift_since_build * drift_since_build))
       rebuildContactList();
-    if (slow) evaluateCoulomb();
+    if (slow_due) evaluateCoulomb();
     ContactStep st = makeStep(dt_taken, coulomb ? slowWeight(step) : 0.0, prev_weight);
     st.dq = dqOrNull();
     st.displacement_bound = drift_since_build;
@@ -662,13 +637,7 @@ struct Engine::Impl {
   /// Velocity offset of the impulse integrator against the smooth trajectory, per unit Coulomb
   /// force: (k/2 - j) dt at j = 1..k-1 steps after an evaluation, 0 at the evaluation step itself
   /// (whose v(t) holds half the impulse) and with k = 1 (Engine.h).
-  double velocityOffset() const {
-    if (!coulomb || (every == 1 && every_prev == 1) || kspace_step < 0) return 0.0;
-    const std::int64_t j = step - kspace_step;
-    // at the evaluation step v(t) holds half the mean weight where the closing half of the
-    // interval that ended would hold half of that interval (the two differ when it changes)
-    return j == 0 ? 0.25 * (every - every_prev) * dt : (0.5 * every - static_cast<double>(j)) * dt;
-  }
+  double velocityOffset() const { return coulomb ? slow.velocityOffset(step, dt) : 0.0; }
   /// v - velocityOffset() * F_coulomb, per slot.
   void smoothVelocities(DVec<double>& sx, DVec<double>& sy, DVec<double>& sz) const {
     const double c = velocityOffset();
@@ -694,12 +663,12 @@ struct Engine::Impl {
         drift_since_coul_build = 0.0;
       }
       double ext = coulomb_ext_energy;
-      if (kspace_step != step)  // the energy alone: no forces
+      if (slow.eval_step != step)  // the energy alone: no forces
         ext = pppm->compute(reinterpret_cast<const double*>(raw(p.pos)), p.size(), nullptr, nullptr,
                             nullptr, raw(p.id));
       return coulombRealEnergy(p, *nl_coul, box, realParams()) + ext;
     }
-    if (kspace_step == step) return coulomb_ext_energy;
+    if (slow.eval_step == step) return coulomb_ext_energy;
     return ewaldOnHost().energy;
   }
 
@@ -859,10 +828,10 @@ void Engine::setTimeStep(double dt, std::int64_t next_change) {
     throw std::invalid_argument("Engine::setTimeStep: dt must be positive and finite");
   Impl& d = *m_impl;
   // (the same step: only an evaluation at this step re-chooses its interval for the new end)
-  if (dt != d.dt || (d.coulomb && d.kspace_step == d.step))
+  if (dt != d.dt || (d.coulomb && d.slow.eval_step == d.step))
     d.changeTimeStep(dt, next_change);
   else
-    d.slow_interval_end = next_change;
+    d.slow.interval_end = next_change;
 }
 
 int Engine::coulombEvery(const MdConfig& c, double dt) {
@@ -889,15 +858,12 @@ Engine::Engine(const MdConfig& config, const Frame& init, bool allow_contacts)
   d.box.L = init.box;
   d.contact = makeContactModel(config.contact, M_EFF);
   d.dt = d.dt_auto = chooseTimeStep(config);
-  d.every = d.every_base = d.every_cap = coulombEvery(config, d.dt);
-  d.every_prev = d.every;
-  if (d.every_base > 1) {
-    const int cap = config.coulomb.every_max > 0 ? config.coulomb.every_max
-                                                 : SLOW_INTERVAL_GROWTH * d.every_base;
-    d.every_cap = std::max(d.every_base, cap);
+  {
+    const int k = coulombEvery(config, d.dt);
+    d.slow = SlowSchedule::start(
+        k, config.coulomb.every_max > 0 ? config.coulomb.every_max : SLOW_INTERVAL_GROWTH * k,
+        d.dt);
   }
-  d.slow_base_time = d.every_base * d.dt;
-  d.slow_cap_time = d.every_cap * d.dt;
 
   Frame f = init;
   if (f.charge.size() != N) f.charge.assign(N, 0.0);
@@ -1075,14 +1041,10 @@ EngineState Engine::engineState() const {
   e.arrays["coulomb_fx"] = toHostById(d.ext_fx, d.p.id);
   e.arrays["coulomb_fy"] = toHostById(d.ext_fy, d.p.id);
   e.arrays["coulomb_fz"] = toHostById(d.ext_fz, d.p.id);
-  e.ints["coulomb_eval_step"] = d.kspace_step;
-  e.ints["coulomb_every"] = d.every;  // the slow interval in force and the one before it
-  e.ints["coulomb_every_prev"] = static_cast<std::int64_t>(d.every_prev);
-  e.reals["coulomb_every_prev"] = d.every_prev;  // (not whole after a change of dt)
+  d.slow.save(e);
   e.reals["coulomb_energy_ext"] = d.coulomb_ext_energy;
   // the split as resolved (withRecordedSplit): a restart keeps it whatever "auto" means then
   e.reals["coulomb_r_fast"] = d.csetup.r_fast;
-  e.ints["coulomb_every_max"] = d.every_cap;
   return e;
 }
 
@@ -1118,22 +1080,10 @@ void Engine::restore(const Frame& s, const Forces& forces, std::int64_t collisio
       toDevice(fx->second, d.ext_fx);
       toDevice(fy->second, d.ext_fy);
       toDevice(fz->second, d.ext_fz);
-      d.kspace_step = at->second;
       d.coulomb_ext_energy = en->second;
-      const auto k = extra.ints.find("coulomb_every"), kp = extra.ints.find("coulomb_every_prev");
-      if (k != extra.ints.end() && kp != extra.ints.end()) {
-        if (k->second < 1 || k->second > d.every_cap || kp->second < 0)
-          throw std::invalid_argument("checkpoint: slow Coulomb interval " +
-                                      std::to_string(k->second) + " outside this run's " +
-                                      std::to_string(d.every_base) + ".." +
-                                      std::to_string(d.every_cap));
-        d.every = static_cast<int>(k->second);
-        const auto kp_real = extra.reals.find("coulomb_every_prev");
-        d.every_prev = kp_real != extra.reals.end() ? kp_real->second
-                                                    : static_cast<double>(kp->second);
-      }  // (older checkpoints: a fixed interval, as configured)
-    } else if (d.every == 1) {
-      d.kspace_step = -1;  // evaluated afresh at the next step, as every step
+      d.slow.load(extra);  // (older checkpoints have no intervals: fixed, as configured)
+    } else if (d.slow.every == 1) {
+      d.slow.eval_step = -1;  // evaluated afresh at the next step, as every step
     } else {
       throw std::invalid_argument(
           "checkpoint lacks the Coulomb forces of the multiple-time-step integrator "
@@ -1206,7 +1156,7 @@ double Engine::coulombListSkin() const { return m_impl->nl_coul ? m_impl->nl_cou
 const CoulombSetup* Engine::coulombSetup() const {
   return m_impl->coulomb ? &m_impl->csetup : nullptr;
 }
-int Engine::slowInterval() const { return m_impl->coulomb ? m_impl->every : 0; }
+int Engine::slowInterval() const { return m_impl->coulomb ? m_impl->slow.every : 0; }
 std::int64_t Engine::slowEvaluations() const { return m_impl->slow_evaluations; }
 
 void Engine::useCoulombDesign(double sum_q2_design) {

@@ -206,8 +206,7 @@ MdConfig adaptiveGas(bool charged, double t_end) {
     c.charging.mode = "exchange";
     c.charging.Q = 0.1;
     c.coulomb.K = 1.0;
-    c.coulomb.every = 2;
-    c.coulomb.every_max = 8;
+    c.coulomb.every = 2;  // every_max "auto": 32 steps at the auto step, recorded as such
   }
   return c;
 }
@@ -302,4 +301,39 @@ TEST_CASE("adaptive dt: frames on their times, the end at t_end, restarts to the
     }
     if (std::getenv("GRANAGG_KEEP_TEST_FILES") == nullptr) fs::remove_all(dir);
   }
+}
+
+TEST_CASE("adaptive dt: the slow interval keeps its bounds in time, a checkpoint the design's",
+          "[md][adaptive][coulomb]") {
+  // K = 1 PPPM, the slow part every 4 auto steps, growing to 16 x 4 = 64 ("auto"). At twice the
+  // step the bounds are 2..32 steps (the same lengths in time); the checkpoint still records the
+  // cap the Coulomb set-up was designed for, 64, so that a restart designs the same set-up
+  // (Engine.cpp, withRecordedSplit) and continues to the bit.
+  MdConfig c;
+  c.system.N = 200;
+  c.system.seed = 5;
+  c.charging.mode = "fixed";
+  c.charging.initial = "bipolar";
+  c.coulomb.K = 1.0;
+  c.coulomb.every = 4;
+  c.integrator.adaptive = true;
+  Engine e(c, randomInitialState(c));
+  REQUIRE(e.coulombSetup()->every_max == 64);
+  const double dt = 2.0 * e.dt();
+  e.run(10);
+  const std::int64_t next_change = e.step() + 40;
+  e.setTimeStep(dt, next_change);
+  e.run(17);
+  CHECK(e.slowInterval() >= 2);
+  CHECK(e.slowInterval() <= 32);
+  const Checkpoint ck = e.checkpoint();
+  CHECK(ck.engine.ints.at("coulomb_every_max") == 64);
+  CHECK(ck.dt == dt);
+  Engine resumed(c, ck);
+  resumed.setTimeStep(dt, next_change);  // (Simulation re-announces the epoch's end)
+  e.run(23);
+  resumed.run(23);
+  CHECK(e.time() == resumed.time());
+  CHECK(e.frame().x == resumed.frame().x);
+  CHECK(e.frame().vy == resumed.frame().vy);
 }
