@@ -4,8 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <algorithm>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -93,6 +95,9 @@ struct H5mdWriter::Impl {
   std::vector<std::int64_t> buf_step;
   std::vector<double> buf_time;
   std::vector<std::vector<double>> buf_values;  // [name][sample]
+  // A reopened file's observables may differ from what the restarted program writes (a run
+  // continued by a newer granagg, which has an observable more): see writeObservables.
+  bool reopened = false;
 
   std::string ctx() const { return "H5MD file '" + path + "'"; }
 
@@ -300,6 +305,35 @@ struct H5mdWriter::Impl {
     buf_values.assign(obs_names.size(), {});
   }
 
+  /// A new observable in a reopened file: its value series gets NaN ("not recorded") for the
+  /// obs_written samples before it and shares the step and time series of the others.
+  void addObservable(const std::string& name) {
+    const std::string c = ctx();
+    if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+      throw std::invalid_argument("H5mdWriter: observable name '" + name +
+                                  "' is not allowed (empty, '.', or contains '/')");
+    writeObservableBuffer();  // the new series starts after every sample buffered so far
+    h5::Handle og = h5::check(H5Gopen2(file.get(), H5MD_OBSERVABLES_GROUP, H5P_DEFAULT), c);
+    h5::Handle g = h5::createGroup(og.get(), name, c);
+    h5::Handle v = h5::createExtendible(g.get(), "value", H5T_IEEE_F64LE, {}, OBS_CHUNK,
+                                        c + " observable " + name);
+    if (obs_written > 0) {
+      const std::vector<double> nan(obs_written, std::numeric_limits<double>::quiet_NaN());
+      h5::writeRows(v.get(), 0, obs_written, H5T_NATIVE_DOUBLE, nan.data(),
+                    c + " observable " + name);
+    }
+    const std::string first = std::string(H5MD_OBSERVABLES_GROUP) + "/" + obs_names[0];
+    for (const char* what : {"step", "time"}) {
+      const std::string src = first + "/" + what;
+      h5::checkStatus(
+          H5Lcreate_hard(file.get(), src.c_str(), g.get(), what, H5P_DEFAULT, H5P_DEFAULT),
+          c + ": cannot link observable " + name + "/" + what);
+    }
+    obs_names.push_back(name);
+    obs_value.push_back(std::move(v));
+    buf_values.emplace_back();
+  }
+
   void writeObservableBuffer() {
     if (buf_step.empty()) return;
     const std::string c = ctx() + " observables";
@@ -442,6 +476,7 @@ H5mdWriter H5mdWriter::reopen(const std::string& path, std::size_t N, std::int64
   m.file = h5::check(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT),
                      "cannot reopen H5MD file '" + path + "'");
   m.openLayout();
+  m.reopened = true;
   m.truncateAfter(restart_step);
   m.flushFile();
   m.writeXdmf();
@@ -591,7 +626,20 @@ void H5mdWriter::writeObservables(std::int64_t step, double time,
   Impl& m = *m_impl;
   m.requireOpen();
   if (m.obs_names.empty()) m.createObservables(values);
-  if (values.size() != m.obs_names.size())
+  // A reopened file may lack an observable that this program writes (the run was started by a
+  // granagg without it): the series is added, NaN before the restart. One it holds but this
+  // program does not write gets NaN from the restart on. A file this writer created keeps the
+  // names of its first call.
+  if (m.reopened) {
+    std::set<std::string> seen;
+    for (const auto& kv : values)
+      if (!seen.insert(kv.first).second)
+        throw std::invalid_argument("H5mdWriter: observable '" + kv.first + "' given twice");
+    for (const auto& kv : values)
+      if (std::find(m.obs_names.begin(), m.obs_names.end(), kv.first) == m.obs_names.end())
+        m.addObservable(kv.first);
+  }
+  if (!m.reopened && values.size() != m.obs_names.size())
     throw std::invalid_argument("H5mdWriter: writeObservables got " +
                                 std::to_string(values.size()) + " values, the first call fixed " +
                                 std::to_string(m.obs_names.size()));
@@ -599,7 +647,7 @@ void H5mdWriter::writeObservables(std::int64_t step, double time,
     throw std::invalid_argument("H5mdWriter: observable steps must increase (step " +
                                 std::to_string(step) + " after " + std::to_string(m.last_obs_step) +
                                 ")");
-  std::vector<double> row(m.obs_names.size());
+  std::vector<double> row(m.obs_names.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<bool> filled(m.obs_names.size(), false);
   for (const auto& [name, v] : values) {
     std::size_t k = 0;

@@ -107,9 +107,12 @@ class H5mdWriter {
 
   /// Appends one sample of scalar observables at `step` / `time` (reduced time units) to
   /// /granagg/observables/<name>. The first call fixes the set of names (non-empty, unique,
-  /// without '/'); later calls must give the same names (any order). Samples are buffered and
-  /// written at the next frame, flush() or close() (or every 4096 samples), so calling it every
-  /// few steps is cheap. Steps must increase strictly.
+  /// without '/'); later calls must give the same names (any order). A reopened file (reopen())
+  /// accepts others, so that a run started by an older granagg can be continued by a newer one:
+  /// a name the file lacks is added, NaN for the samples before it, and a name the file holds
+  /// that a call omits gets NaN for that sample. Samples are buffered and written at the next
+  /// frame, flush() or close() (or every 4096 samples), so calling it every few steps is cheap.
+  /// Steps must increase strictly.
   void writeObservables(std::int64_t step, double time,
                         const std::vector<std::pair<std::string, double>>& values);
 

@@ -573,6 +573,36 @@ TEST_CASE("Reopening for a restart drops what followed the checkpoint", "[md][io
   removeTrajectory(path);
 }
 
+TEST_CASE("A restart by a newer granagg may add or omit observables", "[md][io]") {
+  // A run started by a granagg without an observable (here "dt") is continued by one that writes
+  // it: the series is added with NaN before the restart, and a series the new program no longer
+  // writes gets NaN after it. The other series and the frames are untouched.
+  const std::string path = tempPath("restart_obs.h5");
+  writeTrajectory(path, 8, 4);  // temperature and kinetic_energy every 25 steps, to step 300
+  {
+    H5mdWriter w = H5mdWriter::reopen(path, 8, /*restart_step=*/150);
+    w.writeObservables(175, 0.175, {{"temperature", 0.5}, {"dt", 1e-3}});
+    w.writeObservables(200, 0.2, {{"dt", 2e-3}, {"temperature", 0.25}, {"kinetic_energy", 4.0}});
+    CHECK_THROWS_WITH(w.writeObservables(225, 0.225, {{"dt", 1.0}, {"dt", 2.0}}),
+                      Catch::Contains("'dt' given twice"));
+  }
+  H5mdReader r(path);
+  const auto dt = r.readObservable("dt");
+  REQUIRE(dt.step.size() == 9);  // steps 0..150 kept, then 175 and 200
+  for (std::size_t k = 0; k < 7; ++k) CHECK(std::isnan(dt.value[k]));
+  CHECK(dt.value[7] == 1e-3);
+  CHECK(dt.value[8] == 2e-3);
+  CHECK(dt.step[8] == 200);
+  const auto t = r.readObservable("temperature");
+  CHECK(t.value[6] == 1.0 / (1 + 150));  // before the restart: as written
+  CHECK(t.value[7] == 0.5);
+  CHECK(t.value[8] == 0.25);
+  const auto ke = r.readObservable("kinetic_energy");
+  CHECK(std::isnan(ke.value[7]));
+  CHECK(ke.value[8] == 4.0);
+  removeTrajectory(path);
+}
+
 TEST_CASE("XDMF sidecar describes every frame as a Polyvertex point cloud", "[md][io]") {
   const std::string path = tempPath("xdmf.h5");
   writeTrajectory(path, 7, 3);
