@@ -13,6 +13,9 @@
 #                PAPER_SCALE=1: also the paper-scale neutral run end to end (N = 50016 to t = 1000,
 #                `--preset paper`, seed 1, 2 threads), on the fixed "auto" step and on
 #                integrator.dt = "adaptive", interleaved, the fastest of REPEATS each (~5 min)
+#                BANDWIDTH=1: also this machine's memory bandwidth, one thread, from the L2 to main
+#                memory (scripts/bandwidth.py, ~20 s), the physical limit that docs/benchmarks.md,
+#                "Memory traffic of the neutral step", compares the rates with
 #
 # Installs Debian's `lammps` (29 Sep 2021 stable, binary lmp) if it is missing; builds nothing.
 #
@@ -248,6 +251,13 @@ print(int(f['granagg/observables/dt/step'][-1]))" "$TMP/paper_$rule/traj.h5")
     printf '| %s | %s | %.1f | %s | %.2f |\n' "$rule" "${PS[$rule]}" "$best" \
       "$(range ${PW[$rule]})" "$(calc "$fixed / $best")"
   done
+  echo
+fi
+
+if [ "${BANDWIDTH:-0}" = 1 ]; then
+  echo "Memory bandwidth, one thread (STREAM add, scripts/bandwidth.py):"
+  echo
+  /usr/bin/python3 scripts/bandwidth.py --sizes 1,8,16,24,32,48,128,512,1536
   echo
 fi
 
