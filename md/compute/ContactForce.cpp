@@ -176,8 +176,8 @@ struct ContactForceFunctor {
         if (r2 < 1.0) contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
       }
     }
-    if (CHARGING && dqi != 0.0)
-      dq[i] = dqi;  // applied by the next kick pass (charges are read by others now)
+    // applied by the next kick pass (charges are read by others now)
+    if (CHARGING && dqi != 0.0) dq[i] = dqi;
     StepAccum res;
     res.collisions = nnew;
     res.max_overlap = mx;
@@ -252,12 +252,12 @@ struct ContactForceFunctor {
         double rx, ry, rz;
         const double r2 = separation(pos[pair_owners[p]], pos[pair_partners[p]], rx, ry, rz);
         const unsigned char in_contact = r2 < 1.0;
-        if (in_contact !=
-            pair_hit[p]) {  // a contact begins or ends (rare): the flags of both entries
+        // a contact begins or ends (rare): the flags of both entries; this pass alone writes
+        // the partner's row
+        if (in_contact != pair_hit[p]) {
           pair_hit[p] = in_contact;
           entry_hit[pair_entries[2 * p]] = in_contact;
-          entry_hit[pair_entries[2 * p + 1]] =
-              in_contact;  // the partner's row: this pass alone writes it
+          entry_hit[pair_entries[2 * p + 1]] = in_contact;
         }
         hit[nhit] = p;
         nhit += in_contact;
@@ -270,8 +270,8 @@ struct ContactForceFunctor {
         double rx, ry, rz;
         const double r2 = separation(pos[i], pos[j], rx, ry, rz);
         double f0 = 0.0, f1 = 0.0, f2 = 0.0, dqi = 0.0;
-        contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew,
-                dqi);           // j > i: counts each collision once
+        // j > i: counts each collision once
+        contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
         probe += f0 + f1 + f2;  // (gather() probes only slow forces)
         pair_f[p] = Vec3{f0, f1, f2};
         if (CHARGING) pair_dq[p] = dqi;
@@ -319,8 +319,7 @@ struct ContactForceFunctor {
         }
         f_new[i] = fi;
         if (CHARGING)
-          dq[i] +=
-              q >= 0 ? pair_dq[q] : -pair_dq[~q];  // dq is zero before the pass (kick clears it)
+          dq[i] += q >= 0 ? pair_dq[q] : -pair_dq[~q];  // zero before the pass (kick clears it)
       }
     }
     for (int i = first; i < last; ++i) {
@@ -524,8 +523,8 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
     w.block_flags.resize(nblocks);
     forEachBlocked(N, block, f, CombineStepAccum{}, raw(w.block_flags));
   }
-  p.force.swap(
-      w.f);  // p.force = f(t); the old forces stay in w until the next pass overwrites them
+  // p.force = f(t); the old forces stay in w until the next pass overwrites them
+  p.force.swap(w.f);
   const StepAccum a = reduceBlocks(w.block_flags, StepAccum{}, CombineStepAccum{});
   ContactStepResult r;
   r.collisions = a.collisions;

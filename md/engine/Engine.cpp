@@ -213,8 +213,8 @@ struct Engine::Impl {
   // no step taken since the state was given at full step (construction): the slow force's weight
   // at this step is an opening half only (changeTimeStep)
   bool fresh_start = true;
-  double drift_since_build =
-      0.0;                // sum over steps of dt * max |u| (+ rounding): bounds every displacement
+  // sum over steps of dt * max |u| (+ rounding): bounds every displacement
+  double drift_since_build = 0.0;
   bool exchange = false;  // collisional charging on (charging.mode = "exchange")
   ChargeExchange::Params charging{};
   DVec<double> dq;  // charge gained at the last force pass, per slot (exchange only)
@@ -248,8 +248,8 @@ struct Engine::Impl {
   double u_max_last = -1.0;           // max |u| of the last step; < 0: none in this process yet
 
   explicit Impl(const MdConfig& c) : cfg(c), nl(1.0, c.neighbor.skinCap()) {
-    nl.keepPairs(
-        true);  // contacts only: the force pass walks the compressed list (ContactForce.cpp)
+    // contacts only: the force pass walks the compressed list (ContactForce.cpp)
+    nl.keepPairs(true);
     exchange = c.charging.mode == "exchange";
     charging.seed = c.system.seed;
     charging.Q = c.charging.Q;
@@ -1016,8 +1016,8 @@ Forces Engine::forces(StateKind kind) const {
   unpackVec3(d.p.force, comp[0], comp[1], comp[2]);
   const DVec<double>* f[3] = {&comp[0], &comp[1], &comp[2]};
   DVec<double> g[3];
-  const double w =
-      d.coulomb ? 1.0 - d.slowWeight(d.step) : 0.0;  // physical: contact + Coulomb once
+  // physical: contact + Coulomb once
+  const double w = d.coulomb ? 1.0 - d.slowWeight(d.step) : 0.0;
   if (kind == StateKind::Physical && w != 0.0) {
     const DVec<double>* ext[3] = {&d.ext_fx, &d.ext_fy, &d.ext_fz};
     for (int a = 0; a < 3; ++a) {
