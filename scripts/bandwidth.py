@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 """Memory bandwidth of this machine, one thread, for the physical limit of the MD loop
-(docs/benchmarks.md, "Memory traffic"): the STREAM "add" kernel a = b + c (numpy, float64:
-16 bytes read and 8 written per element) over working sets from the second-level cache to main
-memory. Each size reports the best of REPEATS passes, in GB/s of bytes moved (reads plus writes;
-write-allocate traffic not counted, as STREAM does).
+(docs/benchmarks.md, "Memory traffic of the neutral step"): the STREAM "add" kernel a = b + c
+(numpy, float64: 16 bytes read and 8 written per element) over working sets from the
+second-level cache to main memory. Each size reports the best of REPEATS passes, in GB/s of
+bytes moved (reads plus writes; write-allocate traffic not counted, as STREAM does).
 
 usage: /usr/bin/python3 scripts/bandwidth.py [--repeats R] [--sizes MB,MB,...]
 """
@@ -16,7 +16,7 @@ import numpy as np
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=20)
-    ap.add_argument("--sizes", default="1,8,32,128,512,1536",
+    ap.add_argument("--sizes", default="1,8,16,24,32,48,128,512,1536",
                     help="working sets in MB (three arrays together)")
     a = ap.parse_args()
     print("| working set | GB/s (best of %d) |" % a.repeats)

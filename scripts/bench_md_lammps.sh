@@ -257,7 +257,7 @@ fi
 if [ "${BANDWIDTH:-0}" = 1 ]; then
   echo "Memory bandwidth, one thread (STREAM add, scripts/bandwidth.py):"
   echo
-  /usr/bin/python3 scripts/bandwidth.py --sizes 1,8,16,24,32,48,128,512,1536
+  /usr/bin/python3 scripts/bandwidth.py
   echo
 fi
 

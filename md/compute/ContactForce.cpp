@@ -319,7 +319,7 @@ struct ContactForceFunctor {
         }
         f_new[i] = fi;
         if (CHARGING)
-          dq[i] += q >= 0 ? pair_dq[q] : -pair_dq[~q];  // zero before the pass (kick clears it)
+          dq[i] += q >= 0 ? pair_dq[q] : -pair_dq[~q];  // dq is zero here: the kick clears it
       }
     }
     for (int i = first; i < last; ++i) {
