@@ -25,15 +25,11 @@ namespace granagg::md {
 
 void ContactWork::resize(std::size_t n) { f.resize(n); }
 
-bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step) {
-  return nl.hasPairs() && !(step.fast.r2 > 0.0);
-}
-
 namespace {
 
 /// CHARGING: the charge exchange at new contacts is compiled in (dq non-null); without it the
 /// neutral pass keeps the random-number code out of its registers.
-/// ADVANCE: the pass also advances the step (ContactStep::advance_dt; compressed-list pass only).
+/// ADVANCE: the pass also advances the step (ContactStep::advance_dt).
 template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING, bool ADVANCE = false>
 struct ContactForceFunctor {
   using value_type = StepAccum;
@@ -538,6 +534,22 @@ ContactStepResult forcePass(ParticleData& p, const NeighborList& nl, const commo
   return r;
 }
 
+/// The pass compiled for the step: with the fast Coulomb part the slow forces are always given.
+template <class Potential, bool ADVANCE>
+ContactStepResult forcePassFor(ParticleData& p, const NeighborList& nl, const common::Box& box,
+                               const typename Potential::Params& params, const ContactStep& st,
+                               ContactWork& w) {
+  const bool fast = st.fast.r2 > 0.0;
+  if (st.dq) {
+    if (fast) return forcePass<Potential, true, true, true, ADVANCE>(p, nl, box, params, st, w);
+    return st.ext_fx ? forcePass<Potential, true, false, true, ADVANCE>(p, nl, box, params, st, w)
+                     : forcePass<Potential, false, false, true, ADVANCE>(p, nl, box, params, st, w);
+  }
+  if (fast) return forcePass<Potential, true, true, false, ADVANCE>(p, nl, box, params, st, w);
+  return st.ext_fx ? forcePass<Potential, true, false, false, ADVANCE>(p, nl, box, params, st, w)
+                   : forcePass<Potential, false, false, false, ADVANCE>(p, nl, box, params, st, w);
+}
+
 template <class Potential>
 ContactStepResult computeContactForcesOf(ParticleData& p, const NeighborList& nl,
                                          const common::Box& box,
@@ -547,23 +559,11 @@ ContactStepResult computeContactForcesOf(ParticleData& p, const NeighborList& nl
   if (fast && (nl.listRange() < st.fast.r2 || !st.fast_table.data))
     throw std::logic_error("neighbour list range below the fast Coulomb range");
   if (st.advance_dt > 0.0) {
-    if (!canAdvanceInForcePass(nl, st) || st.advance_dt != st.dt)
-      throw std::logic_error(
-          "computeContactForces: this pass cannot advance the step (ContactStep::advance_dt)");
-    if (st.dq)
-      return st.ext_fx ? forcePass<Potential, true, false, true, true>(p, nl, box, params, st, w)
-                       : forcePass<Potential, false, false, true, true>(p, nl, box, params, st, w);
-    return st.ext_fx ? forcePass<Potential, true, false, false, true>(p, nl, box, params, st, w)
-                     : forcePass<Potential, false, false, false, true>(p, nl, box, params, st, w);
+    if (st.advance_dt != st.dt)
+      throw std::logic_error("computeContactForces: advance_dt differs from dt (ContactStep)");
+    return forcePassFor<Potential, true>(p, nl, box, params, st, w);
   }
-  if (st.dq) {
-    if (fast) return forcePass<Potential, true, true, true>(p, nl, box, params, st, w);
-    return st.ext_fx ? forcePass<Potential, true, false, true>(p, nl, box, params, st, w)
-                     : forcePass<Potential, false, false, true>(p, nl, box, params, st, w);
-  }
-  if (fast) return forcePass<Potential, true, true, false>(p, nl, box, params, st, w);
-  return st.ext_fx ? forcePass<Potential, true, false, false>(p, nl, box, params, st, w)
-                   : forcePass<Potential, false, false, false>(p, nl, box, params, st, w);
+  return forcePassFor<Potential, false>(p, nl, box, params, st, w);
 }
 
 template <class Potential>

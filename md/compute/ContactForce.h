@@ -32,8 +32,8 @@
 ///   On CUDA a block is one particle. With a bound on the displacements since the list was built
 ///   (ContactStep::displacement_bound) the first pass skips the pairs that cannot have come into
 ///   contact since it last looked at them (the same contacts, fewer distance tests).
-/// The pair form can also finish the step and open the next (ContactStep::advance_dt): the
-/// gathering pass advances each particle as soon as its force is known.
+/// Both shapes can also finish the step and open the next (ContactStep::advance_dt): the pass that
+/// completes a particle's force (the row pass, or the gathering pass) advances it at once.
 #include <cstdint>
 
 #include "common/Box.h"
@@ -114,10 +114,9 @@ struct ContactStep {
   /// counted), and with charging q' = q + dq. The same arithmetic as kickDrift() after the pass, in
   /// one sweep over the particles instead of two; the new positions and velocities go to
   /// ContactWork and are swapped in after the pass, so every partner's x and u stay those of t
-  /// while others read them. dt must equal this value (fixed step). Needs the compressed list and
-  /// no fast Coulomb part (canAdvanceInForcePass). On a non-finite force or deep overlap nothing is
-  /// advanced (the forces are stored, positions and velocities stay those of t, for the error
-  /// report; image counts may already have moved).
+  /// while others read them. dt must equal this value (fixed step). On a non-finite force or
+  /// deep overlap nothing is advanced (the forces are stored, positions and velocities stay those
+  /// of t, for the error report; image counts may already have moved).
   double advance_dt = 0.0;
   /// >= 0: a bound on every particle's displacement since the list was built, non-decreasing from
   /// pass to pass while the list stays the same (the engine's sum of dt max|u| plus rounding).
@@ -126,10 +125,6 @@ struct ContactStep {
   /// closed the gap. < 0 (unknown): every pair is screened at every pass.
   double displacement_bound = -1.0;
 };
-
-/// Whether computeContactForces can advance the step (ContactStep::advance_dt) with this list and
-/// step.
-bool canAdvanceInForcePass(const NeighborList& nl, const ContactStep& step);
 
 /// Contact forces of the current positions into p.force (state as described above),
 /// collisions, and with charging the charge each particle gains at its new contacts.

@@ -608,14 +608,6 @@ struct Engine::Impl {
     if (advance) driftTaken(r.max_u2);
   }
 
-  /// Whether the force pass can also advance the step (ContactForce.h decides: no fast Coulomb
-  /// part, compressed list; the list exists, built when the initial forces were computed).
-  bool canAdvanceInForcePass() const {
-    ContactStep st;
-    st.fast = fast_switch;
-    return md::canAdvanceInForcePass(nl, st);
-  }
-
   /// Forces of a state given at full step (initial or restored state without forces): the
   /// predicted velocities are v itself and no pair counts as a new collision.
   void computeInitialForces() {
@@ -751,23 +743,14 @@ struct Engine::Impl {
 
   /// `steps` velocity-Verlet steps; afterwards the forces are those of the new positions and the
   /// closing kick is pending. A step is two passes over the particles: the opening pass (kick +
-  /// drift) and the force pass. Where the force pass can also complete the step and open the next
-  /// (ContactStep::advance_dt; not with a fast Coulomb part), the steps in between take one pass
-  /// each: open, then (forces + close + open) steps - 1 times, then forces -- the same operations
-  /// in the same order.
+  /// drift) and the force pass. The force pass also completes the step and opens the next
+  /// (ContactStep::advance_dt), so the steps in between take one pass each: open, then (forces +
+  /// close + open) steps - 1 times, then forces -- the same operations in the same order as
+  /// separate passes (VelocityVerlet.h: one arithmetic).
   void advance(std::int64_t steps) {
     if (steps <= 0) return;
     openStep();
-    const bool fused = canAdvanceInForcePass();
-    for (std::int64_t s = 1; s < steps; ++s) {
-      if (fused) {
-        computeForces(dt, true);
-      } else {
-        computeForces(dt);
-        close_pending = true;
-        openStep();
-      }
-    }
+    for (std::int64_t s = 1; s < steps; ++s) computeForces(dt, true);
     computeForces(dt);
     close_pending = true;
   }

@@ -12,6 +12,7 @@
 
 #include "common/Box.h"
 #include "md/compute/ContactForce.h"
+#include "md/coulomb/RealSpace.h"
 #include "md/integrate/VelocityVerlet.h"
 #include "md/neighbor/NeighborList.h"
 #include "md/potentials/ContactModels.h"
@@ -254,6 +255,116 @@ TEST_CASE("the pair-form pass equals the per-row pass to the bit, collisions and
   CHECK(charged > 20);
   CHECK(std::fabs(total) <=
         1e-14 * magnitude);  // every transfer leaves one partner and reaches the other
+}
+
+TEST_CASE("advancing the step in the force pass equals the separate kick-drift pass to the bit",
+          "[md][neighbor][coulomb]") {
+  // The force pass can also close the step and open the next (ContactStep::advance_dt), in the
+  // per-row pass and in the pair form's gathering pass. Over three steps, each shape -- per row,
+  // per row advancing, pair form, pair form advancing -- must give the forces, collisions,
+  // exchanged charges, positions and velocities of the per-row pass followed by kickDrift(), to
+  // the last bit, without and with the fast Coulomb part (which the per-row pass computes; the
+  // pair form then falls back to it). Random charges of both signs, a slow force as the engine
+  // passes it, a list out to r2 = 3.5 for the fast part (about 30 entries per row) and a large
+  // step (dt = 0.05, many pairs overlapping) make every branch run: attraction, repulsion and
+  // contacts that start this step, with the charge exchange.
+  const double L = 14.5, dt = 0.05;
+  std::vector<double> pos, vel;
+  randomGas(23, 600, L, pos, vel);
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> uq(-1.0, 1.0);
+  std::vector<double> q(600), x[3];
+  for (double& c : q) c = uq(rng);
+  DVec<double> ext[3];  // a slow force, as the engine always passes with the fast part
+  for (auto& e : ext)
+    for (std::size_t i = 0; i < q.size(); ++i) e.push_back(0.1 * uq(rng));
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < q.size(); ++i) x[c].push_back(pos[3 * i + c]);
+  const HertzViscoelastic::Params prm{278.6, 27.7, true};
+  const common::Box box{L};
+  const auto values = fastPairTableValues(RealSpaceSwitch{2.5, 3.5});
+  const DVec<double> table(values.begin(), values.end());
+  const auto same3 = [](const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const Vec3& u, const Vec3& v) {
+      return u.x == v.x && u.y == v.y && u.z == v.z;
+    });
+  };
+  const auto same4 = [](const std::vector<Scalar4>& a, const std::vector<Scalar4>& b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                      [](const Scalar4& u, const Scalar4& v) {
+                        return u.x == v.x && u.y == v.y && u.z == v.z && u.w == v.w;
+                      });
+  };
+  std::vector<Vec3> vel_without_fast;
+  for (bool fast : {false, true}) {
+    const RealSpaceSwitch sw = fast ? RealSpaceSwitch{2.5, 3.5} : RealSpaceSwitch{};
+    struct Outcome {
+      std::vector<Vec3> force, vel;
+      std::vector<Scalar4> pos;
+      std::vector<double> charge;
+      std::int64_t collisions = 0;
+    } out[4];
+    for (int shape = 0; shape < 4; ++shape) {  // per row, advancing; pair form, advancing
+      INFO("fast Coulomb part " << fast << ", pass shape " << shape);
+      const bool paired = shape >= 2, advancing = shape % 2 == 1;
+      ParticleData p = makeParticles(pos, vel);
+      p.setPositions(x[0], x[1], x[2], q);
+      NeighborList nl(fast ? sw.r2 : 1.0, 0.3);
+      nl.keepPairs(paired);
+      nl.build(p, box);
+      DVec<double> dq(p.size(), 0.0), block_max;
+      ContactWork w;
+      ContactStep st;
+      st.max_overlap = 2.0;
+      st.charging.seed = 99;
+      st.charging.Q = 0.05;
+      st.charging.kappa = 0.83;
+      st.dq = raw(dq);
+      st.ext_fx = raw(ext[0]);
+      st.ext_fy = raw(ext[1]);
+      st.ext_fz = raw(ext[2]);
+      st.ext_predict_scale = 0.25 * dt;  // as at a step after a slow one (ContactStep)
+      if (fast) {
+        st.fast = sw;
+        st.fast_table = pairTable(raw(table), sw.r2 * sw.r2, FAST_PAIR_TABLE_INTERVALS);
+        st.coulomb_K = 5.0;
+      }
+      // a state given at full step, the opening pass, then three steps
+      REQUIRE(computeContactForces(p, nl, box, hertzModel(prm), st, w).worst == 0);
+      kickDrift(p, 0.5 * dt, dt, box, false, raw(dq), block_max);
+      st.dt = dt;
+      for (int s = 1; s <= 3; ++s) {
+        st.step = 100 + s;
+        st.advance_dt = advancing ? dt : 0.0;
+        const ContactStepResult r = computeContactForces(p, nl, box, hertzModel(prm), st, w);
+        REQUIRE(r.worst == 0);
+        out[shape].collisions += r.collisions;
+        if (!advancing) kickDrift(p, 0.5 * dt, dt, box, true, raw(dq), block_max);
+      }
+      out[shape].force.assign(p.force.begin(), p.force.end());
+      out[shape].vel.assign(p.vel.begin(), p.vel.end());
+      out[shape].pos.assign(p.pos.begin(), p.pos.end());
+      out[shape].charge.assign(dq.begin(), dq.end());
+    }
+    INFO("fast Coulomb part " << fast << "; collisions in three steps: " << out[0].collisions);
+    REQUIRE(out[0].collisions > 20);
+    int moved = 0;  // the exchange ran: kickDrift applied dq to the charges (pos.w)
+    for (std::size_t i = 0; i < q.size(); ++i) moved += out[0].pos[i].w != q[i];
+    CHECK(moved > 20);
+    if (fast) {  // the fast part acts: the same steps without it end elsewhere
+      CHECK_FALSE(same3(out[0].vel, vel_without_fast));
+    } else {
+      vel_without_fast = out[0].vel;
+    }
+    for (int shape = 1; shape < 4; ++shape) {
+      INFO("pass shape " << shape << " against the per-row pass and kickDrift()");
+      CHECK(out[shape].collisions == out[0].collisions);
+      CHECK(same3(out[shape].force, out[0].force));
+      CHECK(same3(out[shape].vel, out[0].vel));
+      CHECK(same4(out[shape].pos, out[0].pos));
+      CHECK(out[shape].charge == out[0].charge);
+    }
+  }
 }
 
 TEST_CASE(
