@@ -7,9 +7,10 @@ slopes of S_grid, S without the largest and l, per run, and their mean and stand
 the runs. A check and a figure, not a test; the numbers come from granagg analyze.
 
 usage: /usr/bin/python3 scripts/s_dominance.py OUT NAME=ANALYZE_DIR [NAME=ANALYZE_DIR ...]
-    [--ratio 2] [--t-min 50]
+    [--ratio 2] [--t-min 50] [--length-only]
 writes OUT/<NAME>.csv (one row per frame time present in every run of that ensemble) and
-OUT/s_dominance.png.
+OUT/s_dominance.png; with --length-only the figure shows l(t) and its local slope alone (for
+ensembles that differ only in how l is measured, e.g. analyze's --structure-kcut).
 """
 import argparse
 import math
@@ -92,6 +93,8 @@ def main():
     ap.add_argument("ensembles", nargs="+", help="NAME=ANALYZE_DIR")
     ap.add_argument("--ratio", type=float, default=2.0, help="p of the local slope (default 2)")
     ap.add_argument("--t-min", type=float, default=50.0, help="first time tabulated (default 50)")
+    ap.add_argument("--length-only", action="store_true",
+                    help="figure: l(t) and its local slope only")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     results = {}
@@ -115,6 +118,9 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    if a.length_only:
+        plot_length(results, a, plt)
+        return
     fig, ax = plt.subplots(2, 2, figsize=(11, 8))
     for k, (name, (names, tab)) in enumerate(results.items()):
         c = {n: i for i, n in enumerate(names)}
@@ -150,6 +156,31 @@ def main():
     ax[1, 0].set_ylabel("density length l [d]")
     ax[1, 1].set_ylabel(f"local slope (ratio {a.ratio:g}), mean +- se over runs")
     ax[1, 1].axhline(0.5, color="k", lw=0.5)
+    fig.tight_layout()
+    png = os.path.join(a.out, "s_dominance.png")
+    fig.savefig(png, dpi=110)
+    print(f"wrote {png}")
+
+
+def plot_length(results, a, plt):
+    """l(t) and its local slope, mean +- standard error over the runs, one colour per ensemble."""
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    for k, (name, (names, tab)) in enumerate(results.items()):
+        c = {n: i for i, n in enumerate(names)}
+        t = tab[:, 0]
+        ax[0].errorbar(t, tab[:, c["l_density_mean"]], tab[:, c["l_density_se"]], color=f"C{k}",
+                       label=name)
+        m, se = tab[:, c["z_l_density_mean"]], tab[:, c["z_l_density_se"]]
+        ax[1].plot(t, m, color=f"C{k}", label=name)
+        ax[1].fill_between(t, m - se, m + se, color=f"C{k}", alpha=0.2)
+    for a_ in ax:
+        a_.set_xscale("log")
+        a_.set_xlabel("t")
+        a_.legend(fontsize=8)
+    ax[0].set_yscale("log")
+    ax[0].set_ylabel("density length l [d]")
+    ax[1].set_ylabel(f"local slope of l (ratio {a.ratio:g}), mean +- se over runs")
+    ax[1].axhline(0.5, color="k", lw=0.5)
     fig.tight_layout()
     png = os.path.join(a.out, "s_dominance.png")
     fig.savefig(png, dpi=110)
