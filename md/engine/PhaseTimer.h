@@ -21,7 +21,7 @@ namespace granagg::md {
 
 class PhaseTimer {
  public:
-  /// The phases of a step (Engine.cpp, Pppm.cpp), in the order of the report.
+  /// The phases of a step (Engine.cpp, EngineCoulomb.cpp, Pppm.cpp), in the order of the report.
   enum Phase {
     ContactPass,      ///< contact forces + fast Coulomb pairs (+ the fused kick/drift)
     KickDrift,        ///< velocity-Verlet kicks and drift outside the contact pass

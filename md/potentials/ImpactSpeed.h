@@ -7,7 +7,7 @@
 ///   - the Maxwellian tail of the current granular temperature: the speed exceeded by a fraction
 ///     1e-6 of collisions, v_T = sqrt(4 T_g ln 1e6) (Engine::impactSpeedMax at T_g);
 ///   - the fastest impact a pair of the contact list can still make, v_pair below, times a
-///     margin (Engine.cpp: ADAPTIVE_PAIR_MARGIN).
+///     margin (EngineTimeStep.cpp: ADAPTIVE_PAIR_MARGIN).
 /// v_pair is an energy: the normal speed a pair would have at first touch if its normal energy
 /// were all kinetic. For a pair in contact it counts the elastic energy, so that a persistent
 /// contact (a sticking pair of the charged gas, a pair pressed in a cluster) is resolved like an
