@@ -424,8 +424,7 @@ struct PairImpactSpeed2Of {
       const double r = sqrt(rx * rx + ry * ry + rz * rz);
       if (!(r > 0.0)) continue;
       // closing rate -(v_i - v_j) . r_ij / r
-      const double approach =
-          -((vi.x - vj.x) * rx + (vi.y - vj.y) * ry + (vi.z - vj.z) * rz) / r;
+      const double approach = -((vi.x - vj.x) * rx + (vi.y - vj.y) * ry + (vi.z - vj.z) * rz) / r;
       const double v2 =
           pairImpactSpeed2<Potential>(r, approach, coulomb_K * ri.w * rj.w, params, m_eff);
       best = v2 > best ? v2 : best;
@@ -616,8 +615,9 @@ double maxPairImpactSpeed2(const ParticleData& p, const NeighborList& nl, const 
   return std::visit(
       [&](const auto& c) {
         using Model = typename std::decay_t<decltype(c)>::Model;
-        const PairImpactSpeed2Of<Model> f{raw(p.pos), raw(p.vel), nl.rows(), nl.counts(),
-                                          nl.capacity(), box, c.params, coulomb_K, m_eff};
+        const PairImpactSpeed2Of<Model> f{raw(p.pos),  raw(p.vel),    nl.rows(),
+                                          nl.counts(), nl.capacity(), box,
+                                          c.params,    coulomb_K,     m_eff};
         return thrust::transform_reduce(thrust::counting_iterator<int>(0),
                                         thrust::counting_iterator<int>(N), f, 0.0,
                                         thrust::maximum<double>());

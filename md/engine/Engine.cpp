@@ -69,11 +69,9 @@ MdConfig withRecordedSplit(MdConfig c, const Checkpoint& ck) {
   }
   if (c.coulomb.every_max == 0) {
     const auto m = ints.find("coulomb_every_max");
-    c.coulomb.every_max =
-        m != ints.end()
-            ? static_cast<int>(m->second)
-            : SLOW_INTERVAL_GROWTH_BEFORE_RECORDED *
-                  Engine::coulombEvery(c, Engine::chooseTimeStep(c));
+    c.coulomb.every_max = m != ints.end() ? static_cast<int>(m->second)
+                                          : SLOW_INTERVAL_GROWTH_BEFORE_RECORDED *
+                                                Engine::coulombEvery(c, Engine::chooseTimeStep(c));
   }
   return c;
 }
@@ -315,8 +313,7 @@ void Engine::Impl::abort(int worst) {
 }
 
 void Engine::Impl::driftTaken(double max_u2) {
-  const double moved =
-      dt * std::sqrt(max_u2) + 2.0 * (std::nextafter(box.L, 2.0 * box.L) - box.L);
+  const double moved = dt * std::sqrt(max_u2) + 2.0 * (std::nextafter(box.L, 2.0 * box.L) - box.L);
   drift_since_build += moved;
   drift_since_coul_build += moved;
   u_max_last = std::sqrt(max_u2);
@@ -434,10 +431,10 @@ Engine::Engine(const MdConfig& config, const Checkpoint& ck)
   } else if (ck.dt > 0.0 && ck.dt != d.dt) {
     // a fixed step: the configuration must give the step the checkpoint was written at, or a
     // build whose automatic step differs would continue the run silently on another
-    throw std::invalid_argument("integrator.dt: the checkpoint was written at dt = " +
-                                common::formatReal(ck.dt) + ", and its configuration now gives " +
-                                common::formatReal(d.dt) +
-                                "; continue it with the granagg that wrote it");
+    throw std::invalid_argument(
+        "integrator.dt: the checkpoint was written at dt = " + common::formatReal(ck.dt) +
+        ", and its configuration now gives " + common::formatReal(d.dt) +
+        "; continue it with the granagg that wrote it");
   }
   const auto collisions = e.ints.find("collisions");
   restore(ck.state, ck.forces, collisions == e.ints.end() ? 0 : collisions->second, e);
