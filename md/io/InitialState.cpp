@@ -189,39 +189,46 @@ bool isLammpsData(const std::string& path) {
   return false;
 }
 
-Frame readInitialStateLammps(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("initial state file '" + path + "' cannot be read");
-  // the header (up to the first section keyword), then the sections by name
-  std::vector<DataLine> header;
-  std::map<std::string, std::vector<DataLine>> sections;
-  std::map<std::string, DataLine> keyword;  // section name -> its keyword line
-  std::string current, line;
-  for (std::size_t n = 1; std::getline(in, line); ++n) {
-    if (n == 1) continue;  // title
-    const std::size_t hash = line.find('#');
-    DataLine d{n, words(line.substr(0, hash)),
-               hash == std::string::npos ? "" : common::trim(line.substr(hash + 1))};
-    if (d.words.empty()) continue;
-    if (std::isalpha(static_cast<unsigned char>(d.words[0][0]))) {  // a section keyword
-      current = common::join(d.words, " ");
-      if (keyword.count(current))
-        throw std::invalid_argument(path + ":" + std::to_string(n) + ": section '" + current +
-                                    "' appears twice");
-      keyword[current] = d;
-      sections[current];
-      continue;
+namespace {
+
+/// A LAMMPS data file split into its header lines and its sections by name, with the parsers of
+/// its numbers, whose errors name the file and the line.
+struct DataFile {
+  std::string path;
+  std::vector<DataLine> header;                           // up to the first section keyword
+  std::map<std::string, std::vector<DataLine>> sections;  // section name -> its lines
+  std::map<std::string, DataLine> keyword;                // section name -> its keyword line
+
+  explicit DataFile(const std::string& file) : path(file) {
+    std::ifstream in(path);
+    if (!in) throw std::invalid_argument("initial state file '" + path + "' cannot be read");
+    std::string current, line;
+    for (std::size_t n = 1; std::getline(in, line); ++n) {
+      if (n == 1) continue;  // title
+      const std::size_t hash = line.find('#');
+      DataLine d{n, words(line.substr(0, hash)),
+                 hash == std::string::npos ? "" : common::trim(line.substr(hash + 1))};
+      if (d.words.empty()) continue;
+      if (std::isalpha(static_cast<unsigned char>(d.words[0][0]))) {  // a section keyword
+        current = common::join(d.words, " ");
+        if (keyword.count(current))
+          throw std::invalid_argument(path + ":" + std::to_string(n) + ": section '" + current +
+                                      "' appears twice");
+        keyword[current] = d;
+        sections[current];
+        continue;
+      }
+      (current.empty() ? header : sections[current]).push_back(d);
     }
-    (current.empty() ? header : sections[current]).push_back(d);
   }
-  auto at = [&](const DataLine& d) { return path + ":" + std::to_string(d.number) + ": "; };
-  auto real = [&](const DataLine& d, std::size_t k, const char* what) {
+  std::string at(const DataLine& d) const { return path + ":" + std::to_string(d.number) + ": "; }
+  double real(const DataLine& d, std::size_t k, const char* what) const {
     double v = 0.0;
     if (!common::parseReal(d.words[k], v) || !std::isfinite(v))
       throw std::invalid_argument(at(d) + what + " '" + d.words[k] + "' is not a finite number");
     return v;
-  };
-  auto integer = [&](const DataLine& d, std::size_t k, const char* what) {
+  }
+  long long integer(const DataLine& d, std::size_t k, const char* what) const {
     const std::string& w = d.words[k];
     char* end = nullptr;
     errno = 0;
@@ -229,156 +236,208 @@ Frame readInitialStateLammps(const std::string& path) {
     if (w.empty() || *end != '\0' || errno == ERANGE)
       throw std::invalid_argument(at(d) + what + " '" + w + "' is not an integer");
     return v;
-  };
+  }
+  /// The lines of a section; empty if the file has none.
+  const std::vector<DataLine>& section(const std::string& name) const {
+    static const std::vector<DataLine> none;
+    const auto it = sections.find(name);
+    return it == sections.end() ? none : it->second;
+  }
+};
 
-  long long n_atoms = -1;
-  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+/// The header's atom count and box: the lower corner and the edge of a cubic box.
+struct DataHeader {
+  long long atoms = -1;
+  double lo[3] = {0, 0, 0};
+  double L = 0.0;
+};
+
+DataHeader readHeader(const DataFile& file) {
+  DataHeader h;
+  double hi[3] = {0, 0, 0};
   bool has_box[3] = {false, false, false};
-  for (const DataLine& d : header) {
+  for (const DataLine& d : file.header) {
     const auto& w = d.words;
     if (w.size() == 2 && w[1] == "atoms") {
-      n_atoms = integer(d, 0, "atom count");
+      h.atoms = file.integer(d, 0, "atom count");
     } else if (w.size() == 6 && w[3] == "xy") {
-      throw std::invalid_argument(at(d) + "a triclinic box (xy xz yz); granagg's box is cubic");
+      throw std::invalid_argument(file.at(d) +
+                                  "a triclinic box (xy xz yz); granagg's box is cubic");
     } else if (w.size() == 4 && w[2].size() == 3 && w[2].compare(1, 2, "lo") == 0 &&
                w[3].size() == 3 && w[3].compare(1, 2, "hi") == 0 && w[2][0] == w[3][0] &&
                w[2][0] >= 'x' && w[2][0] <= 'z') {  // "xlo xhi"
       const int a = w[2][0] - 'x';
-      lo[a] = real(d, 0, "box bound");
-      hi[a] = real(d, 1, "box bound");
+      h.lo[a] = file.real(d, 0, "box bound");
+      hi[a] = file.real(d, 1, "box bound");
       has_box[a] = true;
     }
   }
-  if (n_atoms < 0) throw std::invalid_argument(path + ": no 'N atoms' line in the header");
+  const std::string& path = file.path;
+  if (h.atoms < 0) throw std::invalid_argument(path + ": no 'N atoms' line in the header");
   for (int a = 0; a < 3; ++a)
     if (!has_box[a])
       throw std::invalid_argument(path + ": no '" + std::string(1, "xyz"[a]) + "lo " + "xyz"[a] +
                                   "hi' line in the header");
-  const double L = hi[0] - lo[0];
+  h.L = hi[0] - h.lo[0];
   for (int a = 0; a < 3; ++a)
-    if (!(hi[a] - lo[a] > 0.0) || std::fabs((hi[a] - lo[a]) - L) > 1e-12 * L)
+    if (!(hi[a] - h.lo[a] > 0.0) || std::fabs((hi[a] - h.lo[a]) - h.L) > 1e-12 * h.L)
       throw std::invalid_argument(path + ": the box must be cubic with positive edges (got " +
-                                  common::formatReal(hi[0] - lo[0]) + " x " +
-                                  common::formatReal(hi[1] - lo[1]) + " x " +
-                                  common::formatReal(hi[2] - lo[2]) + ")");
-  if (!sections.count("Atoms")) throw std::invalid_argument(path + ": no Atoms section");
-  if (!sections.count("Velocities"))
-    throw std::invalid_argument(path +
-                                ": no Velocities section (an initial state needs velocities)");
-  const auto& atoms = sections["Atoms"];
-  if (static_cast<long long>(atoms.size()) != n_atoms)
-    throw std::invalid_argument(at(keyword["Atoms"]) + "the Atoms section has " +
-                                std::to_string(atoms.size()) + " lines, the header says " +
-                                std::to_string(n_atoms) + " atoms");
-  checkMinimumSize(atoms.size(), path);
+                                  common::formatReal(hi[0] - h.lo[0]) + " x " +
+                                  common::formatReal(hi[1] - h.lo[1]) + " x " +
+                                  common::formatReal(hi[2] - h.lo[2]) + ")");
+  return h;
+}
 
-  // the atom style: named after `Atoms #`, else told by the column count (with or without
-  // image flags); columns of x and of diameter, density, q (-1: absent)
-  struct Style {
-    const char* name;
-    std::size_t columns;
-    int x, diameter, density, q;
-  };
-  static const Style STYLES[] = {{"sphere", 7, 4, 2, 3, -1},
-                                 {"charge", 6, 3, -1, -1, 2},
-                                 {"atomic", 5, 2, -1, -1, -1},
-                                 {"hybrid", 8, 2, 5, 6, 7}};
-  const std::string named =
-      words(keyword["Atoms"].comment).empty() ? std::string() : words(keyword["Atoms"].comment)[0];
-  const std::size_t ncol = atoms.front().words.size();
-  const Style* style = nullptr;
-  for (const Style& s : STYLES)
+/// An atom style granagg reads: its columns, and the columns of x and of diameter, density and
+/// q (-1: absent).
+struct AtomStyle {
+  const char* name;
+  std::size_t columns;
+  int x, diameter, density, q;
+};
+
+/// The Atoms section's style: named after `Atoms #`, else told by the column count (with or
+/// without image flags). `images`: the lines end in three image flags.
+const AtomStyle& atomStyle(const DataFile& file, bool& images) {
+  static const AtomStyle STYLES[] = {{"sphere", 7, 4, 2, 3, -1},
+                                     {"charge", 6, 3, -1, -1, 2},
+                                     {"atomic", 5, 2, -1, -1, -1},
+                                     {"hybrid", 8, 2, 5, 6, 7}};
+  const DataLine& kw = file.keyword.at("Atoms");
+  const DataLine& first = file.section("Atoms").front();
+  const std::string named = words(kw.comment).empty() ? std::string() : words(kw.comment)[0];
+  const std::size_t ncol = first.words.size();
+  const AtomStyle* style = nullptr;
+  for (const AtomStyle& s : STYLES)
     if (named.empty() ? (ncol == s.columns || ncol == s.columns + 3) : named == s.name) style = &s;
   if (!style)
     throw std::invalid_argument(
-        at(keyword["Atoms"]) +
-        (named.empty() ? "atom style not named and " + std::to_string(ncol) +
-                             " columns fit none of sphere, charge, atomic, hybrid sphere charge"
-                       : "atom style '" + named +
-                             "' is not read (sphere, charge, atomic, hybrid sphere charge)"));
-  const bool images = ncol == style->columns + 3;
+        file.at(kw) + (named.empty()
+                           ? "atom style not named and " + std::to_string(ncol) +
+                                 " columns fit none of sphere, charge, atomic, hybrid sphere charge"
+                           : "atom style '" + named +
+                                 "' is not read (sphere, charge, atomic, hybrid sphere charge)"));
+  images = ncol == style->columns + 3;
   if (ncol != style->columns && !images)
-    throw std::invalid_argument(at(atoms.front()) + "atom style " + style->name + " has " +
+    throw std::invalid_argument(file.at(first) + "atom style " + style->name + " has " +
                                 std::to_string(style->columns) + " columns (+3 image flags), " +
                                 "this line " + std::to_string(ncol));
+  return *style;
+}
 
-  // type masses (charge, atomic: Masses; sphere: diameter and density)
-  std::map<long long, double> mass;
-  for (const DataLine& d : sections["Masses"]) {
-    if (d.words.size() < 2) throw std::invalid_argument(at(d) + "a Masses line is 'type mass'");
-    mass[integer(d, 0, "atom type")] = real(d, 1, "mass");
+/// Checks every Atoms line against the first's column count and granagg's particles (diameter
+/// 1, mass 1: from the sphere style's diameter and density, else from the Masses section) and
+/// returns each atom id's line index, ids unique.
+std::map<long long, std::size_t> checkAtoms(const DataFile& file, const AtomStyle& style) {
+  std::map<long long, double> mass;  // per type (charge, atomic: the Masses section)
+  for (const DataLine& d : file.section("Masses")) {
+    if (d.words.size() < 2)
+      throw std::invalid_argument(file.at(d) + "a Masses line is 'type mass'");
+    mass[file.integer(d, 0, "atom type")] = file.real(d, 1, "mass");
   }
   constexpr double UNIT_DENSITY = 6.0 / M_PI;  // mass 1 at diameter 1
-  std::map<long long, std::size_t> by_id;      // id -> line index in `atoms`
+  const auto& atoms = file.section("Atoms");
+  const std::size_t ncol = atoms.front().words.size();
+  std::map<long long, std::size_t> by_id;  // id -> line index in `atoms`
   for (std::size_t i = 0; i < atoms.size(); ++i) {
     const DataLine& d = atoms[i];
     if (d.words.size() != ncol)
-      throw std::invalid_argument(at(d) + "expected " + std::to_string(ncol) +
+      throw std::invalid_argument(file.at(d) + "expected " + std::to_string(ncol) +
                                   " columns as on the first Atoms line, got " +
                                   std::to_string(d.words.size()));
-    const long long id = integer(d, 0, "atom id");
+    const long long id = file.integer(d, 0, "atom id");
     if (!by_id.emplace(id, i).second)
-      throw std::invalid_argument(at(d) + "atom id " + std::to_string(id) + " appears twice");
-    const long long type = integer(d, 1, "atom type");
-    if (style->diameter >= 0) {
-      const double dia = real(d, style->diameter, "diameter"),
-                   rho = real(d, style->density, "density");
+      throw std::invalid_argument(file.at(d) + "atom id " + std::to_string(id) + " appears twice");
+    const long long type = file.integer(d, 1, "atom type");
+    if (style.diameter >= 0) {
+      const double dia = file.real(d, style.diameter, "diameter"),
+                   rho = file.real(d, style.density, "density");
       if (std::fabs(dia - 1.0) > 1e-9)
-        throw std::invalid_argument(at(d) + "atom " + std::to_string(id) + ": diameter " +
+        throw std::invalid_argument(file.at(d) + "atom " + std::to_string(id) + ": diameter " +
                                     common::formatReal(dia) +
                                     " (granagg's particles have diameter 1)");
       if (std::fabs(rho / UNIT_DENSITY - 1.0) > 1e-6)
-        throw std::invalid_argument(at(d) + "atom " + std::to_string(id) + ": density " +
+        throw std::invalid_argument(file.at(d) + "atom " + std::to_string(id) + ": density " +
                                     common::formatReal(rho) +
                                     " (granagg's particles have mass 1: density 6/pi = " +
                                     common::formatReal(UNIT_DENSITY) + ")");
     } else if (mass.count(type) && std::fabs(mass[type] - 1.0) > 1e-9) {
       throw std::invalid_argument(
-          at(d) + "atom " + std::to_string(id) + ": type " + std::to_string(type) + " has mass " +
-          common::formatReal(mass[type]) + " (granagg's particles have mass 1)");
+          file.at(d) + "atom " + std::to_string(id) + ": type " + std::to_string(type) +
+          " has mass " + common::formatReal(mass[type]) + " (granagg's particles have mass 1)");
     }
   }
-  const auto& vels = sections["Velocities"];
+  return by_id;
+}
+
+/// Each atom's Velocities line, by id: one per atom of the Atoms section (by_id).
+std::map<long long, const DataLine*> velocityLines(const DataFile& file,
+                                                   const std::map<long long, std::size_t>& by_id) {
   std::map<long long, const DataLine*> vel_of;
-  for (const DataLine& d : vels) {
+  for (const DataLine& d : file.section("Velocities")) {
     if (d.words.size() < 4)
-      throw std::invalid_argument(at(d) + "a Velocities line is 'id vx vy vz [...]'");
-    const long long id = integer(d, 0, "atom id");
+      throw std::invalid_argument(file.at(d) + "a Velocities line is 'id vx vy vz [...]'");
+    const long long id = file.integer(d, 0, "atom id");
     if (!by_id.count(id))
-      throw std::invalid_argument(at(d) + "velocity of atom " + std::to_string(id) +
+      throw std::invalid_argument(file.at(d) + "velocity of atom " + std::to_string(id) +
                                   ", which is not in the Atoms section");
     if (!vel_of.emplace(id, &d).second)
-      throw std::invalid_argument(at(d) + "atom " + std::to_string(id) + " has two velocity lines");
+      throw std::invalid_argument(file.at(d) + "atom " + std::to_string(id) +
+                                  " has two velocity lines");
   }
+  for (const auto& [id, k] : by_id)
+    if (!vel_of.count(id))
+      throw std::invalid_argument(file.at(file.keyword.at("Velocities")) + "atom " +
+                                  std::to_string(id) + " has no velocity line");
+  return vel_of;
+}
+
+}  // namespace
+
+Frame readInitialStateLammps(const std::string& path) {
+  const DataFile file(path);
+  const DataHeader h = readHeader(file);
+  if (!file.sections.count("Atoms")) throw std::invalid_argument(path + ": no Atoms section");
+  if (!file.sections.count("Velocities"))
+    throw std::invalid_argument(path +
+                                ": no Velocities section (an initial state needs velocities)");
+  const auto& atoms = file.section("Atoms");
+  if (static_cast<long long>(atoms.size()) != h.atoms)
+    throw std::invalid_argument(file.at(file.keyword.at("Atoms")) + "the Atoms section has " +
+                                std::to_string(atoms.size()) + " lines, the header says " +
+                                std::to_string(h.atoms) + " atoms");
+  checkMinimumSize(atoms.size(), path);
+  bool images = false;
+  const AtomStyle& style = atomStyle(file, images);
+  const auto by_id = checkAtoms(file, style);
+  const auto vel_of = velocityLines(file, by_id);
 
   Frame f;
-  f.box = L;
+  f.box = h.L;
   const std::size_t n = atoms.size();
   for (auto* v : {&f.x, &f.y, &f.z, &f.vx, &f.vy, &f.vz, &f.charge}) v->resize(n);
   for (auto* v : {&f.ix, &f.iy, &f.iz}) v->assign(n, 0);
   std::size_t i = 0;
   for (const auto& [id, k] : by_id) {  // particle i: the i-th smallest id
     const DataLine& d = atoms[k];
-    f.x[i] = real(d, style->x, "x") - lo[0];
-    f.y[i] = real(d, style->x + 1, "y") - lo[1];
-    f.z[i] = real(d, style->x + 2, "z") - lo[2];
-    f.charge[i] = style->q >= 0 ? real(d, style->q, "q") : 0.0;
+    f.x[i] = file.real(d, style.x, "x") - h.lo[0];
+    f.y[i] = file.real(d, style.x + 1, "y") - h.lo[1];
+    f.z[i] = file.real(d, style.x + 2, "z") - h.lo[2];
+    f.charge[i] = style.q >= 0 ? file.real(d, style.q, "q") : 0.0;
     if (images) {
       std::int32_t* im[3] = {&f.ix[i], &f.iy[i], &f.iz[i]};
       for (int a = 0; a < 3; ++a) {
-        const long long v = integer(d, style->columns + a, "image flag");
+        const long long v = file.integer(d, style.columns + a, "image flag");
         if (v < -(1LL << 30) || v > (1LL << 30))
-          throw std::invalid_argument(at(d) + "image flag " + std::to_string(v) + " too large");
+          throw std::invalid_argument(file.at(d) + "image flag " + std::to_string(v) +
+                                      " too large");
         *im[a] = static_cast<std::int32_t>(v);
       }
     }
-    const auto v = vel_of.find(id);
-    if (v == vel_of.end())
-      throw std::invalid_argument(at(keyword["Velocities"]) + "atom " + std::to_string(id) +
-                                  " has no velocity line");
-    f.vx[i] = real(*v->second, 1, "vx");
-    f.vy[i] = real(*v->second, 2, "vy");
-    f.vz[i] = real(*v->second, 3, "vz");
+    const DataLine& v = *vel_of.at(id);
+    f.vx[i] = file.real(v, 1, "vx");
+    f.vy[i] = file.real(v, 2, "vy");
+    f.vz[i] = file.real(v, 3, "vz");
     ++i;
   }
   try {
