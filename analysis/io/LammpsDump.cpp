@@ -53,12 +53,18 @@ bool LammpsDump::next(Frame& f) {
   do {
     if (!getLine(line)) return false;
   } while (common::trim(line).empty());
+  const Header h = readHeader(line);
+  const Columns c = columns(h.atoms_line);
+  const Atoms a = readAtoms(h, c);
+  fill(h, c, a, f);
+  ++m_frame;
+  return true;
+}
 
-  bool have_step = false, have_time = false, have_n = false, have_box = false;
-  double time = 0.0;
-  std::int64_t step = 0;
-  std::size_t n = 0;
-  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+LammpsDump::Header LammpsDump::readHeader(std::string& line) {
+  Header h;
+  bool have_step = false, have_n = false, have_box = false;
+  double hi[3] = {0, 0, 0};
   auto need = [&](std::string& l, const char* what) {
     if (!getLine(l))
       error(std::string("file ends inside the frame header (expected ") + what + ")");
@@ -70,19 +76,19 @@ bool LammpsDump::next(Frame& f) {
       need(line, "the timestep");
       char* end = nullptr;
       errno = 0;
-      step = std::strtoll(line.c_str(), &end, 10);
+      h.step = std::strtoll(line.c_str(), &end, 10);
       if (errno || end == line.c_str()) error("bad timestep " + quoted(line, 40));
       have_step = true;
     } else if (item == "TIME") {
       need(line, "the time");
-      if (!common::parseReal(common::trim(line), time)) error("bad time " + quoted(line, 40));
-      have_time = true;
+      if (!common::parseReal(common::trim(line), h.time)) error("bad time " + quoted(line, 40));
+      h.have_time = true;
     } else if (item == "NUMBER OF ATOMS") {
       need(line, "the number of atoms");
       char* end = nullptr;
       const long long v = std::strtoll(line.c_str(), &end, 10);
       if (end == line.c_str() || v <= 0) error("bad number of atoms " + quoted(line, 40));
-      n = static_cast<std::size_t>(v);
+      h.atoms = static_cast<std::size_t>(v);
       have_n = true;
     } else if (item.rfind("BOX BOUNDS", 0) == 0) {
       const auto flags = common::split(common::trim(item.substr(10)), ' ');
@@ -94,7 +100,7 @@ bool LammpsDump::next(Frame& f) {
       for (int d = 0; d < 3; ++d) {
         need(line, "the box bounds");
         std::istringstream is(line);
-        if (!(is >> lo[d] >> hi[d]) || !(hi[d] > lo[d]))
+        if (!(is >> h.lo[d] >> hi[d]) || !(hi[d] > h.lo[d]))
           error("bad box bounds " + quoted(line, 60));
       }
       have_box = true;
@@ -109,110 +115,125 @@ bool LammpsDump::next(Frame& f) {
   }
   if (!have_step || !have_n || !have_box)
     error("frame header lacks TIMESTEP, NUMBER OF ATOMS or BOX BOUNDS");
-  if (m_n == 0) m_n = n;
-  if (n != m_n)
-    error("has " + std::to_string(n) + " atoms, the first frame had " + std::to_string(m_n));
-  const double L = hi[0] - lo[0];
+  if (m_n == 0) m_n = h.atoms;
+  if (h.atoms != m_n)
+    error("has " + std::to_string(h.atoms) + " atoms, the first frame had " + std::to_string(m_n));
+  h.L = hi[0] - h.lo[0];
   for (int d = 1; d < 3; ++d)
-    if (std::fabs((hi[d] - lo[d]) - L) > 1e-9 * L)
+    if (std::fabs((hi[d] - h.lo[d]) - h.L) > 1e-9 * h.L)
       error("the box is not cubic; only cubic boxes are supported");
+  h.atoms_line = line;
+  return h;
+}
 
-  // Column layout.
+LammpsDump::Columns LammpsDump::columns(const std::string& atoms_line) const {
   std::vector<std::string> cols;
-  for (const auto& c : common::split(common::trim(line.substr(line.find("ATOMS") + 5)), ' '))
+  for (const auto& c :
+       common::split(common::trim(atoms_line.substr(atoms_line.find("ATOMS") + 5)), ' '))
     if (!c.empty()) cols.push_back(c);
   auto find = [&](const char* name) {
     const auto it = std::find(cols.begin(), cols.end(), name);
     return it == cols.end() ? -1 : static_cast<int>(it - cols.begin());
   };
-  const int c_id = find("id");
-  int c_pos[3], c_img[3], c_vel[3];
-  enum { WRAPPED, UNWRAPPED, SCALED } kind = WRAPPED;
+  Columns c;
+  c.count = cols.size();
+  c.id = find("id");
   const char* names[3][3] = {{"x", "y", "z"}, {"xu", "yu", "zu"}, {"xs", "ys", "zs"}};
   int found = -1;
   for (int k = 0; k < 3 && found < 0; ++k)
     if (find(names[k][0]) >= 0) found = k;
   if (found < 0) error("ATOMS columns have no positions (x y z, xu yu zu or xs ys zs)");
-  kind = static_cast<decltype(kind)>(found);
+  c.kind = static_cast<Columns::Kind>(found);
   for (int d = 0; d < 3; ++d) {
-    c_pos[d] = find(names[found][d]);
-    if (c_pos[d] < 0) error(std::string("ATOMS columns lack ") + names[found][d]);
-    c_img[d] = find((std::string("i") + "xyz"[d]).c_str());
-    c_vel[d] = find((std::string("v") + "xyz"[d]).c_str());
+    c.pos[d] = find(names[found][d]);
+    if (c.pos[d] < 0) error(std::string("ATOMS columns lack ") + names[found][d]);
+    c.img[d] = find((std::string("i") + "xyz"[d]).c_str());
+    c.vel[d] = find((std::string("v") + "xyz"[d]).c_str());
   }
-  const bool has_img = c_img[0] >= 0 && c_img[1] >= 0 && c_img[2] >= 0;
-  const bool has_vel = c_vel[0] >= 0 && c_vel[1] >= 0 && c_vel[2] >= 0;
-  const int c_q = find("q");
+  c.images = c.img[0] >= 0 && c.img[1] >= 0 && c.img[2] >= 0;
+  c.velocities = c.vel[0] >= 0 && c.vel[1] >= 0 && c.vel[2] >= 0;
+  c.q = find("q");
+  return c;
+}
 
-  std::vector<std::int64_t> ids(n);
-  std::vector<double> pos(3 * n), vel(has_vel ? 3 * n : 0), q(c_q >= 0 ? n : 0);
-  std::vector<std::int32_t> img(3 * n, 0);
-  std::vector<double> values(cols.size());
-  std::vector<std::size_t> line_of(n);  // each atom's line, for errors found after reading
-  for (std::size_t a = 0; a < n; ++a) {
+LammpsDump::Atoms LammpsDump::readAtoms(const Header& h, const Columns& c) {
+  const std::size_t n = h.atoms;
+  Atoms a;
+  a.ids.resize(n);
+  a.pos.resize(3 * n);
+  a.vel.resize(c.velocities ? 3 * n : 0);
+  a.q.resize(c.q >= 0 ? n : 0);
+  a.img.assign(3 * n, 0);
+  a.line_of.resize(n);
+  std::vector<double> values(c.count);
+  std::string line;
+  for (std::size_t k = 0; k < n; ++k) {
     if (!getLine(line))
-      error("file ends after " + std::to_string(a) + " of " + std::to_string(n) +
+      error("file ends after " + std::to_string(k) + " of " + std::to_string(n) +
             " atoms (truncated dump?)");
-    line_of[a] = m_line;
+    a.line_of[k] = m_line;
     const char* p = line.c_str();
-    for (std::size_t c = 0; c < cols.size(); ++c) {
+    for (std::size_t col = 0; col < c.count; ++col) {
       char* end = nullptr;
-      values[c] = std::strtod(p, &end);
+      values[col] = std::strtod(p, &end);
       if (end == p)
-        error("atom line has " + std::to_string(c) + " of " + std::to_string(cols.size()) +
+        error("atom line has " + std::to_string(col) + " of " + std::to_string(c.count) +
               " values: " + quoted(line, 80));
       p = end;
     }
-    ids[a] = c_id >= 0 ? static_cast<std::int64_t>(values[c_id]) : static_cast<std::int64_t>(a);
+    a.ids[k] = c.id >= 0 ? static_cast<std::int64_t>(values[c.id]) : static_cast<std::int64_t>(k);
     for (int d = 0; d < 3; ++d) {
-      const double v = values[c_pos[d]];
-      pos[3 * a + d] = kind == SCALED ? v * L : v - lo[d];
-      if (has_img && kind != UNWRAPPED)
-        img[3 * a + d] = static_cast<std::int32_t>(values[c_img[d]]);
-      if (has_vel) vel[3 * a + d] = values[c_vel[d]];
+      const double v = values[c.pos[d]];
+      a.pos[3 * k + d] = c.kind == Columns::SCALED ? v * h.L : v - h.lo[d];
+      if (c.images && c.kind != Columns::UNWRAPPED)
+        a.img[3 * k + d] = static_cast<std::int32_t>(values[c.img[d]]);
+      if (c.velocities) a.vel[3 * k + d] = values[c.vel[d]];
     }
-    if (c_q >= 0) q[a] = values[c_q];
+    if (c.q >= 0) a.q[k] = values[c.q];
   }
+  return a;
+}
 
+void LammpsDump::fill(const Header& h, const Columns& c, const Atoms& a, Frame& f) const {
+  const std::size_t n = h.atoms;
   // Sort by id (LAMMPS writes atoms in processor order).
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),  // stable: a repeated id is named at its 2nd line
-                   [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
+                   [&](std::size_t x, std::size_t y) { return a.ids[x] < a.ids[y]; });
   for (std::size_t k = 1; k < n; ++k)
-    if (ids[order[k]] == ids[order[k - 1]])
-      errorAt(line_of[order[k]], "atom id " + std::to_string(ids[order[k]]) +
-                                     " appears twice (also on line " +
-                                     std::to_string(line_of[order[k - 1]]) + ")");
+    if (a.ids[order[k]] == a.ids[order[k - 1]])
+      errorAt(a.line_of[order[k]], "atom id " + std::to_string(a.ids[order[k]]) +
+                                       " appears twice (also on line " +
+                                       std::to_string(a.line_of[order[k - 1]]) + ")");
 
-  const common::Box box{L};
-  const bool images = has_img || kind == UNWRAPPED;
+  const common::Box box{h.L};
+  const bool images = c.images || c.kind == Columns::UNWRAPPED;
   f.index = m_frame;
-  f.step = step;
-  f.time =
-      have_time ? time : (m_dt > 0 ? static_cast<double>(step) * m_dt : static_cast<double>(step));
-  f.box = L;
+  f.step = h.step;
+  f.time = h.have_time
+               ? h.time
+               : (m_dt > 0 ? static_cast<double>(h.step) * m_dt : static_cast<double>(h.step));
+  f.box = h.L;
   f.position.resize(3 * n);
   f.image.assign(images ? 3 * n : 0, 0);
-  f.velocity.resize(has_vel ? 3 * n : 0);
-  f.charge.resize(c_q >= 0 ? n : 0);
+  f.velocity.resize(c.velocities ? 3 * n : 0);
+  f.charge.resize(c.q >= 0 ? n : 0);
   f.id.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t a = order[k];
-    f.id[k] = ids[a];
+    const std::size_t i = order[k];
+    f.id[k] = a.ids[i];
     for (int d = 0; d < 3; ++d) {
-      double x = pos[3 * a + d];
+      double x = a.pos[3 * i + d];
       if (!std::isfinite(x))
-        errorAt(line_of[a], "atom " + std::to_string(ids[a]) + " has a non-finite position");
+        errorAt(a.line_of[i], "atom " + std::to_string(a.ids[i]) + " has a non-finite position");
       const int shift = box.wrap(x);
       f.position[3 * k + d] = x;
-      if (images) f.image[3 * k + d] = img[3 * a + d] + shift;
-      if (has_vel) f.velocity[3 * k + d] = vel[3 * a + d];
+      if (images) f.image[3 * k + d] = a.img[3 * i + d] + shift;
+      if (c.velocities) f.velocity[3 * k + d] = a.vel[3 * i + d];
     }
-    if (c_q >= 0) f.charge[k] = q[a];
+    if (c.q >= 0) f.charge[k] = a.q[i];
   }
-  ++m_frame;
-  return true;
 }
 
 }  // namespace granagg::analysis

@@ -11,9 +11,11 @@
 /// Columns: id; x y z (wrapped) or xu yu zu (unwrapped) or xs ys zs (scaled); optional ix iy iz,
 /// vx vy vz, q; others are ignored. Atoms are sorted by id. Positions are shifted by the box's
 /// lower bound and wrapped into [0, L), the shift going into the image count.
+#include <cstdint>
 #include <fstream>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "analysis/io/TrajectoryReader.h"
 
@@ -33,6 +35,38 @@ class LammpsDump final : public TrajectoryReader {
   [[noreturn]] void error(const std::string& what) const;  ///< at the line just read
   [[noreturn]] void errorAt(std::size_t line, const std::string& what) const;
   bool getLine(std::string& line);
+
+  /// A frame's header, read up to its ITEM: ATOMS line (kept in `atoms_line`).
+  struct Header {
+    std::int64_t step = 0;
+    double time = 0.0;
+    bool have_time = false;
+    std::size_t atoms = 0;
+    double lo[3] = {0, 0, 0};
+    double L = 0.0;  // the cubic box's edge
+    std::string atoms_line;
+  };
+  /// Where each quantity sits among the ATOMS columns (-1: absent).
+  struct Columns {
+    std::size_t count = 0;
+    int id = -1, q = -1;
+    int pos[3] = {-1, -1, -1}, img[3] = {-1, -1, -1}, vel[3] = {-1, -1, -1};
+    enum Kind { WRAPPED, UNWRAPPED, SCALED } kind = WRAPPED;  // x y z, xu yu zu, xs ys zs
+    bool images = false, velocities = false;
+  };
+  /// The atoms as read, in file order.
+  struct Atoms {
+    std::vector<std::int64_t> ids;
+    std::vector<double> pos, vel, q;
+    std::vector<std::int32_t> img;
+    std::vector<std::size_t> line_of;  // each atom's line, for errors found after reading
+  };
+  /// Reads the header of a frame whose first line is `line`.
+  Header readHeader(std::string& line);
+  Columns columns(const std::string& atoms_line) const;
+  Atoms readAtoms(const Header& h, const Columns& c);
+  /// The atoms sorted by id (ids unique), wrapped into the box, into f.
+  void fill(const Header& h, const Columns& c, const Atoms& a, Frame& f) const;
 
   std::string m_path;
   double m_dt;
