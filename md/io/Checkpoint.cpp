@@ -76,9 +76,9 @@ void writeFile(const std::string& file_path, const Checkpoint& e) {
     h5::writeAttribute(g.get(), "box", s.box, c);
     h5::writeAttribute(g.get(), "N", static_cast<std::int64_t>(n), c);
     const std::pair<const char*, const std::vector<double>*> reals[] = {
-        {"x", &s.x},   {"y", &s.y},           {"z", &s.z},   {"vx", &s.vx}, {"vy", &s.vy},
-        {"vz", &s.vz}, {"charge", &s.charge}, {"fx", &e.forces.x}, {"fy", &e.forces.y},
-        {"fz", &e.forces.z}};
+        {"x", &s.x},         {"y", &s.y},        {"z", &s.z},           {"vx", &s.vx},
+        {"vy", &s.vy},       {"vz", &s.vz},      {"charge", &s.charge}, {"fx", &e.forces.x},
+        {"fy", &e.forces.y}, {"fz", &e.forces.z}};
     for (const auto& [name, v] : reals)
       writeArray(g.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v->data(), n, c);
     const std::pair<const char*, const std::vector<std::int32_t>*> ints[] = {
@@ -177,24 +177,30 @@ void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint) {
   syncPath(parentDir(path), true);  // make the rename durable; best effort (some FS refuse)
 }
 
-Checkpoint readCheckpoint(const std::string& path) {
-  h5::silenceErrors();
-  const std::string c = "checkpoint '" + path + "'";
-  struct stat st;
-  if (::stat(path.c_str(), &st) != 0) throw std::runtime_error(c + " does not exist");
-  if (H5Fis_hdf5(path.c_str()) <= 0) {
-    h5::lastError();
-    throw std::runtime_error(c + " is not an HDF5 file (corrupt, or not a checkpoint)");
-  }
-  h5::Handle file = h5::check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT),
-                              "cannot open " + c + " (truncated or corrupt?)");
-  const hid_t f = file.get();
-  {
-    h5::Handle a = h5::openAttribute(f, "format");
+namespace {
+
+/// An open checkpoint file and the readers of its parts, whose errors name the file and the
+/// object (`c`, "checkpoint '<path>'").
+struct CheckpointFile {
+  std::string c;
+  h5::Handle file;
+
+  /// Opens `path` and checks that it is a granagg checkpoint of this format version.
+  explicit CheckpointFile(const std::string& path) : c("checkpoint '" + path + "'") {
+    h5::silenceErrors();
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0) throw std::runtime_error(c + " does not exist");
+    if (H5Fis_hdf5(path.c_str()) <= 0) {
+      h5::lastError();
+      throw std::runtime_error(c + " is not an HDF5 file (corrupt, or not a checkpoint)");
+    }
+    file = h5::check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT),
+                     "cannot open " + c + " (truncated or corrupt?)");
+    h5::Handle a = h5::openAttribute(file.get(), "format");
     if (!a || h5::readString(a.get(), true, c + " format") != FORMAT_NAME)
       throw std::runtime_error(c + " is not a granagg checkpoint (no format = \"" +
                                std::string(FORMAT_NAME) + "\")");
-    h5::Handle v = h5::openAttribute(f, "format_version");
+    h5::Handle v = h5::openAttribute(file.get(), "format_version");
     if (!v) throw std::runtime_error(c + " has no format_version");
     const auto ver =
         h5::readNumericAttribute<std::int64_t>(v.get(), H5T_NATIVE_INT64, c + " format_version");
@@ -203,13 +209,18 @@ Checkpoint readCheckpoint(const std::string& path) {
                                (ver.empty() ? std::string("?") : std::to_string(ver[0])) +
                                ", this granagg reads version " + std::to_string(FORMAT_VERSION));
   }
-  auto group = [&](const char* name) {
-    if (h5::objectType(f, name) != H5I_GROUP)
-      throw std::runtime_error(c + " is missing group '/" + std::string(name) + "'");
-    return h5::check(H5Gopen2(f, name, H5P_DEFAULT), c + ": cannot open /" + name);
-  };
-  auto scalar = [&](hid_t g, const std::string& gname, const char* name, hid_t mem_type,
-                    void* out) {
+
+  h5::Handle group(hid_t parent, const std::string& gname, const char* name) const {
+    if (h5::objectType(parent, name) != H5I_GROUP)
+      throw std::runtime_error(c + " is missing group '" + gname + "/" + name + "'");
+    return h5::check(H5Gopen2(parent, name, H5P_DEFAULT),
+                     c + ": cannot open " + gname + "/" + name);
+  }
+  h5::Handle group(const char* name) const { return group(file.get(), "", name); }
+
+  /// A scalar attribute `gname/name` of group g into `out` (of HDF5 memory type mem_type).
+  void scalar(hid_t g, const std::string& gname, const char* name, hid_t mem_type,
+              void* out) const {
     h5::Handle a = h5::openAttribute(g, name);
     if (!a) throw std::runtime_error(c + " is missing attribute '" + gname + "/" + name + "'");
     h5::Handle space = h5::check(H5Aget_space(a.get()), c);
@@ -217,15 +228,32 @@ Checkpoint readCheckpoint(const std::string& path) {
       throw std::runtime_error(c + ": attribute '" + gname + "/" + name + "' is not a scalar");
     h5::checkStatus(H5Aread(a.get(), mem_type, out),
                     c + ": cannot read '" + gname + "/" + name + "'");
-  };
+  }
 
-  Checkpoint cp;
-  Frame& s = cp.state;
-  Checkpoint& e = cp;
-  std::int64_t n = 0;
-  {
+  /// The per-particle dataset `gname/name` of group g (n entries) into `out`.
+  template <class T>
+  void array(hid_t g, const std::string& gname, const std::string& name, hid_t mem_type,
+             std::int64_t n, std::vector<T>& out) const {
+    const std::string dc = c + ": dataset '" + gname + "/" + name + "'";
+    if (h5::objectType(g, name.c_str()) != H5I_DATASET)
+      throw std::runtime_error(c + " is missing dataset '" + gname + "/" + name + "'");
+    h5::Handle d = h5::check(H5Dopen2(g, name.c_str(), H5P_DEFAULT), dc + ": cannot open");
+    const auto dims = h5::datasetDims(d.get(), dc);
+    if (dims.size() != 1 || dims[0] != static_cast<hsize_t>(n))
+      throw std::runtime_error(
+          dc + " has " +
+          (dims.size() == 1 ? std::to_string(dims[0]) : std::string("a wrong shape")) +
+          " entries, expected N = " + std::to_string(n));
+    out.resize(static_cast<std::size_t>(n));
+    h5::checkStatus(H5Dread(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
+                    dc + ": cannot read (corrupt: checksum mismatch?)");
+  }
+
+  /// /state: the particles and the forces; returns N.
+  std::int64_t readState(Checkpoint& cp) const {
+    Frame& s = cp.state;
     h5::Handle g = group("state");
-    std::int64_t step = 0;
+    std::int64_t step = 0, n = 0;
     scalar(g.get(), "/state", "step", H5T_NATIVE_INT64, &step);
     s.step = step;
     scalar(g.get(), "/state", "time", H5T_NATIVE_DOUBLE, &s.time);
@@ -233,88 +261,79 @@ Checkpoint readCheckpoint(const std::string& path) {
     scalar(g.get(), "/state", "N", H5T_NATIVE_INT64, &n);
     if (n <= 0)
       throw std::runtime_error(c + ": /state N = " + std::to_string(n) + " is not positive");
-    auto array = [&](const char* name, hid_t mem_type, auto& out) {
-      const std::string dc = c + ": dataset '/state/" + name + "'";
-      if (h5::objectType(g.get(), name) != H5I_DATASET)
-        throw std::runtime_error(c + " is missing dataset '/state/" + name + "'");
-      h5::Handle d = h5::check(H5Dopen2(g.get(), name, H5P_DEFAULT), dc + ": cannot open");
-      const auto dims = h5::datasetDims(d.get(), dc);
-      if (dims.size() != 1 || dims[0] != static_cast<hsize_t>(n))
-        throw std::runtime_error(
-            dc + " has " +
-            (dims.size() == 1 ? std::to_string(dims[0]) : std::string("a wrong shape")) +
-            " entries, expected N = " + std::to_string(n));
-      out.resize(static_cast<std::size_t>(n));
-      h5::checkStatus(H5Dread(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
-                      dc + ": cannot read (corrupt: checksum mismatch?)");
-    };
-    array("x", H5T_NATIVE_DOUBLE, s.x);
-    array("y", H5T_NATIVE_DOUBLE, s.y);
-    array("z", H5T_NATIVE_DOUBLE, s.z);
-    array("vx", H5T_NATIVE_DOUBLE, s.vx);
-    array("vy", H5T_NATIVE_DOUBLE, s.vy);
-    array("vz", H5T_NATIVE_DOUBLE, s.vz);
-    array("charge", H5T_NATIVE_DOUBLE, s.charge);
-    array("ix", H5T_NATIVE_INT32, s.ix);
-    array("iy", H5T_NATIVE_INT32, s.iy);
-    array("iz", H5T_NATIVE_INT32, s.iz);
-    array("fx", H5T_NATIVE_DOUBLE, e.forces.x);
-    array("fy", H5T_NATIVE_DOUBLE, e.forces.y);
-    array("fz", H5T_NATIVE_DOUBLE, e.forces.z);
+    const hid_t d = H5T_NATIVE_DOUBLE, i32 = H5T_NATIVE_INT32;
+    for (auto [name, out] : {std::pair{"x", &s.x},
+                             {"y", &s.y},
+                             {"z", &s.z},
+                             {"vx", &s.vx},
+                             {"vy", &s.vy},
+                             {"vz", &s.vz},
+                             {"charge", &s.charge}})
+      array(g.get(), "/state", name, d, n, *out);
+    for (auto [name, out] : {std::pair{"ix", &s.ix}, {"iy", &s.iy}, {"iz", &s.iz}})
+      array(g.get(), "/state", name, i32, n, *out);
+    for (auto [name, out] :
+         {std::pair{"fx", &cp.forces.x}, {"fy", &cp.forces.y}, {"fz", &cp.forces.z}})
+      array(g.get(), "/state", name, d, n, *out);
+    return n;
   }
-  {
-    h5::Handle g = group("integrator");
-    scalar(g.get(), "/integrator", "dt", H5T_NATIVE_DOUBLE, &e.dt);
-  }
-  {
+
+  /// /integrator and /run: the time step, the seed, the frame counters and the configuration.
+  void readRun(Checkpoint& cp) const {
+    {
+      h5::Handle g = group("integrator");
+      scalar(g.get(), "/integrator", "dt", H5T_NATIVE_DOUBLE, &cp.dt);
+    }
     h5::Handle g = group("run");
-    scalar(g.get(), "/run", "seed", H5T_NATIVE_UINT64, &e.run.seed);
-    scalar(g.get(), "/run", "frames_written", H5T_NATIVE_UINT64, &e.run.frames_written);
-    scalar(g.get(), "/run", "next_frame_index", H5T_NATIVE_UINT64, &e.run.next_frame_index);
+    scalar(g.get(), "/run", "seed", H5T_NATIVE_UINT64, &cp.run.seed);
+    scalar(g.get(), "/run", "frames_written", H5T_NATIVE_UINT64, &cp.run.frames_written);
+    scalar(g.get(), "/run", "next_frame_index", H5T_NATIVE_UINT64, &cp.run.next_frame_index);
     if (h5::objectType(g.get(), "config_toml") != H5I_DATASET)
       throw std::runtime_error(c + " is missing dataset '/run/config_toml'");
     h5::Handle d =
         h5::check(H5Dopen2(g.get(), "config_toml", H5P_DEFAULT), c + ": /run/config_toml");
-    e.run.config_toml = h5::readString(d.get(), false, c + ": /run/config_toml");
+    cp.run.config_toml = h5::readString(d.get(), false, c + ": /run/config_toml");
   }
-  {
+
+  /// /scalars/int and /scalars/real: the engine's named scalars.
+  void readScalars(Checkpoint& cp) const {
     h5::Handle gs = group("scalars");
-    auto readAll = [&](const char* sub, bool integer) {
-      if (h5::objectType(gs.get(), sub) != H5I_GROUP)
-        throw std::runtime_error(c + " is missing group '/scalars/" + std::string(sub) + "'");
-      h5::Handle g = h5::check(H5Gopen2(gs.get(), sub, H5P_DEFAULT), c);
-      const std::vector<std::string> names = h5::attributeNames(g.get(), c + ": /scalars/" + sub);
+    for (const bool integer : {true, false}) {
+      const char* sub = integer ? "int" : "real";
+      h5::Handle g = group(gs.get(), "/scalars", sub);
       const std::string gname = std::string("/scalars/") + sub;
-      for (const auto& name : names) {
+      for (const auto& name : h5::attributeNames(g.get(), c + ": " + gname)) {
         if (integer) {
           std::int64_t v = 0;
           scalar(g.get(), gname, name.c_str(), H5T_NATIVE_INT64, &v);
-          e.engine.ints[name] = v;
+          cp.engine.ints[name] = v;
         } else {
           double v = 0;
           scalar(g.get(), gname, name.c_str(), H5T_NATIVE_DOUBLE, &v);
-          e.engine.reals[name] = v;
+          cp.engine.reals[name] = v;
         }
       }
-    };
-    readAll("int", true);
-    readAll("real", false);
-  }
-  if (h5::objectType(f, "arrays") == H5I_GROUP) {
-    h5::Handle g = h5::check(H5Gopen2(f, "arrays", H5P_DEFAULT), c + ": cannot open /arrays");
-    for (const auto& name : h5::datasetNames(g.get(), c + ": /arrays")) {
-      const std::string dc = c + ": dataset '/arrays/" + name + "'";
-      h5::Handle d = h5::check(H5Dopen2(g.get(), name.c_str(), H5P_DEFAULT), dc + ": cannot open");
-      const auto dims = h5::datasetDims(d.get(), dc);
-      if (dims.size() != 1 || dims[0] != static_cast<hsize_t>(n))
-        throw std::runtime_error(dc + " does not hold N = " + std::to_string(n) + " entries");
-      std::vector<double>& out = e.engine.arrays[name];
-      out.resize(static_cast<std::size_t>(n));
-      h5::checkStatus(
-          H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
-          dc + ": cannot read (corrupt: checksum mismatch?)");
     }
   }
+
+  /// /arrays (optional): the engine's named per-particle arrays, N entries each.
+  void readArrays(Checkpoint& cp, std::int64_t n) const {
+    if (h5::objectType(file.get(), "arrays") != H5I_GROUP) return;
+    h5::Handle g = group("arrays");
+    for (const auto& name : h5::datasetNames(g.get(), c + ": /arrays"))
+      array(g.get(), "/arrays", name, H5T_NATIVE_DOUBLE, n, cp.engine.arrays[name]);
+  }
+};
+
+}  // namespace
+
+Checkpoint readCheckpoint(const std::string& path) {
+  const CheckpointFile file(path);
+  Checkpoint cp;
+  const std::int64_t n = file.readState(cp);
+  file.readRun(cp);
+  file.readScalars(cp);
+  file.readArrays(cp, n);
   return cp;
 }
 
