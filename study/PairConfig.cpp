@@ -28,72 +28,78 @@ std::string where(const toml::source_region& r, const std::string& file) {
 
 }  // namespace
 
-PairConfig parsePairConfig(const std::string& path) {
-  if (!fs::exists(path)) throw std::invalid_argument("--config: no such file '" + path + "'");
+namespace {
+
+/// A parsed pair-study TOML file and the typed readers of its keys: an absent key leaves the
+/// default, a key of the wrong type is an error at its file:line:column.
+struct PairToml {
+  std::string path;
   toml::table doc;
-  try {
-    doc = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    throw std::invalid_argument(where(e.source(), path) +
-                                ": invalid TOML: " + std::string(e.description()));
-  }
-  PairConfig c;
-  c.source = fs::absolute(path).string();
-  const std::map<std::string, std::set<std::string>> known{
-      {"input", {"version"}},
-      {"pair", {"name", "K", "runs", "seed"}},
-      {"md", {"preset", "config", "set", "engine"}},
-      {"charged", {"Q", "set"}},
-      {"analysis", {"args"}},
-      {"meanfield", {"beta", "t_end", "s_end", "zbeta_min", "zbeta_max", "zbeta_count"}},
-      {"fit", {"window", "column"}},
-      {"lammps", {"launcher", "ranks", "slurm_launcher", "nodes", "tasks_per_node"}}};
-  auto fail = [&](const toml::node& n, const std::string& msg) -> void {
-    throw std::invalid_argument(where(n.source(), path) + ": " + msg);
-  };
-  for (auto&& [skey, snode] : doc) {
-    const std::string s(skey.str());
-    auto it = known.find(s);
-    if (it == known.end() || !snode.is_table()) {
-      std::string list;
-      for (const auto& [k, v] : known) list += (list.empty() ? "" : ", ") + k;
-      fail(snode, "unknown section '" + s + "' (known sections: " + list + ")");
+
+  explicit PairToml(const std::string& file) : path(file) {
+    if (!fs::exists(path)) throw std::invalid_argument("--config: no such file '" + path + "'");
+    try {
+      doc = toml::parse_file(path);
+    } catch (const toml::parse_error& e) {
+      throw std::invalid_argument(where(e.source(), path) +
+                                  ": invalid TOML: " + std::string(e.description()));
     }
-    for (auto&& [kkey, knode] : *snode.as_table()) {
-      const std::string k(kkey.str());
-      if (!it->second.count(k)) {
+  }
+  [[noreturn]] void fail(const toml::node& n, const std::string& msg) const {
+    throw std::invalid_argument(where(n.source(), path) + ": " + msg);
+  }
+  const toml::node* node(const char* sec, const char* key) const {
+    return doc.at_path(std::string(sec) + "." + key).node();
+  }
+
+  /// Every section and key must be one of `known` (a typo is an error, not a silent default).
+  void checkKnown(const std::map<std::string, std::set<std::string>>& known) const {
+    for (auto&& [skey, snode] : doc) {
+      const std::string s(skey.str());
+      auto it = known.find(s);
+      if (it == known.end() || !snode.is_table()) {
         std::string list;
-        for (const auto& x : it->second) list += (list.empty() ? "" : ", ") + x;
-        fail(knode, "unknown key '" + s + "." + k + "' (known keys in [" + s + "]: " + list + ")");
+        for (const auto& [k, v] : known) list += (list.empty() ? "" : ", ") + k;
+        fail(snode, "unknown section '" + s + "' (known sections: " + list + ")");
+      }
+      for (auto&& [kkey, knode] : *snode.as_table()) {
+        const std::string k(kkey.str());
+        if (!it->second.count(k)) {
+          std::string list;
+          for (const auto& x : it->second) list += (list.empty() ? "" : ", ") + x;
+          fail(knode,
+               "unknown key '" + s + "." + k + "' (known keys in [" + s + "]: " + list + ")");
+        }
       }
     }
   }
-  auto number = [&](const char* sec, const char* key, double& out) {
-    const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
+
+  void number(const char* sec, const char* key, double& out) const {
+    const toml::node* n = node(sec, key);
     if (!n) return;
     if (auto v = n->value<double>())
       out = *v;
     else
       fail(*n, std::string(sec) + "." + key + " must be a number");
-  };
-  auto integer = [&](const char* sec, const char* key, long long& out) {
-    const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
+  }
+  void integer(const char* sec, const char* key, long long& out) const {
+    const toml::node* n = node(sec, key);
     if (!n) return;
     if (auto v = n->as_integer())
       out = v->get();
     else
       fail(*n, std::string(sec) + "." + key + " must be an integer");
-  };
-  auto string = [&](const char* sec, const char* key, std::string& out) {
-    const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
+  }
+  void string(const char* sec, const char* key, std::string& out) const {
+    const toml::node* n = node(sec, key);
     if (!n) return;
     if (auto v = n->as_string())
       out = v->get();
     else
       fail(*n, std::string(sec) + "." + key + " must be a string");
-  };
-  auto strings = [&](const char* sec, const char* key, std::vector<std::string>& out) {
-    const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
+  }
+  void strings(const char* sec, const char* key, std::vector<std::string>& out) const {
+    const toml::node* n = node(sec, key);
     if (!n) return;
     const toml::array* a = n->as_array();
     if (!a) fail(*n, std::string(sec) + "." + key + " must be an array of strings");
@@ -104,9 +110,9 @@ PairConfig parsePairConfig(const std::string& path) {
       else
         fail(e, std::string(sec) + "." + key + " must hold strings only");
     }
-  };
-  auto numbers = [&](const char* sec, const char* key, std::vector<double>& out) {
-    const toml::node* n = doc.at_path(std::string(sec) + "." + key).node();
+  }
+  void numbers(const char* sec, const char* key, std::vector<double>& out) const {
+    const toml::node* n = node(sec, key);
     if (!n) return;
     const toml::array* a = n->as_array();
     if (!a) fail(*n, std::string(sec) + "." + key + " must be an array of numbers");
@@ -117,49 +123,66 @@ PairConfig parsePairConfig(const std::string& path) {
       else
         fail(e, std::string(sec) + "." + key + " must hold numbers only");
     }
-  };
+  }
+  /// A lammps.* count: beyond int is refused here, with its position; validate() checks those
+  /// within int.
+  int count(const char* key, long long n) const {
+    const toml::node* nd = node("lammps", key);
+    if (nd && n != static_cast<int>(n))
+      fail(*nd, std::string("lammps.") + key + " must lie in 1.." + std::to_string(MAX_RANKS) +
+                    " (got " + std::to_string(n) + ")");
+    return static_cast<int>(n);
+  }
+};
+
+}  // namespace
+
+PairConfig parsePairConfig(const std::string& path) {
+  const PairToml t(path);
+  t.checkKnown({{"input", {"version"}},
+                {"pair", {"name", "K", "runs", "seed"}},
+                {"md", {"preset", "config", "set", "engine"}},
+                {"charged", {"Q", "set"}},
+                {"analysis", {"args"}},
+                {"meanfield", {"beta", "t_end", "s_end", "zbeta_min", "zbeta_max", "zbeta_count"}},
+                {"fit", {"window", "column"}},
+                {"lammps", {"launcher", "ranks", "slurm_launcher", "nodes", "tasks_per_node"}}});
+  PairConfig c;
+  c.source = fs::absolute(path).string();
   long long version = 1, runs = c.runs, zcount = c.zbeta_count, ranks = c.lammps_ranks,
             nodes = c.lammps_nodes, tasks_per_node = c.lammps_tasks_per_node;
-  integer("input", "version", version);
+  t.integer("input", "version", version);
   if (version != 1)
     throw std::invalid_argument(path + ": [input] version = " + std::to_string(version) +
                                 " is not supported (only 1)");
-  string("pair", "name", c.name);
-  numbers("pair", "K", c.K);
-  integer("pair", "runs", runs);
-  integer("pair", "seed", c.seed);
-  string("md", "preset", c.md_preset);
-  string("md", "config", c.md_config);
-  strings("md", "set", c.md_set);
-  string("md", "engine", c.md_engine);
-  number("charged", "Q", c.charged_Q);
-  strings("charged", "set", c.charged_set);
-  strings("analysis", "args", c.analysis_args);
-  numbers("meanfield", "beta", c.betas);
-  number("meanfield", "t_end", c.mf_t_end);
-  number("meanfield", "s_end", c.mf_s_end);
-  number("meanfield", "zbeta_min", c.zbeta_min);
-  number("meanfield", "zbeta_max", c.zbeta_max);
-  integer("meanfield", "zbeta_count", zcount);
-  numbers("fit", "window", c.fit_window);
-  string("fit", "column", c.fit_column);
-  string("lammps", "launcher", c.lammps_launcher);
-  integer("lammps", "ranks", ranks);
-  string("lammps", "slurm_launcher", c.lammps_slurm_launcher);
-  integer("lammps", "nodes", nodes);
-  integer("lammps", "tasks_per_node", tasks_per_node);
+  t.string("pair", "name", c.name);
+  t.numbers("pair", "K", c.K);
+  t.integer("pair", "runs", runs);
+  t.integer("pair", "seed", c.seed);
+  t.string("md", "preset", c.md_preset);
+  t.string("md", "config", c.md_config);
+  t.strings("md", "set", c.md_set);
+  t.string("md", "engine", c.md_engine);
+  t.number("charged", "Q", c.charged_Q);
+  t.strings("charged", "set", c.charged_set);
+  t.strings("analysis", "args", c.analysis_args);
+  t.numbers("meanfield", "beta", c.betas);
+  t.number("meanfield", "t_end", c.mf_t_end);
+  t.number("meanfield", "s_end", c.mf_s_end);
+  t.number("meanfield", "zbeta_min", c.zbeta_min);
+  t.number("meanfield", "zbeta_max", c.zbeta_max);
+  t.integer("meanfield", "zbeta_count", zcount);
+  t.numbers("fit", "window", c.fit_window);
+  t.string("fit", "column", c.fit_column);
+  t.string("lammps", "launcher", c.lammps_launcher);
+  t.integer("lammps", "ranks", ranks);
+  t.string("lammps", "slurm_launcher", c.lammps_slurm_launcher);
+  t.integer("lammps", "nodes", nodes);
+  t.integer("lammps", "tasks_per_node", tasks_per_node);
   c.runs = static_cast<int>(std::clamp<long long>(runs, -1, MAX_RUNS + 1));
-  // a count beyond int is refused here, with its position; validate() checks those within int
-  const auto count = [&](const char* key, long long n) {
-    const toml::node* node = doc.at_path(std::string("lammps.") + key).node();
-    if (node && n != static_cast<int>(n))
-      fail(*node, std::string("lammps.") + key + " must lie in 1.." + std::to_string(MAX_RANKS) +
-                      " (got " + std::to_string(n) + ")");
-    return static_cast<int>(n);
-  };
-  c.lammps_ranks = count("ranks", ranks);
-  c.lammps_nodes = count("nodes", nodes);
-  c.lammps_tasks_per_node = count("tasks_per_node", tasks_per_node);
+  c.lammps_ranks = t.count("ranks", ranks);
+  c.lammps_nodes = t.count("nodes", nodes);
+  c.lammps_tasks_per_node = t.count("tasks_per_node", tasks_per_node);
   c.zbeta_count = static_cast<int>(std::clamp<long long>(zcount, -1, 100000));
   if (c.md_preset.empty() == c.md_config.empty())
     throw std::invalid_argument(
