@@ -83,17 +83,13 @@ const std::vector<std::string> FITS_COLUMNS = {"z_grid",
                                                "onset_t_base"};
 const char* FITS_DESCRIPTION =
     "growth exponent z of S(t) ~ t^z (grid and particle clusters) by least squares of ln S on ln t "
-    "over "
-    "[fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; for the "
-    "ensemble the bootstrap over runs, z -/+ t_{R-1} sqrt(R/(R-1)) sd of the replicates, the "
-    "rule of fit-beta); err = standard error (bootstrap: sd of the replicates); "
-    "charging_rate_exponent: "
+    "over [fit_t_min, fit_t_max] with its 95% interval [low, high] (Student t for one run; for the "
+    "ensemble the bootstrap over runs, z -/+ t_{R-1} sqrt(R/(R-1)) sd of the replicates, the rule "
+    "of fit-beta); err = standard error (bootstrap: sd of the replicates); charging_rate_exponent: "
     "the same fit to d<|q|>/dt over [charge_fit_t_min, charge_fit_t_max], beside the expected -5/6 "
-    "- 5 kappa/3; "
-    "onset_time: first time S reaches onset_factor x its median over 0 < t <= onset_t_base "
-    "(onset_S_base_grid), "
-    "interpolated in (ln t, ln S); ensemble: onset of the mean S, err = standard error of the "
-    "runs' onsets";
+    "- 5 kappa/3; onset_time: first time S reaches onset_factor x its median over 0 < t <= "
+    "onset_t_base (onset_S_base_grid), interpolated in (ln t, ln S); ensemble: onset of the mean "
+    "S, err = standard error of the runs' onsets";
 
 /// Onset times of one table's S_grid and S_particle, with the standard errors over runs (ensemble).
 struct Onsets {
@@ -296,11 +292,11 @@ void checkSameSystem(const RunResult& a, const RunResult& b) {
                                 "system (same N and box); analyse them separately");
 }
 
-std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const AnalysisOptions& o) {
-  if (runs.empty()) throw std::invalid_argument("analyzeEnsemble needs at least one run.");
-  for (const RunResult& r : runs) checkSameSystem(runs.front(), r);
+namespace {
+
+/// The ensemble average of every per-frame table present in all runs.
+std::vector<Table> ensembleAverages(const std::vector<RunResult>& runs) {
   std::vector<Table> out;
-  // Averages of every per-frame table present in all runs.
   for (const Table& t : runs.front().tables) {
     if (!t.ensemble) continue;
     std::vector<const Table*> same;
@@ -309,7 +305,12 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
     if (same.size() != runs.size()) continue;
     out.push_back(ensembleAverage(same));
   }
-  // Local slope of the mean S(t) (better than the mean of the local slopes: less noise).
+  return out;
+}
+
+/// Adds to the ensemble S(t) the local slope of its mean (less noisy than the mean of the runs'
+/// local slopes).
+void addLocalSlopeOfMean(std::vector<Table>& out, const AnalysisOptions& o) {
   for (Table& t : out)
     if (t.name == "S_t") {
       const auto tt = t.values("t");
@@ -323,107 +324,119 @@ std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const Ana
       }
       t.description += "; z_local_*_of_mean: local slope of the ensemble-mean S(t)";
     }
-  // Pooled Fisher exponents: N_s summed over runs at each time.
-  {
-    Table pooled("fisher_pooled",
-                 "Fisher exponent of N_s summed over all runs at each time (MLE, xmin by KS, and "
-                 "the paper's "
-                 "log-binned least squares, as in fisher.csv)",
-                 FISHER_COLUMNS);
-    std::map<double, std::map<std::uint64_t, std::uint64_t>> g, p;
-    for (const auto& r : runs) {
-      for (const char* name : {"N_s_grid", "N_s_particle"}) {
-        if (!r.hasTable(name)) continue;
-        auto& target = std::string(name) == "N_s_grid" ? g : p;
-        for (const auto& row : r.table(name).rows) {
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "%.9g", row[0]);
-          target[std::strtod(buf, nullptr)][static_cast<std::uint64_t>(row[1])] +=
-              static_cast<std::uint64_t>(row[2]);
-        }
+}
+
+/// Fisher exponents of N_s summed over all runs at each time.
+Table pooledFisher(const std::vector<RunResult>& runs, const AnalysisOptions& o) {
+  Table pooled("fisher_pooled",
+               "Fisher exponent of N_s summed over all runs at each time (MLE, xmin by KS, and "
+               "the paper's log-binned least squares, as in fisher.csv)",
+               FISHER_COLUMNS);
+  std::map<double, std::map<std::uint64_t, std::uint64_t>> g, p;
+  for (const auto& r : runs) {
+    for (const char* name : {"N_s_grid", "N_s_particle"}) {
+      if (!r.hasTable(name)) continue;
+      auto& target = std::string(name) == "N_s_grid" ? g : p;
+      for (const auto& row : r.table(name).rows) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%.9g", row[0]);
+        target[std::strtod(buf, nullptr)][static_cast<std::uint64_t>(row[1])] +=
+            static_cast<std::uint64_t>(row[2]);
       }
     }
-    std::map<double, bool> times;
-    for (const auto& kv : g) times[kv.first] = true;
-    for (const auto& kv : p) times[kv.first] = true;
-    for (const auto& kv : times) {
-      const double t = kv.first;
-      pooled.add(fisherRow(t, g.count(t) ? &g[t] : nullptr, p.count(t) ? &p[t] : nullptr, o));
-    }
-    out.push_back(std::move(pooled));
   }
-  // Ensemble fits: bootstrap over runs on the frame times common to all runs.
-  {
-    const Table* st = nullptr;
-    for (const Table& t : out)
-      if (t.name == "S_t") st = &t;
-    Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
-    fits.ensemble = false;
-    if (st) {
-      std::vector<double> t;
-      const std::size_t n_runs = st->column("n_runs");
-      for (const auto& row : st->rows)
-        if (row[n_runs] == static_cast<double>(runs.size())) t.push_back(row[0]);  // in every run
-      auto seriesOf = [&](const std::string& col, const std::string& table) {
-        std::vector<std::vector<double>> ys;
-        for (const auto& r : runs) {
-          const Table& tb = r.table(table);
-          const auto tt = tb.values("t"), y = tb.values(col);
-          std::vector<double> v;
-          std::size_t j = 0;
-          for (double tk : t) {
-            while (j < tt.size() && std::fabs(tt[j] - tk) > 1e-9 * std::max(1.0, std::fabs(tk)))
-              ++j;
-            v.push_back(j < tt.size() ? y[j] : NaN);
-          }
-          ys.push_back(std::move(v));
-        }
-        return ys;
-      };
-      const auto [w0, w1] = fitWindow(o, t);
-      auto fitOf = [&](const std::vector<std::vector<double>>& ys, const std::vector<double>& tt,
-                       double a, double b) {
-        if (ys.size() >= 2)
-          return bootstrapPowerLaw(tt, ys, a, b, o.bootstrap_replicates, o.bootstrap_seed);
-        return fitPowerLaw(tt, ys.front(), a, b);
-      };
-      const auto fg = fitOf(seriesOf("S_grid", "S_t"), t, w0, w1);
-      const auto fp = fitOf(seriesOf("S_particle", "S_t"), t, w0, w1);
-      // Charging rate per run, then bootstrap of the mean rate.
-      PowerLawFitResult fq;
-      const auto q = seriesOf("mean_abs_q", "thermo");
-      bool have_q = true;
-      for (const auto& v : q)
-        for (double x : v) have_q &= std::isfinite(x);
-      if (have_q && t.size() >= 2) {
-        std::vector<std::vector<double>> rates;
-        std::vector<double> tr;
-        for (const auto& v : q) {
-          auto [tm, rate] = chargingRate(t, v);
-          tr = tm;
-          rates.push_back(rate);
-        }
-        fq = fitOf(rates, tr, o.charge_fit_t_min, o.charge_fit_t_max);
-      }
-      // Onset: of the ensemble-mean S (every frame time, as the local slope of the mean), with the
-      // standard error of the runs' own onsets.
-      Onsets on =
-          onsetsOf(st->values("t"), st->values("S_grid_mean"), st->values("S_particle_mean"), o);
-      std::vector<double> tg, tp;
+  std::map<double, bool> times;
+  for (const auto& kv : g) times[kv.first] = true;
+  for (const auto& kv : p) times[kv.first] = true;
+  for (const auto& kv : times) {
+    const double t = kv.first;
+    pooled.add(fisherRow(t, g.count(t) ? &g[t] : nullptr, p.count(t) ? &p[t] : nullptr, o));
+  }
+  return pooled;
+}
+
+/// Ensemble fits of S(t) and of the charging rate (bootstrap over runs on the frame times common
+/// to all runs) and the onsets, from the ensemble S(t) table `st` (null: no row).
+Table ensembleFits(const std::vector<RunResult>& runs, const Table* st, const AnalysisOptions& o) {
+  Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
+  fits.ensemble = false;
+  if (st) {
+    std::vector<double> t;
+    const std::size_t n_runs = st->column("n_runs");
+    for (const auto& row : st->rows)
+      if (row[n_runs] == static_cast<double>(runs.size())) t.push_back(row[0]);  // in every run
+    auto seriesOf = [&](const std::string& col, const std::string& table) {
+      std::vector<std::vector<double>> ys;
       for (const auto& r : runs) {
-        const Table& tb = r.table("S_t");
-        const Onsets one =
-            onsetsOf(tb.values("t"), tb.values("S_grid"), tb.values("S_particle"), o);
-        tg.push_back(one.grid.valid ? one.grid.t_c : NaN);
-        tp.push_back(one.particle.valid ? one.particle.t_c : NaN);
+        const Table& tb = r.table(table);
+        const auto tt = tb.values("t"), y = tb.values(col);
+        std::vector<double> v;
+        std::size_t j = 0;
+        for (double tk : t) {
+          while (j < tt.size() && std::fabs(tt[j] - tk) > 1e-9 * std::max(1.0, std::fabs(tk))) ++j;
+          v.push_back(j < tt.size() ? y[j] : NaN);
+        }
+        ys.push_back(std::move(v));
       }
-      on.grid_err = standardErrorOfAll(tg);
-      on.particle_err = standardErrorOfAll(tp);
-      fits.add(fitColumns(fg, fp, w0, w1, fq, runs.front().kappa, o.charge_fit_t_min,
-                          o.charge_fit_t_max, static_cast<double>(runs.size()), on, o));
+      return ys;
+    };
+    const auto [w0, w1] = fitWindow(o, t);
+    auto fitOf = [&](const std::vector<std::vector<double>>& ys, const std::vector<double>& tt,
+                     double a, double b) {
+      if (ys.size() >= 2)
+        return bootstrapPowerLaw(tt, ys, a, b, o.bootstrap_replicates, o.bootstrap_seed);
+      return fitPowerLaw(tt, ys.front(), a, b);
+    };
+    const auto fg = fitOf(seriesOf("S_grid", "S_t"), t, w0, w1);
+    const auto fp = fitOf(seriesOf("S_particle", "S_t"), t, w0, w1);
+    // Charging rate per run, then bootstrap of the mean rate.
+    PowerLawFitResult fq;
+    const auto q = seriesOf("mean_abs_q", "thermo");
+    bool have_q = true;
+    for (const auto& v : q)
+      for (double x : v) have_q &= std::isfinite(x);
+    if (have_q && t.size() >= 2) {
+      std::vector<std::vector<double>> rates;
+      std::vector<double> tr;
+      for (const auto& v : q) {
+        auto [tm, rate] = chargingRate(t, v);
+        tr = tm;
+        rates.push_back(rate);
+      }
+      fq = fitOf(rates, tr, o.charge_fit_t_min, o.charge_fit_t_max);
     }
-    out.push_back(std::move(fits));
+    // Onset: of the ensemble-mean S (every frame time, as the local slope of the mean), with the
+    // standard error of the runs' own onsets.
+    Onsets on =
+        onsetsOf(st->values("t"), st->values("S_grid_mean"), st->values("S_particle_mean"), o);
+    std::vector<double> tg, tp;
+    for (const auto& r : runs) {
+      const Table& tb = r.table("S_t");
+      const Onsets one = onsetsOf(tb.values("t"), tb.values("S_grid"), tb.values("S_particle"), o);
+      tg.push_back(one.grid.valid ? one.grid.t_c : NaN);
+      tp.push_back(one.particle.valid ? one.particle.t_c : NaN);
+    }
+    on.grid_err = standardErrorOfAll(tg);
+    on.particle_err = standardErrorOfAll(tp);
+    fits.add(fitColumns(fg, fp, w0, w1, fq, runs.front().kappa, o.charge_fit_t_min,
+                        o.charge_fit_t_max, static_cast<double>(runs.size()), on, o));
   }
+  return fits;
+}
+
+}  // namespace
+
+std::vector<Table> analyzeEnsemble(const std::vector<RunResult>& runs, const AnalysisOptions& o) {
+  if (runs.empty()) throw std::invalid_argument("analyzeEnsemble needs at least one run.");
+  for (const RunResult& r : runs) checkSameSystem(runs.front(), r);
+  std::vector<Table> out = ensembleAverages(runs);
+  addLocalSlopeOfMean(out, o);
+  out.push_back(pooledFisher(runs, o));
+  const Table* st = nullptr;
+  for (const Table& t : out)
+    if (t.name == "S_t") st = &t;
+  Table fits = ensembleFits(runs, st, o);
+  out.push_back(std::move(fits));
   return out;
 }
 
