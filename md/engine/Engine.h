@@ -9,9 +9,10 @@
 /// md/potentials/. This header has no Thrust in it (pimpl), so host-only code (CLI, I/O) can use it
 /// in a CUDA build too.
 ///
-/// Storage: particles are kept sorted by cell (re-sorted every few neighbour-list builds) for
-/// memory locality; ParticleData::id maps slots back to particle ids, and frame(), forces() and
-/// error messages use ids. Determinism: forces are gathered per particle over a neighbour row
+/// Storage: particles are kept sorted by cell for memory locality, re-sorted at every build of the
+/// list built from cells (the contact list without Coulomb forces, the Coulomb list with them);
+/// ParticleData::id maps slots back to particle ids, and frame(), forces() and error messages use
+/// ids. Determinism: forces are gathered per particle over a neighbour row
 /// sorted by particle id, so every sum runs in the same order whatever the thread count, the
 /// storage order, the neighbour-list rebuild schedule, or a restart from a checkpoint: the same
 /// build gives bit-identical trajectories.
