@@ -60,11 +60,13 @@ if [ "$MODE" = bundle ]; then
   build_cuda "$BUNDLE/build.log"
   cp "$CUDA_DIR/bin/granagg" "$CUDA_DIR/tests/test_md_gpu" "$BUNDLE/bin/"
   strip "$BUNDLE/bin/granagg" "$BUNDLE/bin/test_md_gpu"   # ~56 MB in all: fits a 64 MiB transfer
-  # glibc, the dynamic loader, libstdc++ and libgcc_s come from the GPU machine (newer versions
-  # run binaries built against older ones); libcuda is the driver's; the CUDA toolkit's libraries
-  # (cudart, cufft) must be the GPU machine's own toolkit of the same major version (CUDA 13 here).
+  # glibc (all of its libraries: libresolv & co. must match its libc), the dynamic loader,
+  # libstdc++ and libgcc_s come from the GPU machine (newer versions run binaries built against
+  # older ones); libcuda is the driver's; the CUDA toolkit's libraries (cudart, cufft) must be the
+  # GPU machine's own toolkit of the same major version (CUDA 13 here).
   ldd "$BUNDLE/bin/granagg" "$BUNDLE/bin/test_md_gpu" | awk '/=> \// {print $3}' | sort -u |
-    grep -Ev '/(libc|libm|libdl|librt|libpthread|ld-linux[^/]*|libstdc\+\+|libgcc_s)\.so' |
+    grep -Ev '/(libc|libm|libdl|librt|libpthread|libresolv|libnsl|libutil|libanl)\.so' |
+    grep -Ev '/(ld-linux[^/]*|libstdc\+\+|libgcc_s)\.so' |
     grep -Ev '/(libcuda|libcudart|libcufft)\.so' |
     while read -r lib; do cp -L "$lib" "$BUNDLE/lib/"; done
   git rev-parse HEAD > "$BUNDLE/commit" 2>/dev/null || true

@@ -34,6 +34,19 @@ struct EwaldParams {
 };
 
 /// Particle-particle particle-mesh (P3M / PPPM) parameters for a cubic box (Pppm).
+/// How PPPM puts the charges on its mesh (md/coulomb/Pppm.h); both are deterministic.
+enum class ChargeAssignment {
+  Tiles,       ///< colour-ordered tiles, one thread each, plain adds (few, busy threads: CPU)
+  FixedPoint,  ///< one thread per particle, 64-bit fixed-point atomic adds (many threads: GPU)
+};
+
+/// The backend's charge assignment: each is the faster one on its backend (docs/gpu.md).
+#if defined(GRANAGG_CUDA)
+constexpr ChargeAssignment DEFAULT_CHARGE_ASSIGNMENT = ChargeAssignment::FixedPoint;
+#else
+constexpr ChargeAssignment DEFAULT_CHARGE_ASSIGNMENT = ChargeAssignment::Tiles;
+#endif
+
 struct PppmParams {
   double alpha = 0.0;                 ///< splitting parameter, in 1/d
   double r_cut = 0.0;                 ///< real-space cutoff, in d (<= L/2, minimum image)
@@ -41,6 +54,7 @@ struct PppmParams {
   int order = 5;                      ///< charge-assignment order P (2..7): P points per dimension
   double estimated_error_real = 0.0;  ///< Kolafa-Perram real-space RMS force error / K
   double estimated_error_kspace = 0.0;  ///< Deserno-Holm / LAMMPS ik mesh RMS force error / K
+  ChargeAssignment assignment = DEFAULT_CHARGE_ASSIGNMENT;  ///< how charges reach the mesh
   /// sqrt(e_r^2 + e_k^2): estimated relative RMS force error.
   double estimatedError() const;
 };

@@ -10,6 +10,7 @@
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/sort.h>
+#include <thrust/transform.h>
 
 #include "common/HostDevice.h"
 #include "md/engine/ParticleData.h"  // DVec, raw
@@ -217,6 +218,59 @@ struct ScatterTile {
   }
 };
 
+/// Adds v to *p atomically (64-bit integers: any order gives the same sum).
+HD inline void atomicAddInteger(unsigned long long* p, unsigned long long v) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(p, v);
+#else
+  __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
+
+/// x rounded to the nearest integer, ties to even, on both backends.
+HD inline long long roundToInteger(double x) {
+#if defined(__CUDA_ARCH__)
+  return __double2ll_rn(x);
+#else
+  return std::llrint(x);  // the default rounding mode: to nearest, ties to even
+#endif
+}
+
+/// ChargeAssignment::FixedPoint: one thread per particle adds its P^3 stencil terms to the mesh
+/// with 64-bit integer atomics on the charge in fixed point (units of 1 / scale). Integer addition
+/// is associative, so the mesh is the same whatever order the threads run in: deterministic
+/// without ScatterTile's colour passes, whose one thread per tile serialises the dense tiles of a
+/// clustered gas on a GPU (docs/gpu.md). `scale` keeps every partial sum within 2^61
+/// (Pppm::run); each term's rounding, at most 0.5 / scale, lies far below the accuracy that the
+/// PPPM and backend tests resolve.
+struct ScatterFixedPoint {
+  const double *wx, *wy, *wz, *qs;
+  const int *jx, *jy, *jz;
+  int M, P;
+  double scale;
+  unsigned long long* mesh;  // two's complement: wrapping unsigned adds are signed adds
+  HD void operator()(int k) const {
+    const long kp = static_cast<long>(k) * P;
+    const double qk = qs[k] * scale;
+    for (int px = 0, gx = jx[k]; px < P; ++px, gx = gx == 0 ? M - 1 : gx - 1)
+      for (int py = 0, gy = jy[k]; py < P; ++py, gy = gy == 0 ? M - 1 : gy - 1) {
+        const double qw = qk * wx[kp + px] * wy[kp + py];
+        const long mrow = (static_cast<long>(gx) * M + gy) * M;
+        for (int pz = 0, gz = jz[k]; pz < P; ++pz, gz = gz == 0 ? M - 1 : gz - 1)
+          atomicAddInteger(mesh + mrow + gz,
+                           static_cast<unsigned long long>(roundToInteger(qw * wz[kp + pz])));
+      }
+  }
+};
+
+/// Fixed-point mesh charge back to a double.
+struct FromFixedPoint {
+  double inv_scale;
+  HD double operator()(unsigned long long v) const {
+    return static_cast<double>(static_cast<long long>(v)) * inv_scale;
+  }
+};
+
 /// First sorted slot of every cell: start[c] = k for the cells c in (cell[k-1], cell[k]] (and
 /// start[M^3] = n). Every entry is written exactly once, by the particle that opens it.
 struct CellStart {
@@ -345,6 +399,7 @@ struct Pppm::Impl {
   DVec<int> order, start, jx, jy, jz;
   DVec<double> wx, wy, wz, qs;
   DVec<double> terms, blocks;
+  DVec<unsigned long long> mesh_fixed;  // ChargeAssignment::FixedPoint's mesh (ScatterFixedPoint)
   int tiles = 1;                 // tiles per dimension of the charge assignment (ScatterTile)
   double self_correction = 0.0;  // mean P3M self-energy error per unit q^2 (SelfEnergyTerm)
   PppmEnergies energies;
@@ -483,19 +538,34 @@ double Pppm::Impl::run(const double* x, const double* y, const double* z, const 
   s.energies.self = EwaldReference::selfEnergy(s.params.alpha, s.K, sum_q2);
   s.energies.background = EwaldReference::backgroundEnergy(s.params.alpha, s.K, s.L, sum_q);
 
-  // 2. charge assignment (tiles by colour, see ScatterTile) and forward FFT
+  // 2. charge assignment (ChargeAssignment: tiles by colour, ScatterTile, or fixed-point
+  // atomics, ScatterFixedPoint) and forward FFT
   phase.emplace(s.timer, PhaseTimer::PppmAssign);
-  thrust::fill(s.mesh.begin(), s.mesh.end(), 0.0);
-  const int T = s.tiles;
-  const int colours = T == 1 ? 1 : 2;
-  const int tiles_per_pass = T == 1 ? 1 : (T / 2) * (T / 2) * (T / 2);
-  for (int cx = 0; cx < colours; ++cx)
-    for (int cy = 0; cy < colours; ++cy)
-      for (int cz = 0; cz < colours; ++cz)
-        thrust::for_each(
-            counting_iterator<int>(0), counting_iterator<int>(tiles_per_pass),
-            ScatterTile{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx), raw(s.jy), raw(s.jz),
-                        raw(s.start), M, P, T, cx, cy, cz, raw(s.mesh)});
+  if (s.params.assignment == ChargeAssignment::FixedPoint) {
+    // |any partial sum of a mesh point| <= sum |q| <= sqrt(N sum q^2) (Cauchy-Schwarz) = bound;
+    // the largest power of two with bound * scale <= 2^61 leaves room for the terms' rounding
+    const double bound = std::sqrt(static_cast<double>(n) * sum_q2);
+    const double scale = bound > 0.0 ? std::ldexp(1.0, 60 - std::ilogb(bound)) : 1.0;
+    s.mesh_fixed.resize(nr);
+    thrust::fill(s.mesh_fixed.begin(), s.mesh_fixed.end(), 0ull);
+    thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(N),
+                     ScatterFixedPoint{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx),
+                                       raw(s.jy), raw(s.jz), M, P, scale, raw(s.mesh_fixed)});
+    thrust::transform(s.mesh_fixed.begin(), s.mesh_fixed.end(), s.mesh.begin(),
+                      FromFixedPoint{1.0 / scale});
+  } else {
+    thrust::fill(s.mesh.begin(), s.mesh.end(), 0.0);
+    const int T = s.tiles;
+    const int colours = T == 1 ? 1 : 2;
+    const int tiles_per_pass = T == 1 ? 1 : (T / 2) * (T / 2) * (T / 2);
+    for (int cx = 0; cx < colours; ++cx)
+      for (int cy = 0; cy < colours; ++cy)
+        for (int cz = 0; cz < colours; ++cz)
+          thrust::for_each(counting_iterator<int>(0), counting_iterator<int>(tiles_per_pass),
+                           ScatterTile{raw(s.wx), raw(s.wy), raw(s.wz), raw(s.qs), raw(s.jx),
+                                       raw(s.jy), raw(s.jz), raw(s.start), M, P, T, cx, cy, cz,
+                                       raw(s.mesh)});
+  }
   phase.emplace(s.timer, PhaseTimer::PppmFft);
   s.fft.forward(raw(s.mesh), raw(s.spectrum));
   phase.emplace(s.timer, PhaseTimer::PppmKspace);

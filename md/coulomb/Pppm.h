@@ -12,11 +12,15 @@
 /// the same weights. Energy E_k = (K / 2V) sum_k G_opt(k) |Q(k)|^2.
 ///
 /// One source for both backends (Pppm.cpp: Thrust functors, device vectors, Fft3d). Determinism:
-/// no atomics. Particles are sorted by (mesh cell, particle id); the mesh is cut into tiles at
-/// least P cells wide, and tiles of one parity colour (8 passes) scatter their particles' charges
-/// with plain adds, since their stencils cannot overlap; the interpolation is a per-particle
-/// gather; energies are block sums added in a fixed order. Results do not depend on the thread
-/// count, nor (given ids) on the storage order of the particles. The energy carries the mean P3M
+/// particles are sorted by (mesh cell, particle id), and the charge assignment is one of two
+/// (PppmParams::assignment, the backend's faster one by default). Tiles (CPU): the mesh is cut
+/// into tiles at least P cells wide, and tiles of one parity colour (8 passes) scatter their
+/// particles' charges with plain adds, since their stencils cannot overlap. Fixed point (GPU):
+/// one thread per particle adds its terms as 64-bit integers (the charge in units of a power of
+/// two below the round-off of the mesh sums) with atomics, whose sum no order changes. The
+/// interpolation is a per-particle gather; energies are block sums added in a fixed order.
+/// Results do not depend on the thread count, nor (given ids) on the storage order of the
+/// particles. The energy carries the mean P3M
 /// self-energy correction (Ballenegger, Cerda & Holm 2012), so that a lone charge's energy
 /// averages to the exact Ewald value.
 ///

@@ -1,7 +1,8 @@
 // PPPM (md/coulomb/Pppm.h): Madelung constants and the single charge in a background at the default
 // accuracy, forces against converged plain Ewald on gas-like random configurations (neutral and
 // all-positive) at 1e-3, 1e-4 and 1e-5 with the error estimate within a factor 3, determinism with
-// 1 and 2 threads, independence of the storage order, the energy alone, and input validation.
+// 1 and 2 threads, independence of the storage order, the energy alone, the fixed-point charge
+// assignment against the tiles', and input validation.
 #include <catch2/catch.hpp>
 
 #include <omp.h>
@@ -274,6 +275,80 @@ TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of stora
   CHECK(two.compute(pos4.data(), n, nullptr, nullptr, nullptr, id.data()) == e);
   CHECK(two.lastEnergies().total() == e);
 #endif
+}
+
+TEST_CASE("PPPM: the fixed-point charge assignment equals the tiles' to round-off and is "
+          "deterministic",
+          "[md][coulomb]") {
+  // The two assignments (PppmParams::assignment) put the same charges on the mesh; fixed point
+  // rounds each term to a unit of at most 2^-60 sqrt(N sum q^2) (4e-16 here, N = 1000, |q| = 1),
+  // so mesh values, and the forces and energy that are linear and quadratic in them, agree to
+  // ~1e-13 relative. 1e-11 of the largest force leaves room; a missed or misplaced stencil term
+  // changes forces by ~1e-2 of it. Tiles are checked against Ewald above.
+  const int threads_before = omp_get_max_threads();
+  for (bool neutral : {true, false}) {
+    const Charges& c = gasReference(neutral).c;
+    PppmParams p = choosePppmParams(1e-4, c.x.size(), c.L, c.sumQ2(), 6.0);
+    p.assignment = ChargeAssignment::Tiles;
+    Pppm tiles(p, c.L, 1.0);
+    const CoulombResult rt = tiles.computeHost(c.x, c.y, c.z, c.q);
+    p.assignment = ChargeAssignment::FixedPoint;
+    omp_set_num_threads(1);
+    Pppm fixed(p, c.L, 1.0);
+    const CoulombResult r1 = fixed.computeHost(c.x, c.y, c.z, c.q);
+    omp_set_num_threads(2);
+    const CoulombResult r2 = fixed.computeHost(c.x, c.y, c.z, c.q);
+    omp_set_num_threads(threads_before);
+    double f_max = 0.0, d_max = 0.0;
+    for (std::size_t i = 0; i < c.x.size(); ++i) {
+      f_max = std::max({f_max, std::abs(rt.fx[i]), std::abs(rt.fy[i]), std::abs(rt.fz[i])});
+      d_max = std::max({d_max, std::abs(r1.fx[i] - rt.fx[i]), std::abs(r1.fy[i] - rt.fy[i]),
+                        std::abs(r1.fz[i] - rt.fz[i])});
+    }
+    INFO((neutral ? "neutral" : "all +1") << ": largest force " << f_max << ", largest difference "
+                                          << d_max << "; energies " << r1.energy << " and "
+                                          << rt.energy);
+    CHECK(f_max > 0.0);
+    CHECK(d_max <= 1e-11 * f_max);
+    CHECK(std::abs(r1.energy_kspace - rt.energy_kspace) <= 1e-11 * std::abs(rt.energy_kspace));
+    // 1 and 2 threads: the same bits (the atomic adds run in another order)
+    const std::size_t bytes = c.x.size() * sizeof(double);
+    CHECK(std::memcmp(r1.fx.data(), r2.fx.data(), bytes) == 0);
+    CHECK(std::memcmp(r1.fy.data(), r2.fy.data(), bytes) == 0);
+    CHECK(std::memcmp(r1.fz.data(), r2.fz.data(), bytes) == 0);
+    CHECK(r1.energy == r2.energy);
+#if !defined(GRANAGG_CUDA)  // compute() takes device pointers (host memory on the OpenMP backend)
+    // storage order: reversed, with ids, gives the same bits per particle
+    const std::size_t n = c.x.size();
+    std::vector<double> x(n), y(n), z(n), q(n), fx(n, 0.0), fy(n, 0.0), fz(n, 0.0);
+    std::vector<int> id(n);
+    for (std::size_t s = 0; s < n; ++s) {
+      const std::size_t i = n - 1 - s;
+      x[s] = c.x[i];
+      y[s] = c.y[i];
+      z[s] = c.z[i];
+      q[s] = c.q[i];
+      id[s] = static_cast<int>(i);
+    }
+    CHECK(fixed.compute(x.data(), y.data(), z.data(), q.data(), n, fx.data(), fy.data(),
+                        fz.data(), id.data()) == r1.energy);
+    bool same = true;
+    for (std::size_t s = 0; s < n; ++s) {
+      const std::size_t i = n - 1 - s;
+      same = same && fx[s] == r1.fx[i] && fy[s] == r1.fy[i] && fz[s] == r1.fz[i];
+    }
+    CHECK(same);
+#endif
+  }
+  // no charge at all: the scale has no bound to follow, and the mesh stays empty
+  const Charges& c = gasReference(true).c;
+  PppmParams p = choosePppmParams(1e-4, c.x.size(), c.L, c.sumQ2(), 6.0);
+  p.assignment = ChargeAssignment::FixedPoint;
+  Pppm fixed(p, c.L, 1.0);
+  const std::vector<double> zero(c.x.size(), 0.0);
+  const CoulombResult r0 = fixed.computeHost(c.x, c.y, c.z, zero);
+  CHECK(r0.energy == 0.0);
+  CHECK(*std::max_element(r0.fx.begin(), r0.fx.end()) == 0.0);
 }
 
 TEST_CASE("PPPM parameter choice: estimates, cost optimisation and invalid input",
