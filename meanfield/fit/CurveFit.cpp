@@ -114,25 +114,32 @@ LmResult runLm(CurveProblem& prob, double u0, double lnSc0, double lntau0, bool 
   return r;
 }
 
-}  // namespace
+/// Turns GSL's abort-on-error handler off while in scope: the fit reads failures from return
+/// codes, and a throw on the way out restores the handler too.
+class GslErrorsAsCodes {
+ public:
+  GslErrorsAsCodes() : m_old(gsl_set_error_handler_off()) {}
+  ~GslErrorsAsCodes() { gsl_set_error_handler(m_old); }
+  GslErrorsAsCodes(const GslErrorsAsCodes&) = delete;
+  GslErrorsAsCodes& operator=(const GslErrorsAsCodes&) = delete;
 
-CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFitOptions& o) {
-  validateGrowthData(data);
-  validateBetaRange(o.beta_min, o.beta_max);
-  const std::size_t n = data.t.size();
-  if (n < 5)
-    throw std::invalid_argument("too few points for the curve fit: " + std::to_string(n) +
-                                ", at least 5 needed.");
-  std::vector<double> lt(n);
-  for (std::size_t i = 0; i < n; ++i) lt[i] = std::log(data.t[i]);
-  CurveProblem prob{&curves, &lt, {}, o.beta_min, o.beta_max};
-  prob.y.resize(n);
-  for (std::size_t i = 0; i < n; ++i) prob.y[i] = std::log(data.S[i]);
+ private:
+  gsl_error_handler_t* m_old;
+};
 
-  // Coarse scan: beta from beta_min in steps of 1 (and beta_max), ln tau_c in steps of 0.2, ln S_c
-  // profiled out (the mean residual). ln tau_c runs from the value at which the last sample sits at
-  // S_MF = S_scan = 4 S_max / S_min (clamped to [1e3, s_cap]: S_c down to S_min / 4) to the value
-  // at which the last sample sits at t/tau_c = 1e-3 (all data in the early linear regime).
+struct StartValues {
+  double beta, lnSc, lntau;
+};
+
+/// Coarse scan for the start values: beta from beta_min in steps of 1 (and beta_max), ln tau_c in
+/// steps of 0.2, ln S_c profiled out (the mean residual). ln tau_c runs from the value at which
+/// the last sample sits at S_MF = S_scan = 4 S_max / S_min (clamped to [1e3, s_cap]: S_c down to
+/// S_min / 4) to the value at which the last sample sits at t/tau_c = 1e-3 (all data in the
+/// early linear regime).
+StartValues coarseScan(MeanFieldCurves& curves, const CurveProblem& prob,
+                       const CurveFitOptions& o) {
+  const std::vector<double>& lt = *prob.lt;
+  const std::size_t n = lt.size();
   const double y_min = *std::min_element(prob.y.begin(), prob.y.end());
   const double y_max = *std::max_element(prob.y.begin(), prob.y.end());
   const double S_scan =
@@ -140,7 +147,8 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   std::vector<double> betas{o.beta_min};
   for (double b = o.beta_min + 1.0; b < o.beta_max - 0.25; b += 1.0) betas.push_back(b);
   betas.push_back(o.beta_max);
-  double best = std::numeric_limits<double>::infinity(), b0 = betas.front(), s0 = 0.0, tau0 = 0.0;
+  double best = std::numeric_limits<double>::infinity();
+  StartValues start{betas.front(), 0.0, 0.0};
   for (double beta : betas) {
     const double lt_lo = lt.back() - std::log(curves.timeAtS(S_scan, beta));
     const double lt_hi = lt.back() + std::log(1e3);
@@ -157,19 +165,83 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
         ssr += (prob.y[i] - m[i] - mean) * (prob.y[i] - m[i] - mean);
       if (ssr < best) {
         best = ssr;
-        b0 = beta;
-        s0 = mean;
-        tau0 = lntau;
+        start = {beta, mean, lntau};
       }
     }
   }
+  return start;
+}
 
-  gsl_error_handler_t* old = gsl_set_error_handler_off();
-  const LmResult r = runLm(prob, prob.uOf(b0), s0, tau0, true);
-  if (!r.ok) {
-    gsl_set_error_handler(old);
-    throw std::runtime_error("the full-curve fit (gsl_multifit_nlinear) failed to converge.");
+/// Intervals from refits to run-resampled means (the runs are the independent samples).
+void bootstrapIntervals(const CurveProblem& prob, const LmResult& r, const GrowthData& data,
+                        const CurveFitOptions& o, CurveFit& fit) {
+  Rng rng(o.bootstrap.seed);
+  std::vector<double> bs, ss, ts;
+  CurveProblem pb = prob;
+  for (int b = 0; b < o.bootstrap.replicates_curve; ++b) {
+    const std::vector<double> S = resampledMean(data, rng.resample(data.runs.size()));
+    for (std::size_t i = 0; i < pb.y.size(); ++i) pb.y[i] = std::log(S[i]);
+    const LmResult rb = runLm(pb, r.u, r.lnSc, r.lntau, false);
+    if (!rb.ok) continue;
+    bs.push_back(rb.u);
+    ss.push_back(rb.lnSc);
+    ts.push_back(rb.lntau);
   }
+  if (bs.size() < 10)
+    throw std::runtime_error("the bootstrap of the full-curve fit failed in most replicates.");
+  const std::size_t R = data.runs.size();
+  const double conf = o.bootstrap.confidence;
+  double lo, hi;
+  bootstrapInterval(bs, r.u, R, conf, lo, hi);
+  fit.beta_low = prob.betaOf(lo);
+  fit.beta_high = prob.betaOf(hi);
+  bootstrapInterval(ss, r.lnSc, R, conf, lo, hi);
+  fit.S_c_low = std::exp(lo);
+  fit.S_c_high = std::exp(hi);
+  bootstrapInterval(ts, r.lntau, R, conf, lo, hi);
+  fit.tau_c_low = std::exp(lo);
+  fit.tau_c_high = std::exp(hi);
+  fit.interval_method = "bootstrap-runs";
+  fit.replicates = static_cast<int>(bs.size());
+}
+
+/// Intervals from the fit's covariance, scaled by chi^2/dof (unit weights), Student's t.
+void covarianceIntervals(const CurveProblem& prob, const LmResult& r, double dof, double conf,
+                         CurveFit& fit) {
+  const double scale = fit.chi2_dof;
+  auto half = [&](int k) {
+    return common::stats::studentHalfWidth(std::sqrt(std::max(r.cov[k][k] * scale, 0.0)), dof,
+                                           conf);
+  };
+  fit.beta_low = prob.betaOf(r.u - half(0));
+  fit.beta_high = prob.betaOf(r.u + half(0));
+  fit.S_c_low = std::exp(r.lnSc - half(1));
+  fit.S_c_high = std::exp(r.lnSc + half(1));
+  fit.tau_c_low = std::exp(r.lntau - half(2));
+  fit.tau_c_high = std::exp(r.lntau + half(2));
+  fit.interval_method = "covariance";
+}
+
+}  // namespace
+
+CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFitOptions& o) {
+  validateGrowthData(data);
+  validateBetaRange(o.beta_min, o.beta_max);
+  const std::size_t n = data.t.size();
+  if (n < 5)
+    throw std::invalid_argument("too few points for the curve fit: " + std::to_string(n) +
+                                ", at least 5 needed.");
+  std::vector<double> lt(n);
+  for (std::size_t i = 0; i < n; ++i) lt[i] = std::log(data.t[i]);
+  CurveProblem prob{&curves, &lt, {}, o.beta_min, o.beta_max};
+  prob.y.resize(n);
+  for (std::size_t i = 0; i < n; ++i) prob.y[i] = std::log(data.S[i]);
+
+  const StartValues start = coarseScan(curves, prob, o);
+  const GslErrorsAsCodes gsl_errors;
+  const LmResult r = runLm(prob, prob.uOf(start.beta), start.lnSc, start.lntau, true);
+  if (!r.ok)
+    throw std::runtime_error("the full-curve fit (gsl_multifit_nlinear) failed to converge.");
   CurveFit fit;
   fit.points = static_cast<int>(n);
   fit.iterations = r.iterations;
@@ -178,53 +250,11 @@ CurveFit fitCurve(MeanFieldCurves& curves, const GrowthData& data, const CurveFi
   fit.tau_c = std::exp(r.lntau);
   const double dof = static_cast<double>(n - 3);
   fit.chi2_dof = r.chi2 / dof;
-  const double conf = o.bootstrap.confidence;
   if (data.runs.size() >= static_cast<std::size_t>(std::max(o.bootstrap.min_runs, 2)) &&
-      o.bootstrap.replicates_curve > 0) {
-    Rng rng(o.bootstrap.seed);
-    std::vector<double> bs, ss, ts;
-    CurveProblem pb = prob;
-    for (int b = 0; b < o.bootstrap.replicates_curve; ++b) {
-      const std::vector<double> S = resampledMean(data, rng.resample(data.runs.size()));
-      for (std::size_t i = 0; i < n; ++i) pb.y[i] = std::log(S[i]);
-      const LmResult rb = runLm(pb, r.u, r.lnSc, r.lntau, false);
-      if (!rb.ok) continue;
-      bs.push_back(rb.u);
-      ss.push_back(rb.lnSc);
-      ts.push_back(rb.lntau);
-    }
-    if (bs.size() < 10) {
-      gsl_set_error_handler(old);
-      throw std::runtime_error("the bootstrap of the full-curve fit failed in most replicates.");
-    }
-    const std::size_t R = data.runs.size();
-    double lo, hi;
-    bootstrapInterval(bs, r.u, R, conf, lo, hi);
-    fit.beta_low = prob.betaOf(lo);
-    fit.beta_high = prob.betaOf(hi);
-    bootstrapInterval(ss, r.lnSc, R, conf, lo, hi);
-    fit.S_c_low = std::exp(lo);
-    fit.S_c_high = std::exp(hi);
-    bootstrapInterval(ts, r.lntau, R, conf, lo, hi);
-    fit.tau_c_low = std::exp(lo);
-    fit.tau_c_high = std::exp(hi);
-    fit.interval_method = "bootstrap-runs";
-    fit.replicates = static_cast<int>(bs.size());
-  } else {
-    const double scale = fit.chi2_dof;  // covariance scaled by chi^2/dof (unit weights)
-    auto half = [&](int k) {
-      return common::stats::studentHalfWidth(std::sqrt(std::max(r.cov[k][k] * scale, 0.0)), dof,
-                                             conf);
-    };
-    fit.beta_low = prob.betaOf(r.u - half(0));
-    fit.beta_high = prob.betaOf(r.u + half(0));
-    fit.S_c_low = std::exp(r.lnSc - half(1));
-    fit.S_c_high = std::exp(r.lnSc + half(1));
-    fit.tau_c_low = std::exp(r.lntau - half(2));
-    fit.tau_c_high = std::exp(r.lntau + half(2));
-    fit.interval_method = "covariance";
-  }
-  gsl_set_error_handler(old);
+      o.bootstrap.replicates_curve > 0)
+    bootstrapIntervals(prob, r, data, o, fit);
+  else
+    covarianceIntervals(prob, r, dof, o.bootstrap.confidence, fit);
   const double edge = 1e-4 * (o.beta_max - o.beta_min);
   fit.at_bound = fit.beta <= o.beta_min + edge || fit.beta >= o.beta_max - edge;
   if (fit.at_bound) {  // no interval: the data do not determine beta within the range
