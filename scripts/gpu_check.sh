@@ -59,7 +59,7 @@ if [ "$MODE" = bundle ]; then
   mkdir -p "$BUNDLE/bin" "$BUNDLE/lib"
   build_cuda "$BUNDLE/build.log"
   cp "$CUDA_DIR/bin/granagg" "$CUDA_DIR/tests/test_md_gpu" "$BUNDLE/bin/"
-  strip "$BUNDLE/bin/granagg" "$BUNDLE/bin/test_md_gpu"   # ~56 MB in all: fits a 64 MiB transfer
+  strip "$BUNDLE/bin/granagg" "$BUNDLE/bin/test_md_gpu"
   # glibc (all of its libraries: libresolv & co. must match its libc), the dynamic loader,
   # libstdc++ and libgcc_s come from the GPU machine (newer versions run binaries built against
   # older ones); libcuda is the driver's; the CUDA toolkit's libraries (cudart, cufft) must be the
@@ -69,6 +69,9 @@ if [ "$MODE" = bundle ]; then
     grep -Ev '/(ld-linux[^/]*|libstdc\+\+|libgcc_s)\.so' |
     grep -Ev '/(libcuda|libcudart|libcufft)\.so' |
     while read -r lib; do cp -L "$lib" "$BUNDLE/lib/"; done
+  # compressed: 30 MB of binaries become 12, so that bundle and checkout (~5 MB) stay well inside
+  # a 64 MiB transfer; --prebuilt unpacks them
+  gzip -f "$BUNDLE/bin/granagg" "$BUNDLE/bin/test_md_gpu"
   git rev-parse HEAD > "$BUNDLE/commit" 2>/dev/null || true
   echo "gpu_check: bundle in $BUNDLE ($(du -sh "$BUNDLE" | cut -f1)); on the GPU machine, from a" \
        "checkout of the same commit: bash scripts/gpu_check.sh --prebuilt $BUNDLE" >&2
@@ -93,7 +96,13 @@ if [ "$MODE" = gpu ]; then
     || { echo "gpu_check: no GPU found (nvidia-smi lists none); --dry-run checks the script" \
               "on the CPU build" >&2; exit 2; }
   if [ -n "$PREBUILT" ]; then
-    G="$PREBUILT/bin/granagg"; T="$PREBUILT/bin/test_md_gpu"
+    BIN=$(mktemp -d)
+    for b in granagg test_md_gpu; do
+      if [ -f "$PREBUILT/bin/$b.gz" ]; then gunzip -c "$PREBUILT/bin/$b.gz" > "$BIN/$b"
+      else cp "$PREBUILT/bin/$b" "$BIN/$b"; fi
+      chmod +x "$BIN/$b"
+    done
+    G="$BIN/granagg"; T="$BIN/test_md_gpu"
     LD_LIBRARY_PATH="$PREBUILT/lib:/usr/local/cuda/lib64${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
     export LD_LIBRARY_PATH
     echo "prebuilt bundle $PREBUILT (built from $(cat "$PREBUILT/commit" 2>/dev/null))" \
