@@ -142,7 +142,7 @@ bool Engine::Impl::sortByCell() {
   permute(p.pos, order, scratch4);  // (dq is all zero here: applied by the kick pass before)
   for (auto* v : {&p.vel, &p.force}) permute(*v, order, scratch3);
   if (coulomb)  // the Coulomb forces, used until the next evaluation, follow their particles
-    for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) permute(*v, order, scratch_d);
+    for (int a = 0; a < 3; ++a) permute(slow_coulomb->force(a), order, scratch_d);
   for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
   return true;
 }
@@ -180,11 +180,12 @@ void Engine::Impl::chooseSkins(bool contact_list, bool coulomb_list) {
   if (u_max_last < 0.0) return;
   const double delta = dt * u_max_last;
   if (contact_list && contact_skin_follows)
-    nl.setSkin(followingSkin(fast_switch.r2, delta, CONTACT_LIST_BUILD_OVER_USE,
+    nl.setSkin(followingSkin(slow_coulomb->fastSwitch().r2, delta, CONTACT_LIST_BUILD_OVER_USE,
                              NEIGHBOR_SKIN_AUTO_MIN, cfg.neighbor.skinCap()));
   if (coulomb_list && nl_coul && coulomb_skin_follows)
-    nl_coul->setSkin(followingSkin(csetup.r_cut, slow.every * delta, COULOMB_LIST_BUILD_OVER_USE,
-                                   COULOMB_SKIN_AUTO_MIN, coulomb_skin_cap));
+    nl_coul->setSkin(followingSkin(slow_coulomb->setup().r_cut, slow.every * delta,
+                                   COULOMB_LIST_BUILD_OVER_USE, COULOMB_SKIN_AUTO_MIN,
+                                   coulomb_skin_cap));
 }
 
 ContactStep Engine::Impl::makeStep(double dt_taken, double slow_weight, double prev_weight) const {
@@ -194,18 +195,17 @@ ContactStep Engine::Impl::makeStep(double dt_taken, double slow_weight, double p
   st.step = step;
   st.charging = charging;
   if (coulomb) {
-    st.ext_fx = raw(ext_fx);
-    st.ext_fy = raw(ext_fy);
-    st.ext_fz = raw(ext_fz);
+    st.ext_fx = raw(slow_coulomb->force(0));
+    st.ext_fy = raw(slow_coulomb->force(1));
+    st.ext_fz = raw(slow_coulomb->force(2));
     st.ext_force_scale = slow_weight;
     // f_old holds prev_weight ext (ContactStep); with k = 1 both weights are 1 (the term
     // vanishes) and f_old's Coulomb part is the trend itself
     st.ext_predict_scale = 0.5 * dt_taken * (slow_weight - prev_weight);
-    st.fast = fast_switch;
+    st.fast = slow_coulomb->fastSwitch();
     st.coulomb_K = cfg.coulomb.K;
-    if (!fast_table.empty())
-      st.fast_table =
-          pairTable(raw(fast_table), fast_switch.r2 * fast_switch.r2, FAST_PAIR_TABLE_INTERVALS);
+    PairTable table;
+    if (slow_coulomb->fastTable(table)) st.fast_table = table;
   }
   return st;
 }
@@ -249,11 +249,11 @@ void Engine::Impl::smoothVelocities(DVec<double>& sx, DVec<double>& sy, DVec<dou
   const double c = velocityOffset();
   DVec<double> v[3];
   unpackVec3(p.vel, v[0], v[1], v[2]);
-  const DVec<double>* ext[3] = {&ext_fx, &ext_fy, &ext_fz};
   DVec<double>* out[3] = {&sx, &sy, &sz};
   for (int a = 0; a < 3; ++a) {
     out[a]->resize(p.size());
-    thrust::transform(v[a].begin(), v[a].end(), ext[a]->begin(), out[a]->begin(), Axpy{-c});
+    const DVec<double>& f = slow_coulomb->force(a);
+    thrust::transform(v[a].begin(), v[a].end(), f.begin(), out[a]->begin(), Axpy{-c});
   }
 }
 
@@ -512,10 +512,10 @@ Forces Engine::forces(StateKind kind) const {
   // physical: contact + Coulomb once
   const double w = d.coulomb ? 1.0 - d.slowWeight(d.step) : 0.0;
   if (kind == StateKind::Physical && w != 0.0) {
-    const DVec<double>* ext[3] = {&d.ext_fx, &d.ext_fy, &d.ext_fz};
     for (int a = 0; a < 3; ++a) {
       g[a].resize(d.p.size());
-      thrust::transform(f[a]->begin(), f[a]->end(), ext[a]->begin(), g[a].begin(), Axpy{w});
+      const DVec<double>& ext = d.slow_coulomb->force(a);
+      thrust::transform(f[a]->begin(), f[a]->end(), ext.begin(), g[a].begin(), Axpy{w});
       f[a] = &g[a];
     }
   }
@@ -531,13 +531,13 @@ EngineState Engine::engineState() const {
     e.ints["fresh_start"] = d.fresh_start ? 1 : 0;  // (a checkpoint before the first step)
   }
   if (!d.coulomb) return e;
-  e.arrays["coulomb_fx"] = toHostById(d.ext_fx, d.p.id);
-  e.arrays["coulomb_fy"] = toHostById(d.ext_fy, d.p.id);
-  e.arrays["coulomb_fz"] = toHostById(d.ext_fz, d.p.id);
+  e.arrays["coulomb_fx"] = toHostById(d.slow_coulomb->force(0), d.p.id);
+  e.arrays["coulomb_fy"] = toHostById(d.slow_coulomb->force(1), d.p.id);
+  e.arrays["coulomb_fz"] = toHostById(d.slow_coulomb->force(2), d.p.id);
   d.slow.save(e);
-  e.reals["coulomb_energy_ext"] = d.coulomb_ext_energy;
+  e.reals["coulomb_energy_ext"] = d.slow_coulomb->energy();
   // the split as resolved (withRecordedSplit): a restart keeps it whatever "auto" means then
-  e.reals["coulomb_r_fast"] = d.csetup.r_fast;
+  e.reals["coulomb_r_fast"] = d.slow_coulomb->setup().r_fast;
   return e;
 }
 
@@ -570,10 +570,7 @@ void Engine::restore(const Frame& s, const Forces& forces, std::int64_t collisio
       for (const auto* a : {&fx->second, &fy->second, &fz->second})
         if (a->size() != N)
           throw std::invalid_argument("checkpoint: Coulomb force arrays have the wrong length");
-      toDevice(fx->second, d.ext_fx);
-      toDevice(fy->second, d.ext_fy);
-      toDevice(fz->second, d.ext_fz);
-      d.coulomb_ext_energy = en->second;
+      d.slow_coulomb->restore(fx->second, fy->second, fz->second, en->second);
       d.slow.load(extra);  // (older checkpoints have no intervals: fixed, as configured)
     } else if (d.slow.every == 1) {
       d.slow.eval_step = -1;  // evaluated afresh at the next step, as every step

@@ -12,14 +12,10 @@
 #include "common/Box.h"
 #include "common/HostDevice.h"
 #include "md/compute/ContactForce.h"
-#include "md/compute/CoulombRealSpace.h"
-#include "md/coulomb/CoulombDesign.h"
-#include "md/coulomb/Ewald.h"
-#include "md/coulomb/Pppm.h"
-#include "md/coulomb/RealSpace.h"
 #include "md/engine/Engine.h"
 #include "md/engine/ParticleData.h"
 #include "md/engine/PhaseTimer.h"
+#include "md/engine/SlowCoulomb.h"
 #include "md/integrate/SlowSchedule.h"
 #include "md/neighbor/NeighborList.h"
 #include "md/potentials/ChargeExchange.h"
@@ -98,24 +94,16 @@ struct Engine::Impl {
   ChargeExchange::Params charging{};
   DVec<double> dq;  // charge gained at the last force pass, per slot (exchange only)
   // Coulomb (coulomb.K > 0): the slow force of the impulse multiple-time-step integrator
-  // (Engine.h), evaluated every coulomb.every steps into ext_f*: PPPM's real space over its own
-  // neighbour list nl_coul plus its mesh part, or a whole plain-Ewald evaluation
+  // (Engine.h), evaluated every coulomb.every steps by slow_coulomb: PPPM's real space over its
+  // own neighbour list nl_coul plus its mesh part, or a whole plain-Ewald evaluation
   bool coulomb = false;
   // when the slow force was evaluated and is next due (md/integrate/SlowSchedule.h); the next
   // interval is chosen at each evaluation (chooseEvery)
   SlowSchedule slow;
   std::int64_t slow_evaluations = 0;  // in this process (Engine::slowEvaluations)
-  CoulombSetup csetup;
-  std::unique_ptr<Pppm> pppm;
-  std::unique_ptr<EwaldReference> ewald;
-  std::unique_ptr<NeighborList> nl_coul;  // pppm: reaches r_cut + coulomb.skin
-  RealSpaceSwitch fast_switch{};  // pppm with every > 1: the real space within r_fast is fast
-  // ... and the slow and fast pair forces tabulated (PairTable), and the pair energy for the
-  // observables
-  DVec<double> slow_table, fast_table, energy_table;
-  double drift_since_coul_build = 0.0;  // as drift_since_build, for nl_coul
-  DVec<double> ext_fx, ext_fy, ext_fz;  // the Coulomb force at the last evaluation, per slot
-  double coulomb_ext_energy = 0.0;      // pppm: mesh + self + background; ewald: everything
+  std::unique_ptr<SlowCoulomb> slow_coulomb;  // the solvers and the last evaluation's force
+  std::unique_ptr<NeighborList> nl_coul;      // pppm: reaches r_cut + coulomb.skin
+  double drift_since_coul_build = 0.0;        // as drift_since_build, for nl_coul
   ContactModel contact;  // the contact model and its parameters (md/potentials/ContactModels.h)
   PhaseTimer timer;      // Engine::enableProfile
 
@@ -165,18 +153,11 @@ struct Engine::Impl {
   /// an exchanging gas starts neutral) and stored, so that a restart reuses them.
   void setupCoulomb(double sum_q2_design);
 
-  CoulombRealParams realParams() const;
-
-  /// Plain Ewald (the host reference) of the current positions and charges, per slot.
-  CoulombResult ewaldOnHost() const;
-
-  /// The Coulomb force of the current positions into ext_f* (and the energy of everything but the
-  /// PPPM real space into coulomb_ext_energy): PPPM real space over nl_coul plus the mesh part, or
-  /// everything for plain Ewald (host, O(N^2) real space).
+  /// The slow Coulomb force of the current positions (SlowCoulomb::evaluate), with the
+  /// interval's bookkeeping: the interval that ends here and the next one (chooseEvery).
   void evaluateCoulomb();
 
-  /// The slow Coulomb force of the current positions into ext_f* and coulomb_ext_energy
-  /// (evaluateCoulomb without the interval's bookkeeping).
+  /// The slow Coulomb force of the current positions, without the interval's bookkeeping.
   void evaluateSlowForce();
 
   /// The next slow interval (Engine.h, "multiple time stepping"). Fixed: every_base. Following
@@ -191,10 +172,10 @@ struct Engine::Impl {
 
   double slowWeight(std::int64_t at) const { return slow.weight(at); }
 
-  /// \param slow_weight weight of ext_f* in this step's force (0: not added)
+  /// \param slow_weight weight of the slow Coulomb force in this step's force (0: not added)
   ContactStep makeStep(double dt_taken, double slow_weight, double prev_weight) const;
 
-  /// a += c ext_f, per slot (a: the velocities or the forces).
+  /// a += c F_slow, per slot (a: the velocities or the forces).
   void addSlow(DVec<Vec3>& a, double c);
   void kickSlow(double c) { addSlow(p.vel, c); }
   void addSlowForce(double c) { addSlow(p.force, c); }

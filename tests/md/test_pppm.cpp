@@ -59,6 +59,40 @@ CoulombResult pppmTotal(Pppm& pppm, const Charges& c, double K) {
   return r;
 }
 
+/// The particles of `c` stored in reverse order, with their ids (id[s] = the index in c), and
+/// zeroed force arrays: a storage order that PPPM must not see (Pppm::compute with ids).
+struct Reversed {
+  std::vector<double> x, y, z, q, fx, fy, fz;
+  std::vector<int> id;
+  explicit Reversed(const Charges& c) {
+    const std::size_t n = c.x.size();
+    for (auto* v : {&x, &y, &z, &q}) v->resize(n);
+    for (auto* v : {&fx, &fy, &fz}) v->assign(n, 0.0);
+    id.resize(n);
+    for (std::size_t s = 0; s < n; ++s) {
+      const std::size_t i = n - 1 - s;
+      x[s] = c.x[i];
+      y[s] = c.y[i];
+      z[s] = c.z[i];
+      q[s] = c.q[i];
+      id[s] = static_cast<int>(i);
+    }
+  }
+  double compute(Pppm& pppm) {
+    return pppm.compute(x.data(), y.data(), z.data(), q.data(), x.size(), fx.data(), fy.data(),
+                        fz.data(), id.data());
+  }
+  /// Whether the forces equal r's, particle by particle.
+  bool sameForces(const CoulombResult& r) const {
+    bool same = true;
+    for (std::size_t s = 0; s < x.size(); ++s) {
+      const std::size_t i = x.size() - 1 - s;
+      same = same && fx[s] == r.fx[i] && fy[s] == r.fy[i] && fz[s] == r.fz[i];
+    }
+    return same;
+  }
+};
+
 double rmsForce(const CoulombResult& a) {
   double s = 0.0;
   for (std::size_t i = 0; i < a.fx.size(); ++i)
@@ -241,38 +275,23 @@ TEST_CASE("PPPM: results identical with 1 and 2 threads and independent of stora
                             // backend
   // storage order: the same particles stored reversed, with their ids, give bit-identical forces
   const std::size_t n = c.x.size();
-  std::vector<double> x(n), y(n), z(n), q(n), fx(n, 0.0), fy(n, 0.0), fz(n, 0.0);
-  std::vector<int> id(n);
-  for (std::size_t s = 0; s < n; ++s) {
-    const std::size_t i = n - 1 - s;
-    x[s] = c.x[i];
-    y[s] = c.y[i];
-    z[s] = c.z[i];
-    q[s] = c.q[i];
-    id[s] = static_cast<int>(i);
-  }
-  const double e = two.compute(x.data(), y.data(), z.data(), q.data(), n, fx.data(), fy.data(),
-                               fz.data(), id.data());
+  Reversed rev(c);
+  const double e = rev.compute(two);
   CHECK(e == r2.energy);
   // the packed (x, y, z, q) layout of the engine gives the same bits
   std::vector<double> pos4(4 * n), gx(n, 0.0), gy(n, 0.0), gz(n, 0.0);
   for (std::size_t s = 0; s < n; ++s) {
-    pos4[4 * s] = x[s];
-    pos4[4 * s + 1] = y[s];
-    pos4[4 * s + 2] = z[s];
-    pos4[4 * s + 3] = q[s];
+    pos4[4 * s] = rev.x[s];
+    pos4[4 * s + 1] = rev.y[s];
+    pos4[4 * s + 2] = rev.z[s];
+    pos4[4 * s + 3] = rev.q[s];
   }
-  CHECK(two.compute(pos4.data(), n, gx.data(), gy.data(), gz.data(), id.data()) == e);
-  CHECK(std::memcmp(gx.data(), fx.data(), bytes) == 0);
-  CHECK(std::memcmp(gz.data(), fz.data(), bytes) == 0);
-  bool same = true;
-  for (std::size_t s = 0; s < n; ++s) {
-    const std::size_t i = n - 1 - s;
-    same = same && fx[s] == r2.fx[i] && fy[s] == r2.fy[i] && fz[s] == r2.fz[i];
-  }
-  CHECK(same);
+  CHECK(two.compute(pos4.data(), n, gx.data(), gy.data(), gz.data(), rev.id.data()) == e);
+  CHECK(std::memcmp(gx.data(), rev.fx.data(), bytes) == 0);
+  CHECK(std::memcmp(gz.data(), rev.fz.data(), bytes) == 0);
+  CHECK(rev.sameForces(r2));
   // the energy alone (null forces: the engine's observables) is the same energy, to the bit
-  CHECK(two.compute(pos4.data(), n, nullptr, nullptr, nullptr, id.data()) == e);
+  CHECK(two.compute(pos4.data(), n, nullptr, nullptr, nullptr, rev.id.data()) == e);
   CHECK(two.lastEnergies().total() == e);
 #endif
 }
@@ -319,25 +338,9 @@ TEST_CASE("PPPM: the fixed-point charge assignment equals the tiles' to round-of
     CHECK(r1.energy == r2.energy);
 #if !defined(GRANAGG_CUDA)  // compute() takes device pointers (host memory on the OpenMP backend)
     // storage order: reversed, with ids, gives the same bits per particle
-    const std::size_t n = c.x.size();
-    std::vector<double> x(n), y(n), z(n), q(n), fx(n, 0.0), fy(n, 0.0), fz(n, 0.0);
-    std::vector<int> id(n);
-    for (std::size_t s = 0; s < n; ++s) {
-      const std::size_t i = n - 1 - s;
-      x[s] = c.x[i];
-      y[s] = c.y[i];
-      z[s] = c.z[i];
-      q[s] = c.q[i];
-      id[s] = static_cast<int>(i);
-    }
-    CHECK(fixed.compute(x.data(), y.data(), z.data(), q.data(), n, fx.data(), fy.data(),
-                        fz.data(), id.data()) == r1.energy);
-    bool same = true;
-    for (std::size_t s = 0; s < n; ++s) {
-      const std::size_t i = n - 1 - s;
-      same = same && fx[s] == r1.fx[i] && fy[s] == r1.fy[i] && fz[s] == r1.fz[i];
-    }
-    CHECK(same);
+    Reversed rev(c);
+    CHECK(rev.compute(fixed) == r1.energy);
+    CHECK(rev.sameForces(r1));
 #endif
   }
   // no charge at all: the scale has no bound to follow, and the mesh stays empty
