@@ -6,11 +6,19 @@ site-percolation threshold, and the density length l(t) of the structure factor;
 slopes of S_grid, S without the largest and l, per run, and their mean and standard error over
 the runs. A check and a figure, not a test; the numbers come from granagg analyze.
 
-usage: /usr/bin/python3 scripts/s_dominance.py OUT NAME=ANALYZE_DIR [NAME=ANALYZE_DIR ...]
+usage: /usr/bin/python3 scripts/s_dominance.py OUT NAME=SOURCE [NAME=SOURCE ...]
     [--ratio 2] [--t-min 50] [--length-only]
-writes OUT/<NAME>.csv (one row per frame time present in every run of that ensemble) and
+SOURCE is a `granagg analyze` folder (its per_run/S_t.csv) or such a per-run table itself, e.g.
+a committed docs/validation/S_*_runs.csv (one row per run and frame, with the run column).
+Writes OUT/<NAME>.csv (one row per frame time present in every run of that ensemble) and
 OUT/s_dominance.png; with --length-only the figure shows l(t) and its local slope alone (for
 ensembles that differ only in how l is measured, e.g. analyze's --structure-kcut).
+
+Each run's onset t_c is analyze's (docs/analysis.md, "onset"): the time at which S_grid first
+reaches ONSET_FACTOR = 2 times its early plateau, the median of S_grid over 0 < t <= 10,
+interpolated in (ln t, ln S). The figure's last row shows the local slopes against t - t_c (each
+run shifted by its own t_c, then interpolated onto a common log grid for the mean and standard
+error); OUT/<NAME>_onset.csv lists the onsets and those curves.
 """
 import argparse
 import math
@@ -23,6 +31,34 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import granagg_tables as gt  # noqa: E402
 
 P_C = 0.3116  # simple-cubic site percolation (Deng & Bloete, PRE 72, 016126 (2005): 0.311608)
+ONSET_FACTOR = 2.0  # analyze's --onset-factor default (analysis/pipeline/RunAnalyzer.h)
+ONSET_T_BASE = 10.0  # analyze's --onset-baseline default
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def repo_relative(path):
+    """path relative to the repository when it lies inside it (provenance lines name no machine)."""
+    full = os.path.abspath(path)
+    return os.path.relpath(full, REPO) if full.startswith(REPO + os.sep) else path
+
+
+def onset_time(t, s):
+    """analyze's onset (GrowthMarkers.h onsetTime): the first time S reaches ONSET_FACTOR x the
+    median S over 0 < t <= ONSET_T_BASE, interpolated linearly in (ln t, ln S) between the
+    bracketing frames; NaN when S never reaches it."""
+    t = np.asarray(t, float)
+    s = np.asarray(s, float)
+    base = s[(t > 0) & (t <= ONSET_T_BASE) & np.isfinite(s)]
+    if len(base) == 0:
+        return math.nan
+    target = ONSET_FACTOR * float(np.median(base))
+    for i in range(1, len(t)):
+        if s[i] >= target and t[i - 1] > 0 and s[i - 1] > 0:
+            if s[i - 1] >= target:
+                return t[i - 1]
+            f = (math.log(target) - math.log(s[i - 1])) / (math.log(s[i]) - math.log(s[i - 1]))
+            return math.exp(math.log(t[i - 1]) + f * (math.log(t[i]) - math.log(t[i - 1])))
+    return math.nan
 
 
 def local_slope(t, y, ratio):
@@ -43,10 +79,11 @@ def local_slope(t, y, ratio):
     return out
 
 
-def ensemble(folder, ratio, t_min):
-    per = gt.read(os.path.join(folder, "per_run", "S_t.csv"))
+def ensemble(source, ratio, t_min):
+    path = source if os.path.isfile(source) else os.path.join(source, "per_run", "S_t.csv")
+    per = gt.read(path)
     if per is None:
-        sys.exit(f"s_dominance.py: no per_run/S_t.csv in {folder} (run granagg analyze first)")
+        sys.exit(f"s_dominance.py: no per-run table at {path} (run granagg analyze first)")
     runs = sorted(set(int(r) for r in per["run"]))
     series = {}
     for r in runs:
@@ -58,6 +95,7 @@ def ensemble(folder, ratio, t_min):
             s[c] = rows[c]
         for c in ("S_grid", "S_grid_without_largest", "l_density"):
             s["z_" + c] = local_slope(t, rows[c], ratio)
+        s["t_c"] = onset_time(t, rows["S_grid"])
         series[r] = s
     # the frame times every run has (times rounded to 9 digits, as analyze matches them)
     key = lambda x: float("%.9g" % x)  # noqa: E731
@@ -87,6 +125,63 @@ def ensemble(folder, ratio, t_min):
     return names, np.array(table), series, runs
 
 
+SLOPES = ("z_S_grid", "z_S_grid_without_largest", "z_l_density")
+
+
+def since_onset(series, runs, points=40):
+    """The local slopes against tau = t - t_c: each run's slope interpolated in ln tau onto a
+    log grid spanning the tau range that every run with an onset covers; returns (tau, {z: (mean,
+    se, n)}) with NaN where fewer than two runs have a finite value, or None without onsets."""
+    have = [r for r in runs if np.isfinite(series[r]["t_c"])]
+    if not have:
+        return None
+    spans = []
+    for r in have:
+        tau = np.asarray(series[r]["t"], float) - series[r]["t_c"]
+        tau = tau[tau > 0]
+        spans.append((tau.min(), tau.max()))
+    lo, hi = max(a for a, _ in spans), min(b for _, b in spans)
+    if not lo < hi:
+        return None
+    grid = np.exp(np.linspace(math.log(lo), math.log(hi), points))
+    out = {}
+    for z in SLOPES:
+        vals = []
+        for r in have:
+            tau = np.asarray(series[r]["t"], float) - series[r]["t_c"]
+            y = np.asarray(series[r][z], float)
+            ok = (tau > 0) & np.isfinite(y)
+            vals.append(np.interp(np.log(grid), np.log(tau[ok]), y[ok], left=np.nan,
+                                  right=np.nan) if ok.sum() >= 2 else np.full(points, np.nan))
+        v = np.array(vals)
+        n = np.isfinite(v).sum(axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            m = np.nanmean(np.where(n >= 2, v, np.nan), axis=0)
+            se = np.nanstd(np.where(n >= 2, v, np.nan), axis=0, ddof=1) / np.sqrt(n)
+        out[z] = (m, se, n)
+    return grid, out
+
+
+def write_onset(path, name, series, runs, curves, argv):
+    """OUT/<NAME>_onset.csv: the runs' onsets, then the slopes against t - t_c."""
+    with open(path, "w") as f:
+        f.write(f"# command = /usr/bin/python3 scripts/s_dominance.py {' '.join(argv)}\n")
+        f.write(f"# onset t_c per run (S_grid reaches {ONSET_FACTOR:g} x its median over "
+                f"0 < t <= {ONSET_T_BASE:g}): " + "; ".join(
+                    f"run {r}: {series[r]['t_c']:.4g}" for r in runs) + "\n")
+        if curves is None:
+            f.write("# no run reached its onset\n")
+            return
+        grid, out = curves
+        f.write("# local slopes per run interpolated in ln(t - t_c); mean and standard error over "
+                "the runs (n_*: runs with a value)\n")
+        names = ["t_minus_t_c"] + [f"{z}_{k}" for z in SLOPES for k in ("mean", "se", "n")]
+        f.write(",".join(names) + "\n")
+        for i, tau in enumerate(grid):
+            row = [tau] + [x for z in SLOPES for x in (out[z][0][i], out[z][1][i], out[z][2][i])]
+            f.write(",".join("%.6g" % x for x in row) + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out")
@@ -103,17 +198,23 @@ def main():
             sys.exit(f"s_dominance.py: '{spec}' is not NAME=ANALYZE_DIR")
         name, folder = spec.split("=", 1)
         names, tab, series, runs = ensemble(folder, a.ratio, a.t_min)
+        argv = [repo_relative(x) if os.path.exists(x) else
+                (x.split("=", 1)[0] + "=" + repo_relative(x.split("=", 1)[1]) if "=" in x else x)
+                for x in sys.argv[1:]]
         path = os.path.join(a.out, name + ".csv")
         with open(path, "w") as f:
-            f.write(f"# command = /usr/bin/python3 scripts/s_dominance.py {' '.join(sys.argv[1:])}\n")
-            f.write(f"# source = {folder} (granagg analyze; runs {len(runs)})\n")
+            f.write(f"# command = /usr/bin/python3 scripts/s_dominance.py {' '.join(argv)}\n")
+            f.write(f"# source = {repo_relative(folder)} (granagg analyze; runs {len(runs)})\n")
             f.write(f"# local slopes z_* = ln[y(t)/y(t/{a.ratio:g})]/ln {a.ratio:g} per run, then "
                     "mean and standard error over the runs\n")
             f.write(",".join(names) + "\n")
             for row in tab:
                 f.write(",".join("%.6g" % x for x in row) + "\n")
-        results[name] = (names, tab)
-        print(f"wrote {path}")
+        curves = since_onset(series, runs)
+        onset_path = os.path.join(a.out, name + "_onset.csv")
+        write_onset(onset_path, name, series, runs, curves, argv)
+        results[name] = (names, tab, curves)
+        print(f"wrote {path} and {onset_path}")
 
     import matplotlib
     matplotlib.use("Agg")
@@ -121,8 +222,8 @@ def main():
     if a.length_only:
         plot_length(results, a, plt)
         return
-    fig, ax = plt.subplots(2, 2, figsize=(11, 8))
-    for k, (name, (names, tab)) in enumerate(results.items()):
+    fig, ax = plt.subplots(3, 2, figsize=(11, 12))
+    for k, (name, (names, tab, curves)) in enumerate(results.items()):
         c = {n: i for i, n in enumerate(names)}
         t = tab[:, 0]
         col = f"C{k}"
@@ -142,6 +243,15 @@ def main():
             m, se = tab[:, c[z + "_mean"]], tab[:, c[z + "_se"]]
             ax[1, 1].plot(t, m, color=col, ls=ls, label=f"{name}: {lab}")
             ax[1, 1].fill_between(t, m - se, m + se, color=col, alpha=0.15)
+        if curves is not None:
+            grid, out = curves
+            for z, ls, lab, panel in (("z_S_grid", "-", "S_grid", 0),
+                                      ("z_S_grid_without_largest", "--",
+                                       "S_grid without the largest", 0),
+                                      ("z_l_density", ":", "l", 1)):
+                m, se, _ = out[z]
+                ax[2, panel].plot(grid, m, color=col, ls=ls, label=f"{name}: {lab}")
+                ax[2, panel].fill_between(grid, m - se, m + se, color=col, alpha=0.15)
     ax[0, 1].axhline(P_C, color="k", lw=0.8)
     ax[0, 1].text(60, P_C * 1.1, "site percolation p_c = 0.3116", fontsize=8)
     for a_ in ax.flat:
@@ -156,6 +266,10 @@ def main():
     ax[1, 0].set_ylabel("density length l [d]")
     ax[1, 1].set_ylabel(f"local slope (ratio {a.ratio:g}), mean +- se over runs")
     ax[1, 1].axhline(0.5, color="k", lw=0.5)
+    for a_ in ax[2]:
+        a_.set_xlabel("t - t_c (each run's own onset)")
+        a_.set_ylabel(f"local slope (ratio {a.ratio:g}), mean +- se over runs")
+    ax[2, 1].axhline(0.5, color="k", lw=0.5)
     fig.tight_layout()
     png = os.path.join(a.out, "s_dominance.png")
     fig.savefig(png, dpi=110)
@@ -165,7 +279,7 @@ def main():
 def plot_length(results, a, plt):
     """l(t) and its local slope, mean +- standard error over the runs, one colour per ensemble."""
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
-    for k, (name, (names, tab)) in enumerate(results.items()):
+    for k, (name, (names, tab, _)) in enumerate(results.items()):
         c = {n: i for i, n in enumerate(names)}
         t = tab[:, 0]
         ax[0].errorbar(t, tab[:, c["l_density_mean"]], tab[:, c["l_density_se"]], color=f"C{k}",
