@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <thrust/copy.h>
+#include <thrust/scatter.h>
 
 #include "common/Box.h"
 #include "common/HostDevice.h"
@@ -35,6 +36,13 @@ std::vector<T> toHost(const DVec<T>& d) {
 template <class T>
 void toDevice(const std::vector<T>& h, DVec<T>& d) {
   d.assign(h.begin(), h.end());
+}
+/// Host copy in particle-id order: out[id[slot]] = d[slot].
+template <class T>
+std::vector<T> toHostById(const DVec<T>& d, const DVec<int>& id) {
+  DVec<T> tmp(d.size());
+  thrust::scatter(d.begin(), d.end(), id.begin(), tmp.begin());
+  return toHost(tmp);
 }
 
 /// Per particle: momentum, v^2 and |v| (sums over particles in id order: Engine::observables).
