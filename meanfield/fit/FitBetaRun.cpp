@@ -139,16 +139,11 @@ void checkFitBetaOutputs(const std::string& folder, bool curve_fit, bool force) 
   if (curve_fit) common::refuseToOverwrite(f.curve, force);
 }
 
-void writeFitBeta(const FitBetaResult& r, const std::string& folder,
-                  const std::string& command_line, const common::PaperValues& paper, bool force) {
-  const FitBetaFiles f = fitBetaFiles(folder);
-  const double nan = NaN;
-  // A beta at a bound of the search range is not a result: NaN in the CSVs, null in the JSON
-  // (the bound is in curve_fit_note). S_c, tau_c stay: the best curve at that bound.
-  const bool beta_fit_known = r.request.curve_fit && !r.curve.at_bound;
-  const double beta_fit = beta_fit_known ? r.curve.beta : nan;
-  const common::FolderLock lock = common::FolderLock::acquire(folder, command_line, force);
-  if (!r.request.curve_fit && force) fs::remove(f.curve);  // a stale curve would mislead
+namespace {
+
+/// The provenance shared by fit_beta.csv and fit_beta_curve.csv: the input, the window, the
+/// methods and their notes.
+common::Provenance fitBetaProvenance(const FitBetaResult& r, const std::string& command_line) {
   common::Provenance prov(command_line);
   prov.add("input", r.input.source);
   prov.add("column", r.input.column);
@@ -182,6 +177,12 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
   if (!r.curve.note.empty()) prov.add("curve_fit_note", r.curve.note);
   for (std::size_t i = 0; i < r.input.notes.size(); ++i)
     prov.add("note." + std::to_string(i), r.input.notes[i]);
+  return prov;
+}
+
+/// fit_beta.csv: one row, its columns named beside their values.
+void writeFitBetaCsv(const std::string& path, const common::Provenance& prov,
+                     const FitBetaResult& r, double beta_fit, bool force) {
   common::Provenance sp = prov;
   sp.add(
       "columns",
@@ -195,147 +196,149 @@ void writeFitBeta(const FitBetaResult& r, const std::string& folder,
           "beta_asymptotic*: 3 z / (3 - z) (the large-S law inverted) at z, z_low, z_high; "
           "beta_fit_determined: 0 when beta_fit lies at a bound of the search range (beta_fit "
           "is NaN then); NaN = not available"));
-  {
-    common::CsvWriter w(f.csv, sp,
-                        {"z",
-                         "z_low",
-                         "z_high",
-                         "t0",
-                         "t1",
-                         "n_points",
-                         "beta_from_z",
-                         "beta_from_z_low",
-                         "beta_from_z_high",
-                         "beta_fit",
-                         "beta_fit_low",
-                         "beta_fit_high",
-                         "S_c",
-                         "S_c_low",
-                         "S_c_high",
-                         "tau_c",
-                         "tau_c_low",
-                         "tau_c_high",
-                         "chi2_dof",
-                         "S0",
-                         "S1",
-                         "n_runs",
-                         "beta_from_z_scaled",
-                         "beta_from_z_scaled_low",
-                         "beta_from_z_scaled_high",
-                         "beta_asymptotic",
-                         "beta_asymptotic_low",
-                         "beta_asymptotic_high",
-                         "beta_fit_determined"},
-                        force);
-    w.row({r.z.z,
-           r.z.z_low,
-           r.z.z_high,
-           r.z.t0,
-           r.z.t1,
-           static_cast<double>(r.z.points),
-           r.from_z.beta,
-           r.from_z.beta_low,
-           r.from_z.beta_high,
-           beta_fit,
-           r.curve.beta_low,
-           r.curve.beta_high,
-           r.curve.S_c,
-           r.curve.S_c_low,
-           r.curve.S_c_high,
-           r.curve.tau_c,
-           r.curve.tau_c_low,
-           r.curve.tau_c_high,
-           r.curve.chi2_dof,
-           r.z.S0,
-           r.z.S1,
-           static_cast<double>(r.input.runs.size()),
-           r.from_z_scaled.beta,
-           r.from_z_scaled.beta_low,
-           r.from_z_scaled.beta_high,
-           r.asymptotic.beta,
-           r.asymptotic.beta_low,
-           r.asymptotic.beta_high,
-           !r.request.curve_fit ? nan : (r.curve.at_bound ? 0.0 : 1.0)});
-    w.close();
+  const std::vector<std::pair<const char*, double>> columns = {
+      {"z", r.z.z},
+      {"z_low", r.z.z_low},
+      {"z_high", r.z.z_high},
+      {"t0", r.z.t0},
+      {"t1", r.z.t1},
+      {"n_points", static_cast<double>(r.z.points)},
+      {"beta_from_z", r.from_z.beta},
+      {"beta_from_z_low", r.from_z.beta_low},
+      {"beta_from_z_high", r.from_z.beta_high},
+      {"beta_fit", beta_fit},
+      {"beta_fit_low", r.curve.beta_low},
+      {"beta_fit_high", r.curve.beta_high},
+      {"S_c", r.curve.S_c},
+      {"S_c_low", r.curve.S_c_low},
+      {"S_c_high", r.curve.S_c_high},
+      {"tau_c", r.curve.tau_c},
+      {"tau_c_low", r.curve.tau_c_low},
+      {"tau_c_high", r.curve.tau_c_high},
+      {"chi2_dof", r.curve.chi2_dof},
+      {"S0", r.z.S0},
+      {"S1", r.z.S1},
+      {"n_runs", static_cast<double>(r.input.runs.size())},
+      {"beta_from_z_scaled", r.from_z_scaled.beta},
+      {"beta_from_z_scaled_low", r.from_z_scaled.beta_low},
+      {"beta_from_z_scaled_high", r.from_z_scaled.beta_high},
+      {"beta_asymptotic", r.asymptotic.beta},
+      {"beta_asymptotic_low", r.asymptotic.beta_low},
+      {"beta_asymptotic_high", r.asymptotic.beta_high},
+      {"beta_fit_determined", !r.request.curve_fit ? NaN : (r.curve.at_bound ? 0.0 : 1.0)},
+  };
+  std::vector<std::string> names;
+  std::vector<double> values;
+  for (const auto& [name, value] : columns) {
+    names.emplace_back(name);
+    values.push_back(value);
   }
-  if (r.request.curve_fit) {
-    common::Provenance cp = prov;
-    cp.add(
-        "columns",
-        std::string(
-            "t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit) "
-            "(NaN when beta_fit is not determined); "
-            "S_mf_beta2, S_mf_beta3: the mean field for beta = 2 and 3 with the same S_c, tau_c"));
-    common::CsvWriter w(f.curve, cp, {"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"},
-                        force);
-    for (std::size_t i = 0; i < r.data.t.size(); ++i)
-      w.row({r.data.t[i], r.data.S[i], beta_fit_known ? r.curve.S_fitted[i] : nan,
-             r.S_mf_beta2[i], r.S_mf_beta3[i]});
-    w.close();
-  }
-  {
-    nlohmann::ordered_json j;
-    j["version"] = common::versionString();
-    j["command"] = command_line;
-    j["input"] = r.input.source;
-    j["column"] = r.input.column;
-    j["n_runs"] = static_cast<long long>(r.input.runs.size());
-    j["samples"] = static_cast<long long>(r.data.t.size());
-    j["confidence"] = num(r.bootstrap.confidence);
-    j["z"] = num(r.z.z);
-    j["z_low"] = num(r.z.z_low);
-    j["z_high"] = num(r.z.z_high);
-    j["z_interval_method"] = r.z.interval_method;
-    j["z_note"] = r.z.note;
-    j["t0"] = num(r.z.t0);
-    j["t1"] = num(r.z.t1);
-    j["n_points"] = r.z.points;
-    j["window_automatic"] = r.window.automatic;
-    j["window_rule"] = r.window.rule;
-    j["S0"] = num(r.z.S0);
-    j["S1"] = num(r.z.S1);
-    j["beta_from_z"] = num(r.from_z.beta);
-    j["beta_from_z_low"] = num(r.from_z.beta_low);
-    j["beta_from_z_high"] = num(r.from_z.beta_high);
-    j["beta_from_z_note"] = r.from_z.note;
-    j["beta_from_z_scaled"] = num(r.from_z_scaled.beta);
-    j["beta_from_z_scaled_low"] = num(r.from_z_scaled.beta_low);
-    j["beta_from_z_scaled_high"] = num(r.from_z_scaled.beta_high);
-    j["beta_from_z_scaled_note"] = r.from_z_scaled.note;
-    j["beta_asymptotic"] = num(r.asymptotic.beta);
-    j["beta_asymptotic_low"] = num(r.asymptotic.beta_low);
-    // +inf (z_high >= 3) is written as null like NaN; the note says which
-    j["beta_asymptotic_high"] = num(r.asymptotic.beta_high);
-    j["beta_asymptotic_note"] = r.asymptotic.note;
-    j["z_mf_at_beta_min"] = num(r.from_z.z_at_beta_min);
-    j["z_mf_at_beta_max"] = num(r.from_z.z_at_beta_max);
-    j["z_mf_beta2_window"] = num(r.z_mf_beta2);
-    j["z_mf_beta3_window"] = num(r.z_mf_beta3);
-    j["curve_fit"] = r.request.curve_fit;
-    j["beta_fit_determined"] = beta_fit_known;
-    j["beta_fit"] = num(beta_fit);
-    j["beta_fit_low"] = num(r.curve.beta_low);
-    j["beta_fit_high"] = num(r.curve.beta_high);
-    j["S_c"] = num(r.curve.S_c);
-    j["S_c_low"] = num(r.curve.S_c_low);
-    j["S_c_high"] = num(r.curve.S_c_high);
-    j["tau_c"] = num(r.curve.tau_c);
-    j["tau_c_low"] = num(r.curve.tau_c_low);
-    j["tau_c_high"] = num(r.curve.tau_c_high);
-    j["chi2_dof"] = num(r.curve.chi2_dof);
-    j["curve_interval_method"] = r.curve.interval_method;
-    j["curve_fit_note"] = r.curve.note;
-    j["beta_min"] = num(r.request.beta_min);
-    j["beta_max"] = num(r.request.beta_max);
-    j["paper_z_neutral"] = num(paper.z_neutral);
-    j["paper_z_neutral_err"] = num(paper.z_neutral_pm);
-    j["paper_z_charged"] = num(paper.z_charged);
-    j["paper_z_charged_err"] = num(paper.z_charged_pm);
-    j["paper_z_mf_beta2"] = num(paper.z_meanfield_beta2);
-    j["paper_z_mf_beta3"] = num(paper.z_meanfield_beta3);
-    j["notes"] = r.input.notes;
-    writeJson(f.json, j);
-  }
+  common::CsvWriter w(path, sp, names, force);
+  w.row(values);
+  w.close();
+}
+
+/// fit_beta_curve.csv: the data beside the fitted mean field and the beta = 2, 3 curves.
+void writeFitBetaCurve(const std::string& path, const common::Provenance& prov,
+                       const FitBetaResult& r, bool beta_fit_known, bool force) {
+  common::Provenance cp = prov;
+  cp.add(
+      "columns",
+      std::string(
+          "t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit) "
+          "(NaN when beta_fit is not determined); "
+          "S_mf_beta2, S_mf_beta3: the mean field for beta = 2 and 3 with the same S_c, tau_c"));
+  common::CsvWriter w(path, cp, {"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"},
+                      force);
+  for (std::size_t i = 0; i < r.data.t.size(); ++i)
+    w.row({r.data.t[i], r.data.S[i], beta_fit_known ? r.curve.S_fitted[i] : NaN,
+           r.S_mf_beta2[i], r.S_mf_beta3[i]});
+  w.close();
+}
+
+/// fit_beta.json: every number of the result with the paper's values beside them (NaN and inf as
+/// null; the notes say which).
+nlohmann::ordered_json fitBetaJson(const FitBetaResult& r, const std::string& command_line,
+                                   const common::PaperValues& paper, bool beta_fit_known,
+                                   double beta_fit) {
+  nlohmann::ordered_json j;
+  j["version"] = common::versionString();
+  j["command"] = command_line;
+  j["input"] = r.input.source;
+  j["column"] = r.input.column;
+  j["n_runs"] = static_cast<long long>(r.input.runs.size());
+  j["samples"] = static_cast<long long>(r.data.t.size());
+  j["confidence"] = num(r.bootstrap.confidence);
+  j["z"] = num(r.z.z);
+  j["z_low"] = num(r.z.z_low);
+  j["z_high"] = num(r.z.z_high);
+  j["z_interval_method"] = r.z.interval_method;
+  j["z_note"] = r.z.note;
+  j["t0"] = num(r.z.t0);
+  j["t1"] = num(r.z.t1);
+  j["n_points"] = r.z.points;
+  j["window_automatic"] = r.window.automatic;
+  j["window_rule"] = r.window.rule;
+  j["S0"] = num(r.z.S0);
+  j["S1"] = num(r.z.S1);
+  j["beta_from_z"] = num(r.from_z.beta);
+  j["beta_from_z_low"] = num(r.from_z.beta_low);
+  j["beta_from_z_high"] = num(r.from_z.beta_high);
+  j["beta_from_z_note"] = r.from_z.note;
+  j["beta_from_z_scaled"] = num(r.from_z_scaled.beta);
+  j["beta_from_z_scaled_low"] = num(r.from_z_scaled.beta_low);
+  j["beta_from_z_scaled_high"] = num(r.from_z_scaled.beta_high);
+  j["beta_from_z_scaled_note"] = r.from_z_scaled.note;
+  j["beta_asymptotic"] = num(r.asymptotic.beta);
+  j["beta_asymptotic_low"] = num(r.asymptotic.beta_low);
+  // +inf (z_high >= 3) is written as null like NaN; the note says which
+  j["beta_asymptotic_high"] = num(r.asymptotic.beta_high);
+  j["beta_asymptotic_note"] = r.asymptotic.note;
+  j["z_mf_at_beta_min"] = num(r.from_z.z_at_beta_min);
+  j["z_mf_at_beta_max"] = num(r.from_z.z_at_beta_max);
+  j["z_mf_beta2_window"] = num(r.z_mf_beta2);
+  j["z_mf_beta3_window"] = num(r.z_mf_beta3);
+  j["curve_fit"] = r.request.curve_fit;
+  j["beta_fit_determined"] = beta_fit_known;
+  j["beta_fit"] = num(beta_fit);
+  j["beta_fit_low"] = num(r.curve.beta_low);
+  j["beta_fit_high"] = num(r.curve.beta_high);
+  j["S_c"] = num(r.curve.S_c);
+  j["S_c_low"] = num(r.curve.S_c_low);
+  j["S_c_high"] = num(r.curve.S_c_high);
+  j["tau_c"] = num(r.curve.tau_c);
+  j["tau_c_low"] = num(r.curve.tau_c_low);
+  j["tau_c_high"] = num(r.curve.tau_c_high);
+  j["chi2_dof"] = num(r.curve.chi2_dof);
+  j["curve_interval_method"] = r.curve.interval_method;
+  j["curve_fit_note"] = r.curve.note;
+  j["beta_min"] = num(r.request.beta_min);
+  j["beta_max"] = num(r.request.beta_max);
+  j["paper_z_neutral"] = num(paper.z_neutral);
+  j["paper_z_neutral_err"] = num(paper.z_neutral_pm);
+  j["paper_z_charged"] = num(paper.z_charged);
+  j["paper_z_charged_err"] = num(paper.z_charged_pm);
+  j["paper_z_mf_beta2"] = num(paper.z_meanfield_beta2);
+  j["paper_z_mf_beta3"] = num(paper.z_meanfield_beta3);
+  j["notes"] = r.input.notes;
+  return j;
+}
+
+}  // namespace
+
+void writeFitBeta(const FitBetaResult& r, const std::string& folder,
+                  const std::string& command_line, const common::PaperValues& paper, bool force) {
+  const FitBetaFiles f = fitBetaFiles(folder);
+  // A beta at a bound of the search range is not a result: NaN in the CSVs, null in the JSON
+  // (the bound is in curve_fit_note). S_c, tau_c stay: the best curve at that bound.
+  const bool beta_fit_known = r.request.curve_fit && !r.curve.at_bound;
+  const double beta_fit = beta_fit_known ? r.curve.beta : NaN;
+  const common::FolderLock lock = common::FolderLock::acquire(folder, command_line, force);
+  if (!r.request.curve_fit && force) fs::remove(f.curve);  // a stale curve would mislead
+  const common::Provenance prov = fitBetaProvenance(r, command_line);
+  writeFitBetaCsv(f.csv, prov, r, beta_fit, force);
+  if (r.request.curve_fit) writeFitBetaCurve(f.curve, prov, r, beta_fit_known, force);
+  writeJson(f.json, fitBetaJson(r, command_line, paper, beta_fit_known, beta_fit));
 }
 
 std::vector<std::string> fitBetaReport(const FitBetaResult& r, const common::PaperValues& paper) {
