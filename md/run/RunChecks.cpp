@@ -53,9 +53,10 @@ void checkMemory(const MdConfig& c) {
   if (need > machine)
     throw std::invalid_argument(
         "system.N = " + std::to_string(c.system.N) + " needs about " + gigabytes(need) +
-        " of memory (at least " + common::formatShort(per_particle) + " bytes per particle for the engine's " +
-        what + "), more than this machine's " + gigabytes(machine) +
-        ": lower system.N (to at most " + common::formatShort(std::floor(machine / per_particle)) + " here)");
+        " of memory (at least " + common::formatShort(per_particle) +
+        " bytes per particle for the engine's " + what + "), more than this machine's " +
+        gigabytes(machine) + ": lower system.N (to at most " +
+        common::formatShort(std::floor(machine / per_particle)) + " here)");
 }
 
 }  // namespace
@@ -64,13 +65,15 @@ void checkSchedule(const MdConfig& c) {
   std::string why;
   const double dt = Engine::chooseTimeStep(c, &why);
   if (!(dt > 0.0) || !std::isfinite(dt))
-    throw std::invalid_argument("integrator.dt: the time step is " + common::formatShort(dt) + " (" + why +
+    throw std::invalid_argument("integrator.dt: the time step is " + common::formatShort(dt) +
+                                " (" + why +
                                 "): it must be positive and finite; check contact.* or give "
                                 "integrator.dt");
   const double steps = c.run.t_end / dt;
   if (!(steps <= MAX_STEPS))
-    throw std::invalid_argument("run.t_end = " + common::formatShort(c.run.t_end) + " at dt = " + common::formatShort(dt) +
-                                " is " + common::formatShort(steps) + " steps, more than 1e12: lower run.t_end");
+    throw std::invalid_argument(
+        "run.t_end = " + common::formatShort(c.run.t_end) + " at dt = " + common::formatShort(dt) +
+        " is " + common::formatShort(steps) + " steps, more than 1e12: lower run.t_end");
   double frames = 0.0;
   if (c.output.frames_per_decade > 0) {
     const double t0 = std::max(0.01, dt);
@@ -80,11 +83,10 @@ void checkSchedule(const MdConfig& c) {
   if (!(frames <= MAX_FRAMES))
     throw std::invalid_argument(
         "output.frames_per_decade = " + std::to_string(c.output.frames_per_decade) +
-        " and output.frame_interval = " + common::formatShort(c.output.frame_interval) + " ask for " +
-        common::formatShort(std::round(frames)) + " frames up to run.t_end = " + common::formatShort(c.run.t_end) +
-        ", more than 1e6: space them further apart");
+        " and output.frame_interval = " + common::formatShort(c.output.frame_interval) +
+        " ask for " + common::formatShort(std::round(frames)) + " frames up to run.t_end = " +
+        common::formatShort(c.run.t_end) + ", more than 1e6: space them further apart");
   checkMemory(c);
 }
-
 
 }  // namespace granagg::md

@@ -107,8 +107,9 @@ BetaFromZ betaFromZ(MeanFieldCurves& curves, double z, double z_low, double z_hi
     if (!std::isfinite(zt)) return NaN;
     if (zt <= out.z_at_beta_min || zt >= out.z_at_beta_max) {
       const bool below = zt <= out.z_at_beta_min;
-      note += std::string(what) + " = " + common::formatShort(zt) + " lies " + (below ? "below" : "above") +
-              " the mean-field z = " + common::formatShort(below ? out.z_at_beta_min : out.z_at_beta_max) +
+      note += std::string(what) + " = " + common::formatShort(zt) + " lies " +
+              (below ? "below" : "above") + " the mean-field z = " +
+              common::formatShort(below ? out.z_at_beta_min : out.z_at_beta_max) +
               " at beta = " + formatReal(below ? beta_min : beta_max) +
               (central ? ": no beta" : ": clamped to the range") + ". ";
       return central ? NaN : (below ? beta_min : beta_max);

@@ -71,10 +71,10 @@ FitBetaResult runFitBeta(GrowthInput input, const FitBetaRequest& request) {
   }
   const int minPoints = request.min_points;
   if (r.data.t.size() < static_cast<std::size_t>(minPoints))
-    throw std::invalid_argument(
-        "INPUT " + L.source + ": too few points (" + std::to_string(r.data.t.size()) +
-        " usable samples, at least " + std::to_string(minPoints) + " needed" +
-        (dropped.empty() ? std::string() : "; " + dropped) + ").");
+    throw std::invalid_argument("INPUT " + L.source + ": too few points (" +
+                                std::to_string(r.data.t.size()) + " usable samples, at least " +
+                                std::to_string(minPoints) + " needed" +
+                                (dropped.empty() ? std::string() : "; " + dropped) + ").");
 
   // 1. z over the window.
   WindowOptions wo;
@@ -242,17 +242,15 @@ void writeFitBetaCsv(const std::string& path, const common::Provenance& prov,
 void writeFitBetaCurve(const std::string& path, const common::Provenance& prov,
                        const FitBetaResult& r, bool beta_fit_known, bool force) {
   common::Provenance cp = prov;
-  cp.add(
-      "columns",
-      std::string(
-          "t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit) "
-          "(NaN when beta_fit is not determined); "
-          "S_mf_beta2, S_mf_beta3: the mean field for beta = 2 and 3 with the same S_c, tau_c"));
-  common::CsvWriter w(path, cp, {"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"},
-                      force);
+  cp.add("columns",
+         std::string(
+             "t, S_md: the data (mean over runs); S_mf_fitted = S_c S_MF(t/tau_c; beta_fit) "
+             "(NaN when beta_fit is not determined); "
+             "S_mf_beta2, S_mf_beta3: the mean field for beta = 2 and 3 with the same S_c, tau_c"));
+  common::CsvWriter w(path, cp, {"t", "S_md", "S_mf_fitted", "S_mf_beta2", "S_mf_beta3"}, force);
   for (std::size_t i = 0; i < r.data.t.size(); ++i)
-    w.row({r.data.t[i], r.data.S[i], beta_fit_known ? r.curve.S_fitted[i] : NaN,
-           r.S_mf_beta2[i], r.S_mf_beta3[i]});
+    w.row({r.data.t[i], r.data.S[i], beta_fit_known ? r.curve.S_fitted[i] : NaN, r.S_mf_beta2[i],
+           r.S_mf_beta3[i]});
   w.close();
 }
 

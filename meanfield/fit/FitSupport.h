@@ -20,7 +20,8 @@ constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 using common::stats::median;
 
 /// Mean over the runs chosen by `pick` (indices into data.runs), at every time.
-inline std::vector<double> resampledMean(const GrowthData& data, const std::vector<std::size_t>& pick) {
+inline std::vector<double> resampledMean(const GrowthData& data,
+                                         const std::vector<std::size_t>& pick) {
   std::vector<double> S(data.t.size(), 0.0);
   for (std::size_t r : pick)
     for (std::size_t i = 0; i < S.size(); ++i) S[i] += data.runs[r][i];
@@ -46,7 +47,7 @@ struct Rng {
 
 /// OLS slope and intercept of y on x (common/Statistics.h).
 inline void ols(const std::vector<double>& x, const std::vector<double>& y, double& slope,
-         double& intercept, double& se_slope) {
+                double& intercept, double& se_slope) {
   const common::stats::LineFit f = common::stats::fitLine(x, y);
   slope = f.slope;
   intercept = f.intercept;
@@ -55,12 +56,11 @@ inline void ols(const std::vector<double>& x, const std::vector<double>& y, doub
 
 /// The bootstrap interval rule of common/Statistics.h, into low and high.
 inline void bootstrapInterval(const std::vector<double>& values, double estimate, std::size_t runs,
-                       double confidence, double& low, double& high) {
+                              double confidence, double& low, double& high) {
   const common::stats::Interval in =
       common::stats::bootstrapInterval(values, estimate, runs, confidence);
   low = in.low;
   high = in.high;
 }
-
 
 }  // namespace granagg::meanfield::detail

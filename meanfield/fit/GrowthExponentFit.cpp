@@ -46,8 +46,9 @@ ZFit fitGrowthExponent(const GrowthData& data, const SlopeWindow& window,
     f.points = static_cast<int>(idx.size());
     f.confidence = o.confidence;
     f.interval_method = "none";
-    f.note = "S is " + common::formatShort(f.S0) + " at every sample of the window [" + common::formatShort(f.t0) +
-             ", " + common::formatShort(f.t1) + "]: it does not grow, no growth exponent.";
+    f.note = "S is " + common::formatShort(f.S0) + " at every sample of the window [" +
+             common::formatShort(f.t0) + ", " + common::formatShort(f.t1) +
+             "]: it does not grow, no growth exponent.";
     return f;
   }
   double c0, se;

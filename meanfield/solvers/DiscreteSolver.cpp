@@ -53,21 +53,68 @@ Moments moments(const double* n, int M) {
   return m;
 }
 
+/// The initial n_k (k = 1..len; n_1 = 1 without `initial`), checked against the largest size.
+std::vector<double> initialDistribution(const std::vector<double>* initial, int max_size) {
+  std::vector<double> n0 = initial ? *initial : std::vector<double>{1.0};
+  if (n0.empty()) throw std::invalid_argument("the initial distribution is empty.");
+  for (double v : n0)
+    if (!(v >= 0.0) || !std::isfinite(v))
+      throw std::invalid_argument("initial number densities must be >= 0 and finite.");
+  if (static_cast<int>(n0.size()) > max_size)
+    throw std::invalid_argument("the initial distribution has sizes up to " +
+                                std::to_string(n0.size()) +
+                                ", beyond the largest size M = " + std::to_string(max_size) + ".");
+  return n0;
+}
+
+/// The moments of n_1..n_M at time t, with the mass lost since M1(0) = M1_0.
+MomentSample sample(double t, const double* n, int M, double M1_0, double mass_loss_tolerance) {
+  const Moments m = moments(n, M);
+  MomentSample s;
+  s.t = t;
+  s.M0 = m.M0;
+  s.M1 = m.M1;
+  s.M2 = m.M2;
+  s.S = m.M2 / m.M1;
+  s.mass_loss = (M1_0 - m.M1) / M1_0;
+  s.valid = std::fabs(s.mass_loss) <= mass_loss_tolerance;
+  s.max_size = M;
+  return s;
+}
+
+/// n_k for k = 1..min(max_size, M) at time t.
+Snapshot snapshot(double t, const std::vector<double>& n, int M, int max_size) {
+  Snapshot snap;
+  snap.t = t;
+  const int kmax = std::min(max_size, M);
+  for (int k = 1; k <= kmax; ++k) {
+    snap.size.push_back(k);
+    snap.n.push_back(n[k - 1]);
+  }
+  return snap;
+}
+
+/// The stop of a run whose sample `s` lost (or gained) more mass than allowed, over M sizes.
+void stopOnMassLoss(const MomentSample& s, int M, const DiscreteOptions& o, SmolResult& res) {
+  const std::string head = "relative mass loss " + common::formatReal(s.mass_loss) +
+                           " at t = " + common::formatReal(s.t) + " exceeds the tolerance " +
+                           common::formatReal(o.mass_loss_tolerance) +
+                           " (S = " + common::formatReal(s.S) + "): ";
+  res.stop_cause = s.mass_loss > 0.0 ? StopCause::Truncation : StopCause::MassGained;
+  res.stopped_early =
+      s.mass_loss > 0.0
+          ? head + "the size range M = " + std::to_string(M) +
+                (M >= o.max_size ? " (the largest allowed)" : "") + " truncates the distribution"
+          : head + "mass was gained, an integration error (Adams conserves mass to round-off)";
+}
+
 }  // namespace
 
 SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o,
                          const std::vector<double>* initial) {
   validate(o);
   const auto wall0 = std::chrono::steady_clock::now();
-  std::vector<double> n0 = initial ? *initial : std::vector<double>{1.0};
-  if (n0.empty()) throw std::invalid_argument("the initial distribution is empty.");
-  for (double v : n0)
-    if (!(v >= 0.0) || !std::isfinite(v))
-      throw std::invalid_argument("initial number densities must be >= 0 and finite.");
-  if (static_cast<int>(n0.size()) > o.max_size)
-    throw std::invalid_argument(
-        "the initial distribution has sizes up to " + std::to_string(n0.size()) +
-        ", beyond the largest size M = " + std::to_string(o.max_size) + ".");
+  const std::vector<double> n0 = initialDistribution(initial, o.max_size);
   const double M1_0 = moments(n0.data(), static_cast<int>(n0.size())).M1;
   if (!(M1_0 > 0.0)) throw std::invalid_argument("the initial distribution has no mass.");
 
@@ -110,41 +157,13 @@ SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o,
       const double t = o.times[iout++];
       buf.resize(M);
       solver->interpolate(t, buf.data());
-      const Moments m = moments(buf.data(), M);
-      MomentSample s;
-      s.t = t;
-      s.M0 = m.M0;
-      s.M1 = m.M1;
-      s.M2 = m.M2;
-      s.S = m.M2 / m.M1;
-      s.mass_loss = (M1_0 - m.M1) / M1_0;
-      s.valid = std::fabs(s.mass_loss) <= o.mass_loss_tolerance;
-      s.max_size = M;
+      const MomentSample s = sample(t, buf.data(), M, M1_0, o.mass_loss_tolerance);
       res.samples.push_back(s);
-      if (o.snapshot_max_size > 0) {
-        Snapshot snap;
-        snap.t = t;
-        const int kmax = std::min(o.snapshot_max_size, M);
-        for (int k = 1; k <= kmax; ++k) {
-          snap.size.push_back(k);
-          snap.n.push_back(buf[k - 1]);
-        }
-        res.snapshots.push_back(std::move(snap));
-      }
+      if (o.snapshot_max_size > 0)
+        res.snapshots.push_back(snapshot(t, buf, M, o.snapshot_max_size));
       if (o.on_sample) o.on_sample(s);
       if (!s.valid && o.stop_on_truncation) {
-        const std::string head = "relative mass loss " + common::formatReal(s.mass_loss) +
-                                 " at t = " + common::formatReal(t) + " exceeds the tolerance " +
-                                 common::formatReal(o.mass_loss_tolerance) +
-                                 " (S = " + common::formatReal(s.S) + "): ";
-        res.stop_cause = s.mass_loss > 0.0 ? StopCause::Truncation : StopCause::MassGained;
-        res.stopped_early =
-            s.mass_loss > 0.0
-                ? head + "the size range M = " + std::to_string(M) +
-                      (M >= o.max_size ? " (the largest allowed)" : "") +
-                      " truncates the distribution"
-                : head + "mass was gained, an integration error (Adams conserves mass to "
-                         "round-off)";
+        stopOnMassLoss(s, M, o, res);
         done = true;
         break;
       }

@@ -235,15 +235,110 @@ SectionalGrid makeSectionalGrid(double ratio, double max_size) {
   checkRatio(ratio);
   if (!(max_size >= 2.0 && max_size <= SECTIONAL_MAX_PIVOT))
     throw std::invalid_argument("sectional max_size must lie in [2, " +
-                                formatReal(SECTIONAL_MAX_PIVOT) + "] (got " +
-                                formatReal(max_size) + ").");
+                                formatReal(SECTIONAL_MAX_PIVOT) + "] (got " + formatReal(max_size) +
+                                ").");
   SectionalGrid g = buildGrid(ratio, max_size, MAX_SECTIONS + 1);
   if (g.pivots.size() > static_cast<size_t>(MAX_SECTIONS))
-    throw std::invalid_argument("sectional grid with ratio " + formatReal(ratio) +
-                                " up to size " + formatReal(max_size) + " needs more than " +
+    throw std::invalid_argument("sectional grid with ratio " + formatReal(ratio) + " up to size " +
+                                formatReal(max_size) + " needs more than " +
                                 std::to_string(MAX_SECTIONS) + " sections: raise the ratio.");
   return g;
 }
+
+namespace {
+
+/// The initial state on the pivots, with the escaped mass last (zero): n_k for k = 1..len split
+/// onto the two pivots around k, conserving number and mass; without `initial`, n_1 = 1.
+std::vector<double> initialSections(const SectionalGrid& grid, const std::vector<double>* initial,
+                                    double max_size) {
+  using common::formatReal;
+  std::vector<double> y(grid.pivots.size() + 1, 0.0);
+  if (!initial) {
+    y[0] = 1.0;  // monodisperse n_1 = 1
+    return y;
+  }
+  if (initial->empty()) throw std::invalid_argument("sectional initial distribution is empty.");
+  for (size_t k = 0; k < initial->size(); ++k) {
+    const double n = (*initial)[k];
+    if (!(n >= 0.0) || !std::isfinite(n))
+      throw std::invalid_argument("sectional initial n_k must be finite and >= 0 (got " +
+                                  formatReal(n) + " at k = " + std::to_string(k + 1) + ").");
+    if (n == 0.0) continue;
+    int t;
+    double b;
+    splitSize(grid.pivots, static_cast<double>(k + 1), t, b);
+    if (t < 0)
+      throw std::invalid_argument("sectional initial distribution reaches size " +
+                                  std::to_string(k + 1) + ", beyond max_size " +
+                                  formatReal(max_size) + ".");
+    y[t] += (1.0 - b) * n;
+    y[t + 1] += b * n;
+  }
+  return y;
+}
+
+/// Gelling kernels: the solution exists only before t_gel = 1 / (K0 M2(0)) (Ziff 1980 for
+/// K = K0 i j); other gelling kernels have no known gel time and are refused.
+void checkGelTime(const Kernel& kernel, double t_last, double M2_0) {
+  using common::formatReal;
+  if (kernel.type() == KernelType::Multiplicative) {
+    const double t_gel = 1.0 / (kernel.K0() * M2_0);
+    if (t_last >= t_gel)
+      throw std::invalid_argument(
+          "sectional times must stay before the gel time 1/(K0 M2(0)) = " + formatReal(t_gel) +
+          " of the multiplicative kernel (got " + formatReal(t_last) + ").");
+  } else if (kernel.gels()) {
+    throw std::invalid_argument("sectional solver: kernel '" + kernel.name() +
+                                "' gels; no gel time known.");
+  }
+}
+
+/// The moments of the sections y (pivots x) at time t, with the mass lost since M1(0) = M1_0.
+MomentSample sectionMoments(double t, const std::vector<double>& x, const std::vector<double>& y,
+                            double M1_0, double mass_loss_tolerance) {
+  MomentSample s;
+  s.t = t;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double N = y[i];
+    s.M0 += N;
+    s.M1 += x[i] * N;
+    s.M2 += x[i] * x[i] * N;
+  }
+  s.S = s.M2 / s.M1;
+  s.mass_loss = (M1_0 - s.M1) / M1_0;
+  s.valid = std::fabs(s.mass_loss) <= mass_loss_tolerance;
+  return s;
+}
+
+/// The stop of a run whose sample `s` lost (or gained) more mass than allowed: its cause and the
+/// message that names the grid's limit (last pivot `x_last`).
+void stopOnMassLoss(const MomentSample& s, const SectionalOptions& options, double x_last,
+                    SmolResult& result) {
+  using common::formatReal;
+  const std::string head = "mass loss " + formatReal(s.mass_loss) + " at t = " + formatReal(s.t) +
+                           " exceeds mass_loss_tolerance " +
+                           formatReal(options.mass_loss_tolerance);
+  if (s.mass_loss < 0.0) {
+    result.stop_cause = StopCause::MassGained;
+    result.stopped_early = head + ": mass was gained, an integration error";
+    return;
+  }
+  result.stop_cause = StopCause::Truncation;
+  std::string limit = "the grid holds its most sections, " + std::to_string(MAX_SECTIONS) +
+                      ", at ratio " + formatReal(options.ratio);
+  if (!options.grow) {
+    limit = "the grid is fixed";
+  } else if (x_last >= options.max_size) {
+    limit = "the largest size allowed, max_size " + formatReal(options.max_size);
+  } else if (x_last >= SECTIONAL_MAX_PIVOT) {
+    result.stop_cause = StopCause::SizeCeiling;
+    limit = "no grid goes beyond " + formatReal(SECTIONAL_MAX_PIVOT);
+  }
+  result.stopped_early = head + ": aggregates left the grid beyond its last pivot " +
+                         formatReal(x_last) + " (" + limit + ")";
+}
+
+}  // namespace
 
 SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
                           const std::vector<double>* initial) {
@@ -259,48 +354,14 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
   SectionalGrid grid = options.grow ? buildGrid(options.ratio, first_top, MAX_SECTIONS)
                                     : makeSectionalGrid(options.ratio, first_top);
 
-  // Initial state: n_k for k = 1..len onto the pivots (number- and mass-conserving split).
-  std::vector<double> y(grid.pivots.size() + 1, 0.0);
-  if (initial) {
-    if (initial->empty()) throw std::invalid_argument("sectional initial distribution is empty.");
-    for (size_t k = 0; k < initial->size(); ++k) {
-      const double n = (*initial)[k];
-      if (!(n >= 0.0) || !std::isfinite(n))
-        throw std::invalid_argument("sectional initial n_k must be finite and >= 0 (got " +
-                                    formatReal(n) + " at k = " + std::to_string(k + 1) + ").");
-      if (n == 0.0) continue;
-      int t;
-      double b;
-      splitSize(grid.pivots, static_cast<double>(k + 1), t, b);
-      if (t < 0)
-        throw std::invalid_argument("sectional initial distribution reaches size " +
-                                    std::to_string(k + 1) + ", beyond max_size " +
-                                    formatReal(options.max_size) + ".");
-      y[t] += (1.0 - b) * n;
-      y[t + 1] += b * n;
-    }
-  } else {
-    y[0] = 1.0;  // monodisperse n_1 = 1
-  }
+  const std::vector<double> y = initialSections(grid, initial, options.max_size);
   double M1_0 = 0.0, M2_0 = 0.0;
   for (size_t i = 0; i < grid.pivots.size(); ++i) {
     M1_0 += grid.pivots[i] * y[i];
     M2_0 += grid.pivots[i] * grid.pivots[i] * y[i];
   }
   if (!(M1_0 > 0.0)) throw std::invalid_argument("sectional initial distribution has no mass.");
-
-  // Gelling kernels: the solution exists only before t_gel = 1 / (K0 M2(0)) (Ziff 1980 for K = K0 i
-  // j).
-  if (kernel.type() == KernelType::Multiplicative) {
-    const double t_gel = 1.0 / (kernel.K0() * M2_0);
-    if (options.times.back() >= t_gel)
-      throw std::invalid_argument(
-          "sectional times must stay before the gel time 1/(K0 M2(0)) = " + formatReal(t_gel) +
-          " of the multiplicative kernel (got " + formatReal(options.times.back()) + ").");
-  } else if (kernel.gels()) {
-    throw std::invalid_argument("sectional solver: kernel '" + kernel.name() +
-                                "' gels; no gel time known.");
-  }
+  checkGelTime(kernel, options.times.back(), M2_0);
 
   SmolResult result;
   result.method = "sectional";
@@ -359,17 +420,7 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
       startSolver(t_prev, y_prev);
       continue;
     }
-    MomentSample s;
-    s.t = tout;
-    for (size_t i = 0; i < I; ++i) {
-      const double N = yout[i];
-      s.M0 += N;
-      s.M1 += x[i] * N;
-      s.M2 += x[i] * x[i] * N;
-    }
-    s.S = s.M2 / s.M1;
-    s.mass_loss = (M1_0 - s.M1) / M1_0;
-    s.valid = std::fabs(s.mass_loss) <= options.mass_loss_tolerance;
+    MomentSample s = sectionMoments(tout, x, yout, M1_0, options.mass_loss_tolerance);
     size_t lo, hi;
     rhs->activeRange(yout.data(), lo, hi);
     s.max_size = lo < I ? x[hi] : 0.0;
@@ -382,27 +433,7 @@ SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
       result.snapshots.push_back(std::move(snap));
     }
     if (!s.valid && options.stop_on_truncation) {
-      const std::string head = "mass loss " + formatReal(s.mass_loss) + " at t = " +
-                               formatReal(tout) + " exceeds mass_loss_tolerance " +
-                               formatReal(options.mass_loss_tolerance);
-      if (s.mass_loss < 0.0) {
-        result.stop_cause = StopCause::MassGained;
-        result.stopped_early = head + ": mass was gained, an integration error";
-      } else {
-        result.stop_cause = StopCause::Truncation;
-        std::string limit = "the grid holds its most sections, " + std::to_string(MAX_SECTIONS) +
-                            ", at ratio " + formatReal(options.ratio);
-        if (!options.grow) {
-          limit = "the grid is fixed";
-        } else if (x.back() >= options.max_size) {
-          limit = "the largest size allowed, max_size " + formatReal(options.max_size);
-        } else if (x.back() >= SECTIONAL_MAX_PIVOT) {
-          result.stop_cause = StopCause::SizeCeiling;
-          limit = "no grid goes beyond " + formatReal(SECTIONAL_MAX_PIVOT);
-        }
-        result.stopped_early = head + ": aggregates left the grid beyond its last pivot " +
-                               formatReal(x.back()) + " (" + limit + ")";
-      }
+      stopOnMassLoss(s, options, x.back(), result);
       break;
     }
     if (s.S >= options.s_end) break;

@@ -44,9 +44,9 @@ bool skipDirectory(const fs::path& dir) {
 }
 
 bool isText(const fs::path& file) {
-  static const std::set<std::string> EXT = {".cpp", ".h",    ".hpp", ".cu",   ".c",
-                                            ".md",  ".txt",  ".in",  ".cmake", ".py",
-                                            ".sh",  ".toml", ".json", ".yml", ".yaml"};
+  static const std::set<std::string> EXT = {".cpp", ".h",    ".hpp",  ".cu",    ".c",
+                                            ".md",  ".txt",  ".in",   ".cmake", ".py",
+                                            ".sh",  ".toml", ".json", ".yml",   ".yaml"};
   const std::string ext = file.extension().string();
   if (EXT.count(ext)) return true;
   // extension-less scripts (.ci/run) and the root's dot files (.clang-format, .gitignore)
@@ -138,9 +138,8 @@ TEST_CASE("every docs/model.md section cited exists", "[common][repository]") {
   CHECK(*sections.rbegin() == static_cast<int>(sections.size()));
 
   // "model.md section 7", "model.md sections 1, 11 and 12", "model.md §3-§7", "model.md §9, §12"
-  const std::regex citation(
-      R"(^model\.md,?\s+(?:sections?\s+|§ ?))"
-      R"((\d+(?:\s*(?:,\s*|and\s+|-|–)\s*(?:and\s+)?(?:§)?\d+)*))");
+  const std::regex citation(R"(^model\.md,?\s+(?:sections?\s+|§ ?))"
+                            R"((\d+(?:\s*(?:,\s*|and\s+|-|–)\s*(?:and\s+)?(?:§)?\d+)*))");
   const std::regex number(R"(\d+)");
   const std::string key = "model.md";
   std::size_t citations = 0;
