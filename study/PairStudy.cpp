@@ -293,43 +293,13 @@ void PairStudy::runMd(std::vector<RunJob> all) {
                  std::chrono::duration<double>(clock::now() - t0).count());
     std::fflush(stderr);
   };
-  cb.start = [&](std::size_t i) {
-    const RunJob& j = todo[i];
-    fs::create_directories(j.dir);
-    if (!j.restart) {
-      // A fresh start: clear what an interrupted attempt left behind.
-      for (const char* f :
-           {"traj.h5", "traj.xdmf", "checkpoint.h5", "checkpoint.toml", "done.json"})
-        fs::remove(j.dir / f);
-      nlohmann::ordered_json rec = runRecord(j);
-      rec["started"] = nowUtc();
-      writeText(j.dir / "run.json", rec.dump(2) + "\n");
-    }
-    const std::vector<std::string> argv = mdCommand(m_launch, j, threads);
-    appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
-    appendText(j.log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
-    say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": " +
-            (j.restart ? "restarting from its checkpoint" : "started") + " (seed " +
-            std::to_string(j.seed) + ")",
-        !tty);
-    return spawn(argv, j.log);
-  };
+  cb.start = [&](std::size_t i) { return startRun(todo[i], threads, !tty); };
   cb.ended = [&](std::size_t i, int st, double wall) {
     RunJob& job = todo[i];
     const bool ok = WIFEXITED(st) && WEXITSTATUS(st) == 0;
     const std::string name = kName(job.K) + " run " + std::to_string(job.r);
     if (ok) {
-      nlohmann::ordered_json rec = runRecord(job);
-      rec["wall_seconds"] = wall;
-      if (m_launch.lammps())
-        rec["launcher"] = joinCommand(m_launch.launcher);
-      else
-        rec["threads"] = threads;
-      rec["restarted"] = job.restart;
-      rec["finished"] = nowUtc();
-      rec["granagg"] = common::versionString();
-      writeText(job.dir / "done.json", rec.dump(2) + "\n");
-      m_changed_k.insert(kName(job.K));
+      recordFinished(job, wall, threads);
       if (tty) std::fprintf(stderr, "\r%100s\r", "");
       say("md " + name + ": done in " + formatReal(std::round(wall * 10) / 10) + " s" +
           (job.restart ? " (restarted)" : ""));
@@ -377,6 +347,44 @@ void PairStudy::runMd(std::vector<RunJob> all) {
         (m_out / "logs").string() +
         "); finished runs are kept: run the same command again to retry the others");
   }
+}
+
+/// Starts run `j` (its folder, run.json for a fresh start, the command in commands.txt and the log)
+/// and returns its process; `echo` also prints the start to the terminal.
+pid_t PairStudy::startRun(const RunJob& j, int threads, bool echo) {
+  fs::create_directories(j.dir);
+  if (!j.restart) {
+    // A fresh start: clear what an interrupted attempt left behind.
+    for (const char* f : {"traj.h5", "traj.xdmf", "checkpoint.h5", "checkpoint.toml", "done.json"})
+      fs::remove(j.dir / f);
+    nlohmann::ordered_json rec = runRecord(j);
+    rec["started"] = nowUtc();
+    writeText(j.dir / "run.json", rec.dump(2) + "\n");
+  }
+  const std::vector<std::string> argv = mdCommand(m_launch, j, threads);
+  appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
+  appendText(j.log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
+  say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": " +
+          (j.restart ? "restarting from its checkpoint" : "started") + " (seed " +
+          std::to_string(j.seed) + ")",
+      echo);
+  return spawn(argv, j.log);
+}
+
+/// done.json of a finished run: its record, wall time, threads or launcher, and this granagg; its
+/// K is marked changed, so that the stages after the MD redo its analysis.
+void PairStudy::recordFinished(const RunJob& job, double wall, int threads) {
+  nlohmann::ordered_json rec = runRecord(job);
+  rec["wall_seconds"] = wall;
+  if (m_launch.lammps())
+    rec["launcher"] = joinCommand(m_launch.launcher);
+  else
+    rec["threads"] = threads;
+  rec["restarted"] = job.restart;
+  rec["finished"] = nowUtc();
+  rec["granagg"] = common::versionString();
+  writeText(job.dir / "done.json", rec.dump(2) + "\n");
+  m_changed_k.insert(kName(job.K));
 }
 
 /// What a run said last: granagg-lammps's last line, not the report mpirun appends after it.

@@ -115,6 +115,8 @@ class PairStudy {
   /// The runs of `all` still to do (finished ones counted in `done`), restarts marked.
   std::vector<RunJob> runsToDo(std::vector<RunJob>& all, int& done);
   void runMd(std::vector<RunJob> jobs);
+  pid_t startRun(const RunJob& j, int threads, bool echo);
+  void recordFinished(const RunJob& job, double wall, int threads);
   void stopRun(pid_t pid);
   std::string runLastLine(const RunJob& j) const;
   int runStep(const std::string& label, std::vector<std::string> argv, const std::string& logname,
