@@ -3,8 +3,9 @@
 /// The HD macro marks physics functions compiled for both host and device.
 /// Our own macro, because the CUDA 13 Thrust no longer defines __host__/__device__ for g++
 /// (STYLE.md, "Keep CUDA-only code small"). Besides this header, only md/engine/Launch.h (the
-/// block launches), md/engine/PhaseTimer.h (device synchronisation for timing) and md/fft/ (cuFFT)
-/// know about CUDA.
+/// block launches), md/engine/PhaseTimer.h (device synchronisation for timing), md/fft/ (cuFFT)
+/// and md/engine/Engine.cpp (the device's name and OpenMP's or CUDA's thread settings in
+/// setThreads and backendDescription) know about CUDA.
 #if defined(__CUDACC__)
 #define HD __host__ __device__
 #else

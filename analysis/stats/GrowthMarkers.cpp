@@ -39,8 +39,8 @@ LogBinnedFit fitLogBinnedPowerLaw(const std::map<std::uint64_t, std::uint64_t>& 
   }
   fit.bins = x.size();
   if (x.size() < min_bins) return fit;
-  // (gsl_fit_linear's covariance is already estimated from the scatter about the line; this fit
-  // used to scale it by the residual variance a second time, so tau_err was off by that factor)
+  // gsl_fit_linear's covariance is already estimated from the scatter about the line: tau_err is
+  // its slope's standard error as it is, not scaled by the residual variance again
   const common::stats::LineFit f = common::stats::fitLine(x, y);
   fit.tau = -f.slope;
   fit.tau_err = f.slope_se;

@@ -5,9 +5,10 @@
 /// row at a time, in a form the compiler vectorises: each entry's force terms are written to
 /// buffers, and the caller sums them in row order. The sum's order, and every operation of each
 /// term, are the scalar loop's, so results are the same to the bit on every instruction set
-/// (docs/benchmarks-coulomb.md, "Session 13", "The slow real space in SIMD"). The same treatment
-/// of the contact pass's fast pairs (about 30 entries per particle) was measured and dropped: no
-/// faster, since its ordered sum and its contacts, not the terms, bound that loop.
+/// (docs/benchmarks-coulomb.md, "The slow real space in SIMD"). The contact pass's fast pairs
+/// (about 30 entries per particle) are not treated so: their ordered sum and their contacts, not
+/// the terms, bound that loop (docs/benchmarks-coulomb.md, "Contact pass in the cold clustered
+/// gas").
 ///
 /// CPU build only (the CUDA build runs the pair loops per thread on the device). PairChunks.cpp
 /// is compiled for several x86-64 levels and picks one at run time (GCC's target_clones); it is

@@ -181,7 +181,7 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
                       target.force);
   std::size_t j = 0;
   for (const auto& s : r.samples) {
-    if (!std::isfinite(s.S))  // (the table used to end in NaN rows, with exit status 0)
+    if (!std::isfinite(s.S))  // an overflow is an error, never a table that ends in NaN rows
       throw std::runtime_error("S(t) is no longer finite at t = " + common::formatReal(s.t) +
                                " (the solver's numbers overflowed): lower --t-end");
     double z = std::nan("");

@@ -135,7 +135,7 @@ TEST_CASE("adaptive dt: a persistent contact is resolved like the impact of its 
 }
 
 TEST_CASE("adaptive dt: changes of step keep the charged gas's energy and momentum",
-          "[md][adaptive][coulomb]") {
+          "[md][adaptive][coulomb][slow]") {
   // The elastic charged gas of the multiple-time-stepping energy tests (test_coulomb_md.cpp):
   // fixed +-1 charges, K = 5, PPPM with the slow part every 8 steps of 0.002, growing to 16 as
   // the gas allows. 6000 steps with the step changed every 50 between 0.002 and 0.0025
@@ -224,7 +224,7 @@ struct StopAt : Reporter {
 }  // namespace
 
 TEST_CASE("adaptive dt: frames on their times, the end at t_end, restarts to the bit",
-          "[md][adaptive][run]") {
+          "[md][adaptive][run][slow]") {
   for (bool charged : {false, true}) {
     INFO((charged ? "charged" : "neutral"));
     const fs::path dir = test::tempDir(charged ? "adaptive_charged" : "adaptive_neutral");
@@ -304,7 +304,7 @@ TEST_CASE("adaptive dt: frames on their times, the end at t_end, restarts to the
 }
 
 TEST_CASE("adaptive dt: the slow interval keeps its bounds in time, a checkpoint the design's",
-          "[md][adaptive][coulomb]") {
+          "[md][adaptive][coulomb][slow]") {
   // K = 1 PPPM, the slow part every 4 auto steps, growing to 16 x 4 = 64 ("auto"). At twice the
   // step the bounds are 2..32 steps (the same lengths in time); the checkpoint still records the
   // cap the Coulomb set-up was designed for, 64, so that a restart designs the same set-up
