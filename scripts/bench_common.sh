@@ -121,9 +121,12 @@ lammps_loop_seconds() {  # LOG FIRST -> sum of the "Loop time" of every run in L
                      END {if (k < first) exit 1; printf "%.9g\n", s}' "$1"
 }
 
+lammps_last_run() {  # LOG -> LOG's lines from its last "Loop time" on (the last run's summary)
+  awk '/^Loop time/ {buf = ""} {buf = buf $0 "\n"} END {printf "%s", buf}' "$1"
+}
 lammps_time_split() {  # LOG -> "Pair 60.1%, Kspace 30.2%, ..." of the last run in LOG (its
   # timing breakdown: a run with `post yes`)
-  awk '/^Loop time/ {buf = ""} {buf = buf $0 "\n"} END {printf "%s", buf}' "$1" \
+  lammps_last_run "$1" \
     | awk '/^Section/ {s = 1; next} s && /^---/ {next}
            s && /\|/ {gsub(/ /, ""); split($0, a, "|"); printf "%s %s%%, ", a[1], a[6]; next}
            {s = 0}' | sed 's/, $//'

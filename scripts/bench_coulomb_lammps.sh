@@ -241,12 +241,11 @@ lammps_time() {  # N n1 n2 ranks rc acc [respa] -> loop seconds of steps n1..n2
 }
 lammps_info() {  # log -> "grid, G, estimated accuracy; time split of the timed run"
   local log=$1
-  local grid g est last brk
+  local grid g est brk
   grid=$(grep -m1 'grid =' "$log" | sed 's/.*grid = //')
   g=$(grep -m1 'G vector' "$log" | sed 's/.*= *//')
   est=$(grep -m1 'estimated relative force accuracy' "$log" | sed 's/.*= *//')
-  last=$(awk '/^Loop time/ {buf = ""} {buf = buf $0 "\n"} END {printf "%s", buf}' "$log")
-  brk=$(awk '/^Section/ {s = 1; next} s && /^---/ {next} s && /\|/ {gsub(/ /, ""); split($0, a, "|"); printf "%s %s%%, ", a[1], a[6]; next} {s = 0}' <<< "$last" | sed 's/, $//')
+  brk=$(lammps_time_split "$log")
   echo "grid $grid, G = $g, LAMMPS-estimated error $est (absolute); $brk"
 }
 

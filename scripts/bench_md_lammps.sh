@@ -202,11 +202,11 @@ for N in $SIZES; do
   # the last LAMMPS run on the fewest ranks
   # shellcheck disable=SC2086
   log="$TMP/lmp_$(printf '%s\n' $LMP_RANKS | sort -n | head -n 1).log"
-  last=$(awk '/^Loop time/ {buf = ""} {buf = buf $0 "\n"} END {printf "%s", buf}' "$log")  # from the last "Loop time"
+  last=$(lammps_last_run "$log")
   temps=$(awk '/^ *Step/ {getline; t = $2} END {print t}' "$log")
   temp2=$(awk '/^Loop time/ {t = prev} {prev = $2} END {print t}' "$log")
   builds=$(grep 'Neighbor list builds' <<< "$last" | awk '{print $NF}')
-  brk=$(awk '/^Section/ {s = 1; next} s && /^---/ {next} s && /\|/ {gsub(/ /, ""); split($0, a, "|"); printf "%s %s%%, ", a[1], a[6]; next} {s = 0}' <<< "$last" | sed 's/, $//')
+  brk=$(lammps_time_split "$log")
   NOTES+=("- N = $N, steps $n1..$n2: LAMMPS temperature $temps -> $temp2, $builds neighbour-list builds; LAMMPS time split (last run on $(basename "$log" .log | sed "s/lmp_//") rank(s)): $brk")
   np1=$(printf '%s\n' $LMP_RANKS | sort -n | head -n 1)
   NOTES+=("  temperature at step $n2 by LAMMPS integrator (the same trajectory): $(for fix in $LMP_FIXES; do printf 'fix %s %s; ' "$fix" "$(awk '/^Loop time/ {t = prev} {prev = $2} END {print t}' "$TMP/lmp_${np1}_${fix//\//_}.log")"; done)")
