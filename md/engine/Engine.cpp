@@ -1,8 +1,9 @@
 /// \file Engine.cpp
 /// md::Engine's public API (construction, run, state, observables, threads) and the per-step core
-/// of Engine::Impl (EngineImpl.h): force pass, kick and drift, list rebuilds, cell sort. The
-/// checkpoint (its fields and the restart from it) is in EngineCheckpoint.cpp, the Coulomb part
-/// in EngineCoulomb.cpp, the time-step control in EngineTimeStep.cpp.
+/// of Engine::Impl (EngineImpl.h): force pass, kick and drift. The neighbour lists (cell sort,
+/// builds, skins) are in EngineLists.cpp, the checkpoint (its fields and the restart from it) in
+/// EngineCheckpoint.cpp, the abort message in EngineAbort.cpp, the Coulomb part in
+/// EngineCoulomb.cpp, the time-step control in EngineTimeStep.cpp.
 #include "md/engine/Engine.h"
 
 #include <algorithm>
@@ -15,7 +16,6 @@
 #include <variant>
 
 #include <thrust/fill.h>
-#include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/scatter.h>
 #include <thrust/sequence.h>
@@ -31,7 +31,6 @@
 #include "md/engine/EngineImpl.h"
 #include "md/engine/Launch.h"
 #include "md/integrate/VelocityVerlet.h"
-#include "md/neighbor/Skin.h"
 
 namespace granagg::md {
 
@@ -50,13 +49,6 @@ namespace {
 // reference, and the cold gas's energy drift is at most 3e-5 of E_kin per 1000 steps at each
 // (docs/benchmarks-coulomb.md).
 constexpr int SLOW_INTERVAL_GROWTH = 16;
-/// d = d[order] (storage permutation).
-template <class T>
-void permute(DVec<T>& d, const DVec<int>& order, DVec<T>& scratch) {
-  scratch.resize(d.size());
-  thrust::gather(order.begin(), order.end(), d.begin(), scratch.begin());
-  d.swap(scratch);
-}
 
 struct ChargeSums {
   double total = 0.0, abs_sum = 0.0, abs_max = 0.0;
@@ -101,58 +93,6 @@ void Engine::Impl::upload(const Frame& f) {
   p.id.resize(f.size());
   thrust::sequence(p.id.begin(), p.id.end());
   if (exchange) dq.assign(f.size(), 0.0);
-}
-
-bool Engine::Impl::sortByCell() {
-  const DVec<int>& order = nl.computeCellOrder(p, box);
-  if (order.size() != p.size()) return false;  // all-pairs builds: nothing to sort
-  permute(p.pos, order, scratch4);  // (dq is all zero here: applied by the kick pass before)
-  for (auto* v : {&p.vel, &p.force}) permute(*v, order, scratch3);
-  if (coulomb)  // the Coulomb forces, used until the next evaluation, follow their particles
-    for (int a = 0; a < 3; ++a) permute(slow_coulomb->force(a), order, scratch_d);
-  for (auto* v : {&p.ix, &p.iy, &p.iz, &p.id}) permute(*v, order, scratch_i);
-  return true;
-}
-
-void Engine::Impl::rebuildList(bool sort) {
-  PhaseTimer::Scope phase(&timer, nl_coul ? PhaseTimer::CoulombList : PhaseTimer::ContactList);
-  chooseSkins(true, true);
-  const bool sorted = sort && sortByCell();
-  if (nl_coul) {
-    nl_coul->build(p, box);
-    drift_since_coul_build = 0.0;
-    nl.buildFrom(*nl_coul, p, box);
-  } else if (sorted) {
-    nl.buildSorted(p, box);  // the storage is in nl's cell order now
-  } else {
-    nl.build(p, box);
-  }
-  drift_since_build = 0.0;
-}
-
-void Engine::Impl::rebuildContactList() {
-  chooseSkins(true, false);
-  if (!nl_coul) {
-    rebuildList(true);
-  } else if (nl.listRange() <= nl_coul->listRange() - 2.0 * drift_since_coul_build) {
-    PhaseTimer::Scope phase(&timer, PhaseTimer::ContactList);
-    nl.buildFrom(*nl_coul, p, box);
-    drift_since_build = 0.0;
-  } else {
-    rebuildList(true);
-  }
-}
-
-void Engine::Impl::chooseSkins(bool contact_list, bool coulomb_list) {
-  if (u_max_last < 0.0) return;
-  const double delta = dt * u_max_last;
-  if (contact_list && contact_skin_follows)
-    nl.setSkin(followingSkin(slow_coulomb->fastSwitch().r2, delta, CONTACT_LIST_BUILD_OVER_USE,
-                             NEIGHBOR_SKIN_AUTO_MIN, cfg.neighbor.skinCap()));
-  if (coulomb_list && nl_coul && coulomb_skin_follows)
-    nl_coul->setSkin(followingSkin(slow_coulomb->setup().r_cut, slow.every * delta,
-                                   COULOMB_LIST_BUILD_OVER_USE, COULOMB_SKIN_AUTO_MIN,
-                                   coulomb_skin_cap));
 }
 
 ContactStep Engine::Impl::makeStep(double dt_taken, double slow_weight, double prev_weight) const {
