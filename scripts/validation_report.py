@@ -6,7 +6,9 @@
 Reads what granagg wrote under OUT (pair studies: OUT/<part>/analysis, fit, meanfield; fit-beta
 windows: OUT/<part>/windows; grid variants: OUT/sensitivity) and writes OUT/report/:
   verdict.md          the verdict table (one row per published number) with our values
-  verdict.csv         the same numbers, machine-readable (granagg pair prints them beside a demo)
+  verdict.csv         the same numbers, machine-readable (granagg pair prints them beside a demo);
+                      the rows of "What S measures" (quantity_id 4-6) come from the committed
+                      docs/validation/dominance_*.csv (scripts/dominance_verdict.py)
   ensembles.csv       one row per ensemble: N, runs, K, Q, t_end, onset, growth, regime numbers
   windows.csv         z, beta from z and asymptotic beta over every fitted window
   fisher.csv          Fisher tau at t = 50, 100, 150: MLE and the paper's log-binned least squares
@@ -35,6 +37,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import dominance_verdict  # noqa: E402
 from granagg_tables import col, load_json, meta, read  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -813,6 +816,10 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_
               "(-tau, log-binned least squares, at the frame t0 = t1; paper: the paper's slope "
               "at that t, nan where it prints none); numeric columns only "
               "(granagg's common::readCsv reads it)")
+    # quantity_id 4-6, "What S measures": from the committed tables of s_dominance.py
+    d_rows, d_lines = dominance_verdict.rows(os.path.join(ROOT, "docs", "validation"))
+    dominance_verdict.rewrite_csv(os.path.join(rep, "verdict.csv"), d_rows)
+    dominance_verdict.rewrite_md(os.path.join(rep, "verdict.md"), d_lines)
 
 
 if __name__ == "__main__":
