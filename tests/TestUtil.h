@@ -41,6 +41,10 @@ inline void spit(const std::filesystem::path& path, const std::string& bytes) {
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
+/// Whether the test binary was started with --write-reference (tests/catch_main.cpp): golden-value
+/// tests then rewrite their reference files from this build instead of checking them.
+bool writeReference();
+
 /// Same values to the bit (so -0.0 != 0.0 and NaN payloads count): what "bit for bit" means.
 template <class T>
 bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {

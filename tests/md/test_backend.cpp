@@ -14,10 +14,12 @@
 //     multiply-adds and cuFFT's round-off, not for a different algorithm.
 // Regenerate the files (CPU build only) after an intended change of the trajectory with
 //     bash scripts/write_reference_states.sh [BUILD_DIR]
-// (the test binary with GRANAGG_WRITE_BACKEND_REFERENCE=1), and review `git diff`.
+// (`test_md --write-reference "[backend]"`), and review `git diff`.
 #include <catch2/catch.hpp>
 
 #include <toml++/toml.h>
+
+#include "TestUtil.h"
 
 #include <algorithm>
 #include <cmath>
@@ -194,8 +196,9 @@ Outcome runCase(const MdConfig& c, const Frame& init, bool allow_contacts, std::
   return o;
 }
 
-/// The two reference cases: a dense neutral gas (Hertz contacts, 300 steps) and a charged gas
-/// (K = 5, PPPM with multiple time stepping, bipolar charges changed by exchange, 200 steps).
+/// The reference cases, one file each: per contact model a dense neutral gas (Hertz, 300 steps;
+/// spring-dashpot, 300 steps) and per Coulomb method a charged gas (K = 5, bipolar charges changed
+/// by exchange: PPPM with multiple time stepping, 200 steps; plain Ewald, 100 steps).
 struct ReferenceCase {
   std::string name;
   MdConfig config;
@@ -205,7 +208,7 @@ struct ReferenceCase {
 };
 
 std::vector<ReferenceCase> referenceCases() {
-  std::vector<ReferenceCase> cases(2);
+  std::vector<ReferenceCase> cases(4);
   ReferenceCase& a = cases[0];
   a.name = "contacts";
   a.init = denseBlock(8, 200, 16.0, 3);
@@ -229,6 +232,25 @@ std::vector<ReferenceCase> referenceCases() {
   assignInitialCharges(b.config, b.init);
   b.allow_contacts = false;
   b.steps = 200;
+  ReferenceCase& c = cases[2];
+  c.name = "spring_dashpot";
+  c.init = a.init;
+  c.config = a.config;
+  c.config.contact.model = "spring_dashpot";
+  // softer than the default 2e4, so that the block's overlaps (up to ~0.03 d) hold forces of the
+  // Hertz case's size rather than releasing a hundred times its elastic energy
+  c.config.contact.stiffness = 500.0;
+  c.allow_contacts = true;
+  c.steps = 300;
+  ReferenceCase& d = cases[3];
+  d.name = "ewald";
+  d.config = b.config;
+  d.config.system.N = 300;
+  d.config.coulomb.method = "ewald";
+  d.init = randomInitialState(d.config);
+  assignInitialCharges(d.config, d.init);
+  d.allow_contacts = false;
+  d.steps = 100;
   return cases;
 }
 
@@ -395,10 +417,10 @@ double energyDifference(const Energies& a, const Energies& b) {
 }
 
 /// Compares an outcome with the CPU backend's reference file (or writes the file when
-/// GRANAGG_WRITE_BACKEND_REFERENCE is set, CPU build only).
+/// the test binary runs with --write-reference, CPU build only).
 void checkAgainstReference(const ReferenceCase& rc, const Outcome& o) {
   const std::string path = referencePath(rc.name);
-  if (std::getenv("GRANAGG_WRITE_BACKEND_REFERENCE")) {
+  if (granagg::test::writeReference()) {
     REQUIRE_FALSE(CUDA_BUILD);  // the reference is the CPU backend's by definition
     std::ofstream(path) << referenceText(rc, o);
     WARN("wrote the reference " << path);
