@@ -4,8 +4,9 @@
 /// Our own macro, because the CUDA 13 Thrust no longer defines __host__/__device__ for g++
 /// (STYLE.md, "Keep CUDA-only code small"). Besides this header, only md/engine/Launch.h (the
 /// block launches), md/engine/PhaseTimer.h (device synchronisation for timing), md/fft/ (cuFFT)
-/// and md/engine/Engine.cpp (the device's name and OpenMP's or CUDA's thread settings in
-/// setThreads and backendDescription) know about CUDA.
+/// and md/engine/Engine.cpp (the device's name and the thread settings) call the CUDA API; a few
+/// sources choose a CPU-only path with GRANAGG_CUDA (the SIMD pair chunks, the run log's
+/// backend line).
 #if defined(__CUDACC__)
 #define HD __host__ __device__
 #else

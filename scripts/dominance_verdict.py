@@ -9,10 +9,10 @@ standard error over the runs), per ensemble
 
 For 4 and 6, `value` is the mean local slope over the flattest window of at least half a decade
 (t1 / t0 >= sqrt(10), frames with t >= T_MIN), `low` and `high` the smallest and largest mean
-local slope in that window, and zloc_min, zloc_max the range over all frames with t >= T_MIN. A
-window is flat when its range is at most 25 % of its mean (the rule of the z rows,
-validation_report.py). For 5, `value` is the mean share at the last frame and low, high its 95 %
-interval (1.96 standard errors over the runs). `paper` is the paper's z (1.21 neutral, 1.49
+local slope in that window, and zloc_min, zloc_max the range over all frames with t >= T_MIN.
+Flattest: the smallest range relative to the midrange (max + min) / 2; flat: a range of at most
+25 % of the midrange (the rule of the z rows, validation_report.py). For 5, `value` is the mean
+share at the last frame and low, high its 95 % interval (1.96 standard errors over the runs). `paper` is the paper's z (1.21 neutral, 1.49
 charged) for 4 and nan otherwise: the paper reports no such quantity.
 
     /usr/bin/python3 scripts/dominance_verdict.py ROOT
@@ -37,7 +37,8 @@ PAPER = load_json(os.path.join(HERE, "..", "data", "reference", "paper.json"))
 T_MIN = 50.0
 HALF_DECADE = math.sqrt(10.0)
 FLAT = 0.25
-HEAD_4_6 = ("# quantity_id 4-6 (scripts/dominance_verdict.py, from docs/validation/dominance_*.csv): "
+HEAD_4_6 = ("# quantity_id 4-6 (scripts/dominance_verdict.py, from "
+            "docs/validation/dominance_*.csv): "
             "4 = local slope of S_grid without the largest cluster, 6 = local slope of the density "
             "length l (value: mean over the flattest half decade t0..t1, low/high: its range; "
             "zloc_min/max: range over t >= 50), 5 = the largest cluster's share of the occupied "
@@ -45,31 +46,31 @@ HEAD_4_6 = ("# quantity_id 4-6 (scripts/dominance_verdict.py, from docs/validati
 BEGIN = "<!-- dominance rows (scripts/dominance_verdict.py) -->"
 END = "<!-- end of dominance rows -->"
 
-# table in docs/validation (one ensemble), label, K, N, runs
+# table in docs/validation (one ensemble; its n_runs column gives the runs), label, K, N
 ENSEMBLES = [
-    ("dominance_neutral_md.csv", "neutral, L = 70 (paper's N)", 0.0, 50016, 4),
-    ("dominance_box_L140.csv", "neutral, L = 140", 0.0, 400128, 2),
-    ("dominance_charged-K5-N50016-t1000.csv", "charged K = 5, L = 70 (paper's N)", 5.0, 50016, 5),
+    ("dominance_neutral_md.csv", "neutral, L = 70 (paper's N)", 0.0, 50016),
+    ("dominance_box_L140.csv", "neutral, L = 140", 0.0, 400128),
+    ("dominance_charged-K5-N50016-t1000.csv", "charged K = 5, L = 70 (paper's N)", 5.0, 50016),
 ]
 
 
 def flattest(t, z):
-    """(t0, t1, mean, lo, hi, flat) of the window of at least half a decade whose local slope
-    varies least relative to its mean; None without such a window."""
+    """(t0, t1, mean, lo, hi, flat) of the window of at least half a decade (every window of
+    consecutive frames with finite slopes is tried) whose local slope has the smallest range
+    relative to its midrange; None without such a window."""
     best = None
     for i in range(len(t)):
         for j in range(i + 1, len(t)):
-            if t[j] / t[i] < HALF_DECADE:
-                continue
             w = z[i:j + 1]
             if not np.all(np.isfinite(w)):
                 break
-            m = float(np.mean(w))
-            spread = float(np.max(w) - np.min(w))
-            score = spread / abs(m) if m != 0 else math.inf
+            if t[j] / t[i] < HALF_DECADE:
+                continue
+            lo, hi = float(np.min(w)), float(np.max(w))
+            mid = 0.5 * (lo + hi)
+            score = (hi - lo) / abs(mid) if mid != 0 else math.inf
             if best is None or score < best[0]:
-                best = (score, t[i], t[j], m, float(np.min(w)), float(np.max(w)))
-            break  # the shortest window from i is the flattest from i
+                best = (score, t[i], t[j], float(np.mean(w)), lo, hi)
     if best is None:
         return None
     score, t0, t1, m, lo, hi = best
@@ -79,10 +80,11 @@ def flattest(t, z):
 def rows(docs_validation):
     """verdict.csv rows (dicts) and verdict.md lines of every ensemble whose table exists."""
     csv_rows, lines = [], []
-    for name, label, K, N, runs in ENSEMBLES:
+    for name, label, K, N in ENSEMBLES:
         tab = read(os.path.join(docs_validation, name))
         if tab is None:
             continue
+        runs = int(tab["n_runs"][-1])
         t = np.asarray(tab["t"], float)
         keep = t >= T_MIN
         t_end = float(t[-1])

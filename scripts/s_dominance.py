@@ -16,9 +16,10 @@ ensembles that differ only in how l is measured, e.g. analyze's --structure-kcut
 
 Each run's onset t_c is analyze's (docs/analysis.md, "onset"): the time at which S_grid first
 reaches ONSET_FACTOR = 2 times its early plateau, the median of S_grid over 0 < t <= 10,
-interpolated in (ln t, ln S). The figure's last row shows the local slopes against t - t_c (each
-run shifted by its own t_c, then interpolated onto a common log grid for the mean and standard
-error); OUT/<NAME>_onset.csv lists the onsets and those curves.
+interpolated in (ln t, ln S). The figure's last row shows the local slopes in tau = t - t_c,
+ln[y(tau)/y(tau/ratio)]/ln ratio (the exponent of a law y ~ (t - t_c)^z), each run from its own
+onset, interpolated onto a common log grid for the mean and standard error; OUT/<NAME>_onset.csv
+lists the onsets and those curves.
 """
 import argparse
 import math
@@ -43,21 +44,24 @@ def repo_relative(path):
 
 
 def onset_time(t, s):
-    """analyze's onset (GrowthMarkers.h onsetTime): the first time S reaches ONSET_FACTOR x the
-    median S over 0 < t <= ONSET_T_BASE, interpolated linearly in (ln t, ln S) between the
-    bracketing frames; NaN when S never reaches it."""
+    """analyze's onset (analysis/stats/GrowthMarkers.cpp, onsetTime): over the usable samples
+    (t > 0, S finite and > 0), the first time S reaches ONSET_FACTOR x their median over
+    t <= ONSET_T_BASE, interpolated linearly in (ln t, ln S) from the usable sample before it (the
+    sample's own time when it is the first); NaN when S never reaches it."""
     t = np.asarray(t, float)
     s = np.asarray(s, float)
-    base = s[(t > 0) & (t <= ONSET_T_BASE) & np.isfinite(s)]
+    ok = (t > 0) & np.isfinite(s) & (s > 0)
+    t, s = t[ok], s[ok]
+    base = s[t <= ONSET_T_BASE]
     if len(base) == 0:
         return math.nan
     target = ONSET_FACTOR * float(np.median(base))
-    for i in range(1, len(t)):
-        if s[i] >= target and t[i - 1] > 0 and s[i - 1] > 0:
-            if s[i - 1] >= target:
-                return t[i - 1]
-            f = (math.log(target) - math.log(s[i - 1])) / (math.log(s[i]) - math.log(s[i - 1]))
-            return math.exp(math.log(t[i - 1]) + f * (math.log(t[i]) - math.log(t[i - 1])))
+    for i in range(len(t)):
+        if s[i] >= target:
+            if i == 0:
+                return float(t[0])
+            f = math.log(target / s[i - 1]) / math.log(s[i] / s[i - 1])
+            return math.exp(math.log(t[i - 1]) + f * math.log(t[i] / t[i - 1]))
     return math.nan
 
 
@@ -128,18 +132,29 @@ def ensemble(source, ratio, t_min):
 SLOPES = ("z_S_grid", "z_S_grid_without_largest", "z_l_density")
 
 
-def since_onset(series, runs, points=40):
-    """The local slopes against tau = t - t_c: each run's slope interpolated in ln tau onto a
-    log grid spanning the tau range that every run with an onset covers; returns (tau, {z: (mean,
-    se, n)}) with NaN where fewer than two runs have a finite value, or None without onsets."""
-    have = [r for r in runs if np.isfinite(series[r]["t_c"])]
+def since_onset(series, runs, ratio, points=40):
+    """The local slopes in tau = t - t_c, ln[y(tau)/y(tau/ratio)] / ln ratio (the exponent of a
+    law y ~ (t - t_c)^z), per run from its own onset, interpolated in ln tau onto a log grid over
+    the tau range every run with an onset covers; returns (tau, {z: (mean, se, n)}) with NaN where
+    fewer than two runs have a finite value, or None without onsets."""
+    have = []
+    for r in runs:
+        if not np.isfinite(series[r]["t_c"]):
+            continue
+        tau = np.asarray(series[r]["t"], float) - series[r]["t_c"]
+        if (tau > 0).sum() >= 2:
+            have.append(r)
     if not have:
         return None
     spans = []
+    slopes = {}
     for r in have:
         tau = np.asarray(series[r]["t"], float) - series[r]["t_c"]
-        tau = tau[tau > 0]
-        spans.append((tau.min(), tau.max()))
+        pos = tau > 0
+        spans.append((tau[pos].min(), tau[pos].max()))
+        slopes[r] = {z: local_slope(tau[pos], np.asarray(series[r][z[2:]], float)[pos], ratio)
+                     for z in SLOPES}
+        slopes[r]["tau"] = tau[pos]
     lo, hi = max(a for a, _ in spans), min(b for _, b in spans)
     if not lo < hi:
         return None
@@ -148,9 +163,9 @@ def since_onset(series, runs, points=40):
     for z in SLOPES:
         vals = []
         for r in have:
-            tau = np.asarray(series[r]["t"], float) - series[r]["t_c"]
-            y = np.asarray(series[r][z], float)
-            ok = (tau > 0) & np.isfinite(y)
+            tau = slopes[r]["tau"]
+            y = slopes[r][z]
+            ok = np.isfinite(y)
             vals.append(np.interp(np.log(grid), np.log(tau[ok]), y[ok], left=np.nan,
                                   right=np.nan) if ok.sum() >= 2 else np.full(points, np.nan))
         v = np.array(vals)
@@ -162,7 +177,7 @@ def since_onset(series, runs, points=40):
     return grid, out
 
 
-def write_onset(path, name, series, runs, curves, argv):
+def write_onset(path, series, runs, curves, argv, ratio):
     """OUT/<NAME>_onset.csv: the runs' onsets, then the slopes against t - t_c."""
     with open(path, "w") as f:
         f.write(f"# command = /usr/bin/python3 scripts/s_dominance.py {' '.join(argv)}\n")
@@ -173,8 +188,9 @@ def write_onset(path, name, series, runs, curves, argv):
             f.write("# no run reached its onset\n")
             return
         grid, out = curves
-        f.write("# local slopes per run interpolated in ln(t - t_c); mean and standard error over "
-                "the runs (n_*: runs with a value)\n")
+        f.write(f"# local slopes in t - t_c, z = ln[y(tau)/y(tau/{ratio:g})]/ln {ratio:g} with "
+                "tau = t - t_c, per run from its own onset, interpolated in ln tau; mean and "
+                "standard error over the runs (n_*: runs with a value)\n")
         names = ["t_minus_t_c"] + [f"{z}_{k}" for z in SLOPES for k in ("mean", "se", "n")]
         f.write(",".join(names) + "\n")
         for i, tau in enumerate(grid):
@@ -185,17 +201,20 @@ def write_onset(path, name, series, runs, curves, argv):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out")
-    ap.add_argument("ensembles", nargs="+", help="NAME=ANALYZE_DIR")
+    ap.add_argument("ensembles", nargs="+",
+                    help="NAME=SOURCE: an analyze folder or a per-run table (per_run/S_t.csv)")
     ap.add_argument("--ratio", type=float, default=2.0, help="p of the local slope (default 2)")
     ap.add_argument("--t-min", type=float, default=50.0, help="first time tabulated (default 50)")
     ap.add_argument("--length-only", action="store_true",
                     help="figure: l(t) and its local slope only")
+    ap.add_argument("--png", default=None,
+                    help="where the figure goes (default OUT/s_dominance.png)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     results = {}
     for spec in a.ensembles:
         if "=" not in spec:
-            sys.exit(f"s_dominance.py: '{spec}' is not NAME=ANALYZE_DIR")
+            sys.exit(f"s_dominance.py: '{spec}' is not NAME=SOURCE")
         name, folder = spec.split("=", 1)
         names, tab, series, runs = ensemble(folder, a.ratio, a.t_min)
         argv = [repo_relative(x) if os.path.exists(x) else
@@ -210,9 +229,9 @@ def main():
             f.write(",".join(names) + "\n")
             for row in tab:
                 f.write(",".join("%.6g" % x for x in row) + "\n")
-        curves = since_onset(series, runs)
+        curves = since_onset(series, runs, a.ratio)
         onset_path = os.path.join(a.out, name + "_onset.csv")
-        write_onset(onset_path, name, series, runs, curves, argv)
+        write_onset(onset_path, series, runs, curves, argv, a.ratio)
         results[name] = (names, tab, curves)
         print(f"wrote {path} and {onset_path}")
 
@@ -267,11 +286,11 @@ def main():
     ax[1, 1].set_ylabel(f"local slope (ratio {a.ratio:g}), mean +- se over runs")
     ax[1, 1].axhline(0.5, color="k", lw=0.5)
     for a_ in ax[2]:
-        a_.set_xlabel("t - t_c (each run's own onset)")
-        a_.set_ylabel(f"local slope (ratio {a.ratio:g}), mean +- se over runs")
+        a_.set_xlabel("tau = t - t_c (each run's own onset)")
+        a_.set_ylabel(f"local slope in tau (ratio {a.ratio:g}), mean +- se over runs")
     ax[2, 1].axhline(0.5, color="k", lw=0.5)
     fig.tight_layout()
-    png = os.path.join(a.out, "s_dominance.png")
+    png = a.png or os.path.join(a.out, "s_dominance.png")
     fig.savefig(png, dpi=110)
     print(f"wrote {png}")
 
@@ -296,7 +315,7 @@ def plot_length(results, a, plt):
     ax[1].set_ylabel(f"local slope of l (ratio {a.ratio:g}), mean +- se over runs")
     ax[1].axhline(0.5, color="k", lw=0.5)
     fig.tight_layout()
-    png = os.path.join(a.out, "s_dominance.png")
+    png = a.png or os.path.join(a.out, "s_dominance.png")
     fig.savefig(png, dpi=110)
     print(f"wrote {png}")
 

@@ -4,7 +4,8 @@
 /// (Hertz viscoelastic or spring-dashpot), velocity Verlet (docs/model.md sections 3-6).
 ///
 /// One source for both backends: Engine::Impl (EngineImpl.h; defined in Engine.cpp,
-/// EngineCoulomb.cpp and EngineTimeStep.cpp) holds the state in Thrust device vectors (structure of
+/// EngineLists.cpp, EngineCheckpoint.cpp, EngineAbort.cpp, EngineCoulomb.cpp and
+/// EngineTimeStep.cpp) holds the state in Thrust device vectors (structure of
 /// arrays) and loops through Thrust algorithms whose functors call the HD physics of
 /// md/potentials/. This header has no Thrust in it (pimpl), so host-only code (CLI, I/O) can use it
 /// in a CUDA build too.

@@ -68,7 +68,8 @@ std::vector<double> initialDistribution(const std::vector<double>* initial, int 
 }
 
 /// The moments of n_1..n_M at time t, with the mass lost since M1(0) = M1_0.
-MomentSample sample(double t, const double* n, int M, double M1_0, double mass_loss_tolerance) {
+MomentSample discreteMoments(double t, const double* n, int M, double M1_0,
+                             double mass_loss_tolerance) {
   const Moments m = moments(n, M);
   MomentSample s;
   s.t = t;
@@ -83,7 +84,7 @@ MomentSample sample(double t, const double* n, int M, double M1_0, double mass_l
 }
 
 /// n_k for k = 1..min(max_size, M) at time t.
-Snapshot snapshot(double t, const std::vector<double>& n, int M, int max_size) {
+Snapshot snapshotUpTo(double t, const std::vector<double>& n, int M, int max_size) {
   Snapshot snap;
   snap.t = t;
   const int kmax = std::min(max_size, M);
@@ -157,10 +158,10 @@ SmolResult solveDiscrete(const Kernel& kernel, const DiscreteOptions& o,
       const double t = o.times[iout++];
       buf.resize(M);
       solver->interpolate(t, buf.data());
-      const MomentSample s = sample(t, buf.data(), M, M1_0, o.mass_loss_tolerance);
+      const MomentSample s = discreteMoments(t, buf.data(), M, M1_0, o.mass_loss_tolerance);
       res.samples.push_back(s);
       if (o.snapshot_max_size > 0)
-        res.snapshots.push_back(snapshot(t, buf, M, o.snapshot_max_size));
+        res.snapshots.push_back(snapshotUpTo(t, buf, M, o.snapshot_max_size));
       if (o.on_sample) o.on_sample(s);
       if (!s.valid && o.stop_on_truncation) {
         stopOnMassLoss(s, M, o, res);

@@ -342,7 +342,6 @@ void stopOnMassLoss(const MomentSample& s, const SectionalOptions& options, doub
 
 SmolResult solveSectional(const Kernel& kernel, const SectionalOptions& options,
                           const std::vector<double>* initial) {
-  using common::formatReal;
   const auto wall_start = std::chrono::steady_clock::now();
   validate(options);
   // The first grid also covers the initial distribution; beyond max_size it is refused below.
