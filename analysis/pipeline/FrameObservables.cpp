@@ -156,7 +156,7 @@ StructureObservable::StructureObservable(const AnalysisOptions& o)
               {"t", "k", "S_k", "modes"}, 2) {}
 
 double StructureObservable::add(const Frame& f) {
-  const StructureFactor sk = structureFactor(f, m_o.structure);
+  const StructureFactor sk = structureFactor(f, m_o.structure, m_mesh);
   for (std::size_t m = 0; m < sk.k.size(); ++m)
     m_table.add({f.time, sk.k[m], sk.S[m], static_cast<double>(sk.modes[m])});
   return sk.length;

@@ -22,6 +22,7 @@
 #include "analysis/pipeline/Table.h"
 #include "analysis/stats/Msd.h"
 #include "analysis/stats/PowerLawMle.h"
+#include "analysis/stats/StructureFactor.h"
 #include "analysis/stats/VelocityStats.h"
 
 namespace granagg::analysis {
@@ -79,6 +80,7 @@ class StructureObservable {
  private:
   const AnalysisOptions& m_o;
   Table m_table;
+  StructureFactorMesh m_mesh;  // one mesh for all frames of the run
 };
 
 /// Temperature, the speed distribution, charges, their correlation and the MSD of each frame.

@@ -26,7 +26,39 @@ inline std::size_t wrap(long i, long M) { return static_cast<std::size_t>(((i % 
 
 }  // namespace
 
+struct StructureFactorMesh::Buffers {
+  long M = 0;
+  std::unique_ptr<double, decltype(&fftw_free)> rho{nullptr, fftw_free};
+  std::unique_ptr<fftw_complex, decltype(&fftw_free)> rk{nullptr, fftw_free};
+  std::unique_ptr<fftw_plan_s, PlanDeleter> plan;
+};
+
+StructureFactorMesh::StructureFactorMesh() : m_buffers(std::make_unique<Buffers>()) {}
+StructureFactorMesh::~StructureFactorMesh() = default;
+
+StructureFactorMesh::Buffers& StructureFactorMesh::forSize(long M) {
+  Buffers& b = *m_buffers;
+  if (b.M == M && b.plan) return b;
+  b.plan.reset();
+  const std::size_t cells = static_cast<std::size_t>(M) * M * M;
+  b.rho.reset(fftw_alloc_real(cells));
+  b.rk.reset(fftw_alloc_complex(static_cast<std::size_t>(M) * M * (M / 2 + 1)));
+  if (!b.rho || !b.rk) throw std::runtime_error("structure factor: no memory for the mesh");
+  // (FFTW_ESTIMATE does not touch the arrays)
+  b.plan.reset(fftw_plan_dft_r2c_3d(static_cast<int>(M), static_cast<int>(M), static_cast<int>(M),
+                                    b.rho.get(), b.rk.get(), FFTW_ESTIMATE));
+  if (!b.plan) throw std::runtime_error("structure factor: FFTW could not plan the mesh");
+  b.M = M;
+  return b;
+}
+
 StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o) {
+  StructureFactorMesh mesh;
+  return structureFactor(f, o, mesh);
+}
+
+StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o,
+                                StructureFactorMesh& mesh) {
   const std::size_t N = f.size();
   const double L = f.box;
   if (N == 0) throw std::invalid_argument("structure factor: the frame has no particles");
@@ -45,14 +77,9 @@ StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o)
   // of the mesh changes only the phase of rho_k)
   const std::size_t cells = static_cast<std::size_t>(M) * M * M;
   const long Mz = M / 2 + 1;
-  double* rho = fftw_alloc_real(cells);
-  fftw_complex* rk = fftw_alloc_complex(static_cast<std::size_t>(M) * M * Mz);
-  std::unique_ptr<double, decltype(&fftw_free)> rho_owner(rho, fftw_free);
-  std::unique_ptr<fftw_complex, decltype(&fftw_free)> rk_owner(rk, fftw_free);
-  // (FFTW_ESTIMATE does not touch the arrays)
-  std::unique_ptr<fftw_plan_s, PlanDeleter> plan(fftw_plan_dft_r2c_3d(
-      static_cast<int>(M), static_cast<int>(M), static_cast<int>(M), rho, rk, FFTW_ESTIMATE));
-  if (!plan) throw std::runtime_error("structure factor: FFTW could not plan the mesh");
+  StructureFactorMesh::Buffers& buffers = mesh.forSize(M);
+  double* rho = buffers.rho.get();
+  const fftw_complex* rk = buffers.rk.get();
   std::fill(rho, rho + cells, 0.0);
   for (std::size_t j = 0; j < N; ++j) {
     long i0[3];
@@ -66,12 +93,12 @@ StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o)
     for (int dx = 0; dx < 2; ++dx)
       for (int dy = 0; dy < 2; ++dy)
         for (int dz = 0; dz < 2; ++dz) {
-          const double w = (dx ? w1[0] : 1.0 - w1[0]) * (dy ? w1[1] : 1.0 - w1[1]) *
-                           (dz ? w1[2] : 1.0 - w1[2]);
+          const double w =
+              (dx ? w1[0] : 1.0 - w1[0]) * (dy ? w1[1] : 1.0 - w1[1]) * (dz ? w1[2] : 1.0 - w1[2]);
           rho[(wrap(i0[0] + dx, M) * M + wrap(i0[1] + dy, M)) * M + wrap(i0[2] + dz, M)] += w;
         }
   }
-  fftw_execute(plan.get());
+  fftw_execute(buffers.plan.get());
 
   // complete shells below the Nyquist wavenumber pi / h: every component |n_a| < M / 2
   const long shells = static_cast<long>(std::floor(static_cast<double>(M) / 2.0 - 0.5));

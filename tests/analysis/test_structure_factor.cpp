@@ -12,6 +12,8 @@
 #include "analysis/io/Frame.h"
 #include "analysis/stats/StructureFactor.h"
 
+#include "TestUtil.h"
+
 using namespace granagg::analysis;
 
 namespace {
@@ -154,4 +156,20 @@ TEST_CASE("S without the largest cluster leaves out one largest cluster",
   CHECK(d.S_without_largest == Approx(17.0 / 5.0));
   CHECK(std::isnan(ClusterSizes::fromSizes({7}).S_without_largest));
   CHECK(ClusterSizes::fromSizes({7}).largest_share == 1.0);
+}
+
+TEST_CASE("a mesh kept between frames gives each frame's S(k) to the bit", "[analysis][structure]") {
+  // A trajectory's frames share one StructureFactorMesh (FrameObservables); the buffers are
+  // cleared and the plan reused, so each frame's result must equal a fresh mesh's exactly, also
+  // after a frame of another box size (another M) in between.
+  const Frame a = uniformGas(3000, 20.0, 3), b = uniformGas(3000, 24.0, 4);
+  StructureFactorMesh mesh;
+  const StructureFactorOptions o;
+  for (const Frame* f : {&a, &b, &a, &a}) {
+    const StructureFactor shared = structureFactor(*f, o, mesh), fresh = structureFactor(*f, o);
+    CHECK(shared.mesh == fresh.mesh);
+    CHECK(granagg::test::sameBits(shared.S, fresh.S));
+    CHECK(granagg::test::sameBits(shared.k, fresh.k));
+    CHECK(shared.length == fresh.length);
+  }
 }
