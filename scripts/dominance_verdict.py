@@ -48,7 +48,7 @@ END = "<!-- end of dominance rows -->"
 
 # table in docs/validation (one ensemble; its n_runs column gives the runs), label, K, N
 ENSEMBLES = [
-    ("dominance_neutral_md.csv", "neutral, L = 70 (paper's N)", 0.0, 50016),
+    ("dominance_neutral_20runs.csv", "neutral, L = 70 (paper's N)", 0.0, 50016),
     ("dominance_box_L140.csv", "neutral, L = 140", 0.0, 400128),
     ("dominance_charged-K5-N50016-t1000.csv", "charged K = 5, L = 70 (paper's N)", 5.0, 50016),
 ]
