@@ -14,7 +14,8 @@ import numpy as np
 
 
 def read(path):
-    """A granagg CSV table as a numpy structured array (None if absent or empty); '#' lines dropped."""
+    """A granagg CSV table as a numpy structured array (None if absent or empty); '#' lines
+    dropped."""
     if not os.path.exists(path):
         return None
     with open(path) as f:

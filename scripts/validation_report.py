@@ -650,7 +650,8 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_
                              K=0.0, N=e["N"],
                              runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1,
                              value=r["z"], low=r["z_low"], high=r["z_high"],
-                             onset=e["onset"], growth_factor=e["growth"], paper=zp["value"], zloc_min=e["zloc_min"], zloc_max=e["zloc_max"]))
+                             onset=e["onset"], growth_factor=e["growth"], paper=zp["value"],
+                             zloc_min=e["zloc_min"], zloc_max=e["zloc_max"]))
     zc = PAPER["z_charged"]
     for part in ("charged-K5", "charged-K1", "charged-K0.25", "charged-K5-Q0.025",
                  "charged-K5-Q0.1"):
@@ -683,7 +684,8 @@ def verdict(have, ens_rows, win_rows, fi_rows, se_rows, rep, missing, k_rows, q_
                                  K=e["K"], N=e["N"],
                                  runs=e["runs"], t_end=e["t_end"], t0=t0, t1=t1, value=r["z"],
                                  low=r["z_low"], high=r["z_high"], onset=e["onset"],
-                                 growth_factor=e["growth"], paper=zc["value"], zloc_min=e["zloc_min"], zloc_max=e["zloc_max"]))
+                                 growth_factor=e["growth"], paper=zc["value"],
+                                 zloc_min=e["zloc_min"], zloc_max=e["zloc_max"]))
     # z against K: the paper finds the same z for K = 0.25, 1 and 5
     kz = [r for r in k_rows if r["K"] > 0 and r.get("z_50_150") is not None]
     if len(kz) >= 2:
