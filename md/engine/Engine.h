@@ -101,8 +101,8 @@ class Engine : public RunEngine {
   /// and the multiple-time-step state. The run's own fields (config_toml, seed, frame counters)
   /// are left for the caller (md/run/Simulation).
   Checkpoint checkpoint() const;
-  /// checkpoint() with the run's fields of `run_fields` (config_toml, seed, frames_written,
-  /// next_frame_index), written atomically to checkpointPath(folder) = folder/checkpoint.h5
+  /// checkpoint() with the run's fields of `run_fields` (config_toml, seed, frames_written),
+  /// written atomically to checkpointPath(folder) = folder/checkpoint.h5
   /// (md::writeCheckpoint).
   void saveCheckpoint(const std::filesystem::path& folder, const RunFields& run_fields) override;
   Observables observables() const override;

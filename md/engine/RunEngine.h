@@ -134,9 +134,9 @@ class RunEngine {
     return folder / "checkpoint.h5";
   }
   /// Writes the checkpoint of the current state into `folder`, atomically, with the run's own
-  /// fields (`run_fields`: config_toml, seed, frames_written, next_frame_index; the rest of it
-  /// is ignored). Collective; the files are written by the writing rank. Not const: LAMMPS's
-  /// write_restart migrates atoms between ranks (the state's values do not change).
+  /// fields (`run_fields`: config_toml, seed, frames_written). Collective; the files are
+  /// written by the writing rank. Not const: LAMMPS's write_restart migrates atoms between
+  /// ranks (the state's values do not change).
   virtual void saveCheckpoint(const std::filesystem::path& folder,
                               const RunFields& run_fields) = 0;
 };

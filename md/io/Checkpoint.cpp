@@ -94,7 +94,6 @@ void writeFile(const std::string& file_path, const Checkpoint& e) {
     h5::Handle g = h5::createGroup(f, "run", c);
     writeU64(g.get(), "seed", e.run.seed, c);
     writeU64(g.get(), "frames_written", e.run.frames_written, c);
-    writeU64(g.get(), "next_frame_index", e.run.next_frame_index, c);
     h5::writeStringDataset(g.get(), "config_toml", e.run.config_toml, c);
   }
   {
@@ -287,7 +286,6 @@ struct CheckpointFile {
     h5::Handle g = group("run");
     scalar(g.get(), "/run", "seed", H5T_NATIVE_UINT64, &cp.run.seed);
     scalar(g.get(), "/run", "frames_written", H5T_NATIVE_UINT64, &cp.run.frames_written);
-    scalar(g.get(), "/run", "next_frame_index", H5T_NATIVE_UINT64, &cp.run.next_frame_index);
     if (h5::objectType(g.get(), "config_toml") != H5I_DATASET)
       throw std::runtime_error(c + " is missing dataset '/run/config_toml'");
     h5::Handle d =

@@ -12,7 +12,7 @@
 ///         x y z vx vy vz charge fx fy fz   double[N]
 ///         ix iy iz                         int32[N]
 ///     /integrator       +-- dt (double)
-///     /run              +-- seed (uint64), frames_written (uint64), next_frame_index (uint64)
+///     /run              +-- seed (uint64), frames_written (uint64)
 ///         config_toml   string                            (RunFields)
 ///     /scalars/int      +-- one int64 attribute per entry of EngineState::ints
 ///     /scalars/real     +-- one double attribute per entry of EngineState::reals
@@ -34,12 +34,11 @@
 namespace granagg::md {
 
 /// The run's own fields (md::Simulation's, the same whatever the engine): the configuration, the
-/// seed and where the trajectory stands.
+/// seed and the frames in the trajectory (the next scheduled frame follows from the step).
 struct RunFields {
   std::string config_toml;             ///< TOML text of the resolved configuration
   std::uint64_t seed = 0;              ///< RNG seed (Philox key; no RNG state is stored)
   std::uint64_t frames_written = 0;    ///< frames already in the trajectory file
-  std::uint64_t next_frame_index = 0;  ///< index of the next scheduled frame in the output schedule
 };
 
 /// The state an engine defines for itself, beyond particles and forces: named integers (counters,

@@ -497,7 +497,6 @@ void LammpsEngine::saveCheckpoint(const fs::path& /*folder: the constructor's*/,
                   {"creator", common::versionString()},
                   {"seed", std::to_string(run.seed)},
                   {"frames_written", static_cast<std::int64_t>(run.frames_written)},
-                  {"next_frame_index", static_cast<std::int64_t>(run.next_frame_index)},
                   {"config_toml", run.config_toml}};
     std::ostringstream text;
     text << "# granagg-lammps checkpoint (docs/lammps.md): the run's fields; the state is the "
@@ -570,7 +569,6 @@ LammpsCheckpoint readLammpsCheckpoint(const fs::path& folder, MPI_Comm comm) {
     ck.run_fields.config_toml = text_of("config_toml");
     ck.run_fields.seed = std::strtoull(text_of("seed").c_str(), nullptr, 10);
     ck.run_fields.frames_written = static_cast<std::uint64_t>(int_of("frames_written"));
-    ck.run_fields.next_frame_index = static_cast<std::uint64_t>(int_of("next_frame_index"));
   };
   onRankZero(rank, comm, [&] {
     if (!fs::exists(path))

@@ -71,7 +71,7 @@ struct LammpsCheckpoint {
   double box = 0.0;            ///< edge L of the periodic cube
   double sum_q2_design = 0.0;  ///< CoulombSetup::sum_q2_design of the run (0 without Coulomb)
   bool record_collisions = false;  ///< the run logs its collisions (collisions.csv)
-  RunFields run_fields;            ///< config_toml, seed, frames_written, next_frame_index
+  RunFields run_fields;            ///< config_toml, seed, frames_written
 };
 
 /// The name of the checkpoint file in a run's folder.

@@ -240,7 +240,6 @@ void CheckpointReporter::save() {
   run.config_toml = toToml(m_cfg);
   run.seed = m_cfg.system.seed;
   run.frames_written = m_trajectory.framesWritten();
-  run.next_frame_index = m_trajectory.nextFrameIndex();
   m_engine.saveCheckpoint(m_folder, run);
   m_last_step = m_engine.step();
   m_last_time = Clock::now();

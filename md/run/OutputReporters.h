@@ -75,7 +75,6 @@ class TrajectoryReporter : public Reporter {
 
   const std::filesystem::path& file() const { return m_file; }
   std::size_t framesWritten() const;
-  std::size_t nextFrameIndex() const { return m_next_frame; }
 
  private:
   [[noreturn]] void damaged(const std::string& what) const;
