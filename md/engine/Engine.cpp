@@ -163,7 +163,7 @@ void Engine::Impl::driftTaken(double max_u2) {
   const double moved = dt * std::sqrt(max_u2) + 2.0 * (std::nextafter(box.L, 2.0 * box.L) - box.L);
   drift_since_build += moved;
   drift_since_coul_build += moved;
-  u_max_last = std::sqrt(max_u2);
+  tuner.observe(std::sqrt(max_u2));
   fresh_start = false;
   ++step;
   time = time_origin + static_cast<double>(step - step_origin) * dt;

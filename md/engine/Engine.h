@@ -5,10 +5,10 @@
 ///
 /// One source for both backends: Engine::Impl (EngineImpl.h; defined in Engine.cpp,
 /// EngineLists.cpp, EngineCheckpoint.cpp, EngineAbort.cpp, EngineCoulomb.cpp and
-/// EngineTimeStep.cpp) holds the state in Thrust device vectors (structure of
-/// arrays) and loops through Thrust algorithms whose functors call the HD physics of
-/// md/potentials/. This header has no Thrust in it (pimpl), so host-only code (CLI, I/O) can use it
-/// in a CUDA build too.
+/// EngineTimeStep.cpp) holds the state in Thrust device vectors (structure of arrays) and loops
+/// through Thrust algorithms whose functors call the HD physics of md/potentials/; its lists'
+/// storage order and skins are tuned by a ListTuner (ListTuner.h). This header has no Thrust in
+/// it (pimpl), so host-only code (CLI, I/O) can use it in a CUDA build too.
 ///
 /// Storage: particles are kept sorted by cell for memory locality, re-sorted at every build of the
 /// list built from cells (the contact list without Coulomb forces, the Coulomb list with them);

@@ -12,6 +12,7 @@
 #include <thrust/transform_reduce.h>
 
 #include "md/engine/EngineImpl.h"
+#include "md/neighbor/Skin.h"
 
 namespace granagg::md {
 
@@ -36,12 +37,15 @@ void Engine::Impl::setupCoulomb(double sum_q2_design) {
   nl_coul.reset();
   if (slow_coulomb->usesMesh()) {
     nl_coul = std::make_unique<NeighborList>(d.pppm.r_cut, d.coulomb_skin);
-    coulomb_skin_cap = d.coulomb_skin;
-    coulomb_skin_follows = d.coulomb_skin_follows;
+    tuner.setCoulombRule({d.coulomb_skin_follows, slow_coulomb->setup().r_cut,
+                          COULOMB_LIST_BUILD_OVER_USE, COULOMB_SKIN_AUTO_MIN, d.coulomb_skin});
   }
   nl = NeighborList(d.contact_list_cutoff, skin);
   nl.keepPairs(d.contact_list_keeps_pairs);
-  contact_skin_follows = cfg.neighbor.skin == 0.0 && d.fast_switch.r2 > 0.0;
+  // the contact list's skin follows where it is "auto" and the list holds fast Coulomb pairs
+  const double r2 = slow_coulomb->fastSwitch().r2;
+  tuner.setContactRule({cfg.neighbor.skin == 0.0 && r2 > 0.0, r2, CONTACT_LIST_BUILD_OVER_USE,
+                        NEIGHBOR_SKIN_AUTO_MIN, skin});
   slow.eval_step = -1;
 }
 
@@ -78,7 +82,7 @@ void Engine::Impl::slowBoundsForStep() {
 double Engine::Impl::coulombEnergyNow() {
   if (!coulomb) return 0.0;
   if (nl_coul && nl_coul->needsRebuild(p, drift_since_coul_build * drift_since_coul_build)) {
-    chooseSkins(false, true);
+    tuner.tuneCoulomb(*nl_coul, dt, slow.every);
     nl_coul->build(p, box);
     drift_since_coul_build = 0.0;
   }

@@ -14,6 +14,7 @@
 #include "common/HostDevice.h"
 #include "md/compute/ContactForce.h"
 #include "md/engine/Engine.h"
+#include "md/engine/ListTuner.h"
 #include "md/engine/ParticleData.h"
 #include "md/engine/PhaseTimer.h"
 #include "md/engine/SlowCoulomb.h"
@@ -78,11 +79,8 @@ struct Engine::Impl {
   ParticleData p;
   NeighborList nl;
   ContactWork work;
+  ListTuner tuner;          // the storage order and the skins that follow the gas
   DVec<double> block_max;  // kickDrift's per-block maximum speeds
-  DVec<double> scratch_d;  // for permutations
-  DVec<int> scratch_i;
-  DVec<Scalar4> scratch4;
-  DVec<Vec3> scratch3;
   double dt = 0.0;
   double dt_auto = 0.0;  // the "auto" step (Engine::chooseTimeStep): the adaptive step's reference
   std::int64_t step = 0;
@@ -115,12 +113,6 @@ struct Engine::Impl {
   ContactModel contact;  // the contact model and its parameters (md/potentials/ContactModels.h)
   PhaseTimer timer;      // Engine::enableProfile
 
-  // Skins that follow the gas (md/neighbor/Skin.h), chosen at each build from the fastest drift
-  // velocity of the last step; they change no result, only the cost of the passes and builds
-  bool contact_skin_follows = false;  // neighbor.skin "auto" and the list has fast Coulomb pairs
-  bool coulomb_skin_follows = false;  // coulomb.skin "auto" with multiple time stepping
-  double coulomb_skin_cap = 0.0;      // the Coulomb list's skin when fixed, its largest otherwise
-  double u_max_last = -1.0;           // max |u| of the last step; < 0: none in this process yet
 
   explicit Impl(const MdConfig& c);
 
@@ -129,15 +121,10 @@ struct Engine::Impl {
   /// Copies a host state (same N, wrapped, with images and charges) into the device arrays.
   void upload(const Frame& f);
 
-  /// Stores particles in cell order (memory locality for the neighbour gathers: a particle's
-  /// neighbours then sit within a few hundred slots of it). Rows are sorted by particle id, so
-  /// forces, and hence trajectories, do not depend on the storage order. The caller rebuilds the
-  /// list. Returns false if nothing was sorted (boxes too small for cells).
-  bool sortByCell();
-
-  /// Builds the neighbour lists for the current positions (storage first re-sorted by cell: the
-  /// cost is a gather per array, far less than the cache misses of neighbours scattered in memory).
-  /// A re-sort moves slots, so it rebuilds every list.
+  /// Builds the neighbour lists for the current positions, their skins first set by the tuner
+  /// (storage first re-sorted by cell, ListTuner::sortByCell: the cost is a gather per array, far
+  /// less than the cache misses of neighbours scattered in memory). A re-sort moves slots, so it
+  /// rebuilds every list.
   void rebuildList(bool sort);
   /// Contact list only, when it alone is out of date. With a Coulomb list the storage is not
   /// re-sorted here (that would invalidate the Coulomb list's slots; it is re-sorted when the
@@ -146,13 +133,6 @@ struct Engine::Impl {
   /// a pair within R now was within R + 2 d when the Coulomb list was built, d bounding every
   /// displacement since.
   void rebuildContactList();
-
-  /// Sets the skins of the lists about to be rebuilt (only those: a list reports its new skin at
-  /// once, NeighborList::setSkin) where they follow the gas: md/neighbor/Skin.h's optimum for the
-  /// displacement bound of one use, dt max|u| of the last step for the contact list (used every
-  /// step) and `every` times that for the Coulomb list (used at slow steps). Before the first step
-  /// of this process (also after a restart) the skins keep their caps.
-  void chooseSkins(bool contact_list, bool coulomb_list);
 
   /// Builds the Coulomb solvers from designCoulomb's parameters for the configured accuracy
   /// (md/coulomb/CoulombDesign.h, docs/coulomb.md); the contact list then reaches r_fast. The
