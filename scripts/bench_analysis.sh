@@ -24,13 +24,13 @@ ls -l "$WORK/traj.h5"
 run() {
   local label=$1
   shift
-  /usr/bin/time -v "$BIN" analyze "$WORK/traj.h5" --out "$WORK/out-$label" --threads "$THREADS" -q "$@" \
-    2> "$WORK/time-$label.txt"
+  /usr/bin/time -v "$BIN" analyze "$WORK/traj.h5" --out "$WORK/out-$label" --threads "$THREADS" \
+    -q "$@" 2> "$WORK/time-$label.txt"
   local wall mem
   wall=$(grep "Elapsed (wall clock)" "$WORK/time-$label.txt" | awk '{print $NF}')
   mem=$(grep "Maximum resident set size" "$WORK/time-$label.txt" | awk '{print $NF}')
-  printf "%-28s N = %-8s frames = %-5s threads = %s  wall = %s  peak RSS = %.1f MiB\n" "$label" "$N" "$F" \
-    "$THREADS" "$wall" "$(echo "$mem / 1024" | bc -l)"
+  printf "%-28s N = %-8s frames = %-5s threads = %s  wall = %s  peak RSS = %.1f MiB\n" "$label" \
+    "$N" "$F" "$THREADS" "$wall" "$(echo "$mem / 1024" | bc -l)"
 }
 
 echo "== granagg analyze ($("$BIN" --version))"

@@ -46,7 +46,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 G=$(realpath "${1:-build/bin/granagg}")
-[ -x "$G" ] || { echo "bench_coulomb_lammps: no granagg binary at $G (build it first)" >&2; exit 1; }
+[ -x "$G" ] \
+  || { echo "bench_coulomb_lammps: no granagg binary at $G (build it first)" >&2; exit 1; }
 SIZES=${SIZES-"10000 100000"}
 DT=${DT:-0.002}
 REPEATS=${REPEATS:-2}
@@ -71,25 +72,31 @@ trap 'rm -rf "$TMP"' EXIT
 
 steps_for() {  # N -> "n1 n2"
   local var="STEPS_$1"
-  if [ -n "${!var:-}" ]; then echo "${!var}"; elif [ "$1" -le 20000 ]; then echo "24 120"; else echo "8 48"; fi  # windows of whole multiples of coulomb.every = 8
+  if [ -n "${!var:-}" ]; then echo "${!var}"
+  elif [ "$1" -le 20000 ]; then echo "24 120"
+  else echo "8 48"; fi  # windows of whole multiples of coulomb.every = 8
 }
 
 echo "Machine: $(bench_machine)"
 echo "granagg: $("$G" --version 2>&1 | head -n 1); $G"
 echo "LAMMPS:  $(bench_lmp_version); $LMP"
 echo "Load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
-echo "Settings: K = $K, granagg coulomb.accuracy = $ACC, LAMMPS kspace accuracy = $LMP_ACC (absolute, = ACC K), dt = $DT, skin = $SKIN"
+echo "Settings: K = $K, granagg coulomb.accuracy = $ACC, LAMMPS kspace accuracy = $LMP_ACC" \
+  "(absolute, = ACC K), dt = $DT, skin = $SKIN"
 echo
 
 # ---------------------------------------------------------------------------------------------
 # Initial states: random sequential insertion, Maxwell velocities at T_g = 1 exactly (as in
 # bench_md_lammps.sh), and a random +-1 charge assignment with zero net charge.
 gen_state() {  # N -> $TMP/state_N.csv (granagg, with a q column) and $TMP/state_N.data (LAMMPS)
-  if [ -n "${STATE_DIR:-}" ] && [ -s "$STATE_DIR/state_$1.csv" ] && [ -s "$STATE_DIR/state_$1.data" ]; then
+  if [ -n "${STATE_DIR:-}" ] && [ -s "$STATE_DIR/state_$1.csv" ] \
+    && [ -s "$STATE_DIR/state_$1.data" ]; then
     cp "$STATE_DIR/state_$1.csv" "$STATE_DIR/state_$1.data" "$TMP/"; return
   fi
   /usr/bin/python3 "$ROOT/scripts/lammps/make_state.py" "$1" "$PHI" "$TMP" --charged
-  if [ -n "${STATE_DIR:-}" ]; then mkdir -p "$STATE_DIR" && cp "$TMP/state_$1.csv" "$TMP/state_$1.data" "$STATE_DIR/"; fi
+  if [ -n "${STATE_DIR:-}" ]; then
+    mkdir -p "$STATE_DIR" && cp "$TMP/state_$1.csv" "$TMP/state_$1.data" "$STATE_DIR/"
+  fi
 }
 
 # ---------------------------------------------------------------------------------------------
@@ -117,7 +124,9 @@ EOF
     if [ "$3" = cut ]; then
       printf 'pair_style coul/cut 25.0\npair_coeff * *\n' >> "$TMP/two.in"
     else
-      printf 'pair_style hybrid/overlay gran/hertz/history %s 0.0 %s 0.0 0.0 0 limit_damping coul/long %s\npair_coeff * * gran/hertz/history\npair_coeff * * coul/long\nkspace_style pppm %s\n' \
+      printf 'pair_style hybrid/overlay gran/hertz/history %s 0.0 %s 0.0 0.0 0 limit_damping '\
+'coul/long %s\npair_coeff * * gran/hertz/history\npair_coeff * * coul/long\n'\
+'kspace_style pppm %s\n' \
         "$KN" "$GN" "$RC_ISSUE" "$(calc "$LMP_ACC / 10")" >> "$TMP/two.in"
     fi
     cat >> "$TMP/two.in" <<EOF
@@ -128,16 +137,20 @@ run             0
 variable        f equal fx[1]
 print           "TWO_CHARGE fx=\$(v_f:%.8f)"
 EOF
-    (cd "$TMP" && "$LMP" -in two.in -log none -nocite -echo none 2>&1) | sed -n 's/^TWO_CHARGE fx=\(.*\)/\1/p'
+    (cd "$TMP" && "$LMP" -in two.in -log none -nocite -echo none 2>&1) \
+      | sed -n 's/^TWO_CHARGE fx=\(.*\)/\1/p'
   }
-  echo "Coulomb prefactor: force on charge +1 at the origin from charge q2 at distance r on the x axis (LAMMPS, dielectric 1/K)"
+  echo "Coulomb prefactor: force on charge +1 at the origin from charge q2 at distance r on the x" \
+    "axis (LAMMPS, dielectric 1/K)"
   echo
-  echo "| q2 | r | K q1 q2 / r^2 (repulsion > 0) | expected fx on atom 1 | LAMMPS coul/cut, open box | LAMMPS coul/long + pppm, periodic L = 60 |"
+  echo "| q2 | r | K q1 q2 / r^2 (repulsion > 0) | expected fx on atom 1 |" \
+    "LAMMPS coul/cut, open box | LAMMPS coul/long + pppm, periodic L = 60 |"
   echo "|---|---|---|---|---|---|"
   for qr in "-1 2" "1 1.5" "-1 5"; do
     read -r q2 r <<< "$qr"
     f=$(calc "$K * $q2 / ($r * $r)")
-    printf '| %s | %s | %.6f | %.6f | %s | %s |\n' "$q2" "$r" "$f" "$(calc "-1 * $f")" "$(two_charge "$q2" "$r" cut)" "$(two_charge "$q2" "$r" pppm)"
+    printf '| %s | %s | %.6f | %.6f | %s | %s |\n' "$q2" "$r" "$f" "$(calc "-1 * $f")" \
+      "$(two_charge "$q2" "$r" cut)" "$(two_charge "$q2" "$r" pppm)"
   done
   echo
 
@@ -158,8 +171,10 @@ neighbor        $SKIN bin
 run             0
 write_dump      all custom $3 id fx fy fz modify sort id
 EOF
-    (cd "$TMP" && "$LMP" -in acc.in -log none -nocite -echo none > acc.log 2>&1) || { cat "$TMP/acc.log" >&2; exit 1; }
-    grep -E 'grid =|G vector|estimated (absolute|relative)' "$TMP/acc.log" | sed 's/^ *//' | paste -sd';' -
+    (cd "$TMP" && "$LMP" -in acc.in -log none -nocite -echo none > acc.log 2>&1) \
+      || { cat "$TMP/acc.log" >&2; exit 1; }
+    grep -E 'grid =|G vector|estimated (absolute|relative)' "$TMP/acc.log" | sed 's/^ *//' \
+      | paste -sd';' -
   }
   rms_err() {  # file -> RMS |F - F_ref| / K
     /usr/bin/python3 - "$1" "$TMP/ref.dump" "$K" <<'EOF'
@@ -175,7 +190,9 @@ print(f"{math.sqrt(se) / K:.2e} {math.sqrt(se / sf):.2e}")
 EOF
   }
   lmp_forces 9.0 "ewald 1e-10" "$TMP/ref.dump" > /dev/null
-  echo "LAMMPS's Coulomb force error on the N = 1000 state (+-1, phi = $PHI, K = $K) against LAMMPS ewald 1e-10: RMS |F - F_ref| / K (granagg's definition of coulomb.accuracy) and / RMS force"
+  echo "LAMMPS's Coulomb force error on the N = 1000 state (+-1, phi = $PHI, K = $K) against" \
+    "LAMMPS ewald 1e-10: RMS |F - F_ref| / K (granagg's definition of coulomb.accuracy) and /" \
+    "RMS force"
   echo
   echo "| kspace_style | cutoff | error / K | error / RMS force | LAMMPS's log |"
   echo "|---|---|---|---|---|"
@@ -253,7 +270,8 @@ ROWS=()
 NOTES=()
 for N in $SIZES; do
   read -r n1 n2 <<< "$(steps_for "$N")"
-  echo "N = $N: generating the initial state, timing steps $n1..$n2 ($REPEATS repeats; load $(cut -d' ' -f1 /proc/loadavg))" >&2
+  echo "N = $N: generating the initial state, timing steps $n1..$n2" \
+    "($REPEATS repeats; load $(cut -d' ' -f1 /proc/loadavg))" >&2
   gen_state "$N"
   declare -A T=() R=() LR=()
   tl() {  # key ranks rc acc [respa]: one LAMMPS timing appended to T[key], R[key]
@@ -269,7 +287,8 @@ for N in $SIZES; do
       tl "s$rc" 1 "$rc" "$LMP_ACC"
       r=${R[s$rc]% }
       echo "  LAMMPS cutoff $rc, 1 rank: $r particle-steps/s" >&2
-      NOTES+=("- N = $N, LAMMPS cutoff scan (1 rank, pppm $LMP_ACC): cutoff $rc: $(printf '%.3g' "$r") particle-steps/s; $(lammps_info "$TMP/lmp_${N}_1_${rc}_${LMP_ACC}.log")")
+      NOTES+=("- N = $N, LAMMPS cutoff scan (1 rank, pppm $LMP_ACC): cutoff $rc: $(printf '%.3g' \
+        "$r") particle-steps/s; $(lammps_info "$TMP/lmp_${N}_1_${rc}_${LMP_ACC}.log")")
       if awk "BEGIN {exit !($r > $best_rate)}"; then best_rate=$r; best_rc=$rc; fi
     done
   fi
@@ -287,45 +306,59 @@ for N in $SIZES; do
       T[a$th]+="$ta "; T[b$th]+="$tb "; R[g$th]+="$(calc "$N * ($n2 - $n1) / ($tb - $ta)") "
       for ev in $EVERY_ALSO; do
         ta=$(granagg_time "$N" "$n1" "$th" "$ev"); tb=$(granagg_time "$N" "$n2" "$th" "$ev")
-        T[a${th}_$ev]+="$ta "; T[b${th}_$ev]+="$tb "; R[g${th}_$ev]+="$(calc "$N * ($n2 - $n1) / ($tb - $ta)") "
+        T[a${th}_$ev]+="$ta "; T[b${th}_$ev]+="$tb "
+        R[g${th}_$ev]+="$(calc "$N * ($n2 - $n1) / ($tb - $ta)") "
       done
     done
-    echo "  repeat $rep: load $(cut -d' ' -f1 /proc/loadavg); granagg $(for th in $THREADS; do printf '%s threads: %s; ' "$th" "${R[g$th]}"; done)" >&2
+    echo "  repeat $rep: load $(cut -d' ' -f1 /proc/loadavg); granagg $(for th in $THREADS; do
+      printf '%s threads: %s; ' "$th" "${R[g$th]}"; done)" >&2
   done
   for rc in $RCS; do
-    which="issue's cutoff"; [ "$rc" = "$RC_ISSUE" ] || which="tuned cutoff (fastest of $RC_SCAN on 1 rank)"
+    which="issue's cutoff"
+    [ "$rc" = "$RC_ISSUE" ] || which="tuned cutoff (fastest of $RC_SCAN on 1 rank)"
     for np in $LMP_RANKS; do
       # shellcheck disable=SC2086
       LR[${np}_$rc]=$(calc "$N * ($n2 - $n1) / $(mins ${T[l${np}_$rc]})")
       # shellcheck disable=SC2086
-      ROWS+=("| $N | LAMMPS pppm $LMP_ACC, $which | $rc | $np | $(printf '%.3g' "${LR[${np}_$rc]}") | | $(range ${R[l${np}_$rc]}) |")
-      NOTES+=("- N = $N, LAMMPS cutoff $rc, $np rank(s): $(lammps_info "$TMP/lmp_${N}_${np}_${rc}_${LMP_ACC}.log")")
+      ROWS+=("| $N | LAMMPS pppm $LMP_ACC, $which | $rc | $np | $(printf '%.3g' \
+        "${LR[${np}_$rc]}") | | $(range ${R[l${np}_$rc]}) |")
+      NOTES+=("- N = $N, LAMMPS cutoff $rc, $np rank(s): $(lammps_info \
+        "$TMP/lmp_${N}_${np}_${rc}_${LMP_ACC}.log")")
       for k in $LMP_RESPA; do
         # shellcheck disable=SC2086
         LR[r${k}_${np}_$rc]=$(calc "$N * ($n2 - $n1) / $(mins ${T[r${k}_${np}_$rc]})")
         # shellcheck disable=SC2086
-        ROWS+=("| $N | LAMMPS pppm $LMP_ACC, run_style respa 2 $k (coul/long + pppm every $k steps), $which | $rc | $np | $(printf '%.3g' "${LR[r${k}_${np}_$rc]}") | | $(range ${R[r${k}_${np}_$rc]}) |")
-        NOTES+=("- N = $N, LAMMPS respa 2 $k, cutoff $rc, $np rank(s): $(lammps_info "$TMP/lmp_${N}_${np}_${rc}_${LMP_ACC}_respa$k.log")")
+        ROWS+=("| $N | LAMMPS pppm $LMP_ACC, run_style respa 2 $k (coul/long + pppm every $k \
+steps), $which | $rc | $np | $(printf '%.3g' "${LR[r${k}_${np}_$rc]}") | | $(range \
+          ${R[r${k}_${np}_$rc]}) |")
+        NOTES+=("- N = $N, LAMMPS respa 2 $k, cutoff $rc, $np rank(s): $(lammps_info \
+          "$TMP/lmp_${N}_${np}_${rc}_${LMP_ACC}_respa$k.log")")
       done
     done
   done
   if [ -n "${ISSUE_LITERAL:-}" ]; then
     # shellcheck disable=SC2086
-    ROWS+=("| $N | LAMMPS literal pppm 1e-4 (5x stricter), issue's cutoff | $RC_ISSUE | 1 | $(printf '%.3g' "$(calc "$N * ($n2 - $n1) / $(mins ${T[lit]})")") | | $(range ${R[lit]}) |")
-    NOTES+=("- N = $N, LAMMPS literal pppm 1e-4, cutoff $RC_ISSUE, 1 rank: $(lammps_info "$TMP/lmp_${N}_1_${RC_ISSUE}_1e-4.log")")
+    ROWS+=("| $N | LAMMPS literal pppm 1e-4 (5x stricter), issue's cutoff | $RC_ISSUE | 1 | $(
+      printf '%.3g' "$(calc "$N * ($n2 - $n1) / $(mins ${T[lit]})")") | | $(range ${R[lit]}) |")
+    NOTES+=("- N = $N, LAMMPS literal pppm 1e-4, cutoff $RC_ISSUE, 1 rank: $(lammps_info \
+      "$TMP/lmp_${N}_1_${RC_ISSUE}_1e-4.log")")
   fi
   for th in $THREADS; do
     # shellcheck disable=SC2086
     rate=$(calc "$N * ($n2 - $n1) / ($(mins ${T[b$th]}) - $(mins ${T[a$th]}))")
     ratios=""
     for rc in $RCS; do
-      [ -z "${LR[${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[${th}_$rc]}" | xargs printf '%.2f') (cutoff $rc); "
+      [ -z "${LR[${th}_$rc]:-}" ] \
+        || ratios+="$(calc "$rate / ${LR[${th}_$rc]}" | xargs printf '%.2f') (cutoff $rc); "
       for k in $LMP_RESPA; do
-        [ -z "${LR[r${k}_${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[r${k}_${th}_$rc]}" | xargs printf '%.2f') (respa $k, cutoff $rc); "
+        [ -z "${LR[r${k}_${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[r${k}_${th}_$rc]}" \
+          | xargs printf '%.2f') (respa $k, cutoff $rc); "
       done
     done
     # shellcheck disable=SC2086
-    ROWS+=("| $N | granagg pppm $ACC, own choice, coulomb.every = 8 (default) | $(sed 's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' "$rate") | ${ratios%; } | $(range ${R[g$th]}) |")
+    ROWS+=("| $N | granagg pppm $ACC, own choice, coulomb.every = 8 (default) | $(sed \
+      's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' \
+      "$rate") | ${ratios%; } | $(range ${R[g$th]}) |")
   done
   for ev in $EVERY_ALSO; do
     for th in $THREADS; do
@@ -333,10 +366,13 @@ for N in $SIZES; do
       rate=$(calc "$N * ($n2 - $n1) / ($(mins ${T[b${th}_$ev]}) - $(mins ${T[a${th}_$ev]}))")
       ratios=""
       for rc in $RCS; do
-        [ -z "${LR[${th}_$rc]:-}" ] || ratios+="$(calc "$rate / ${LR[${th}_$rc]}" | xargs printf '%.2f') (cutoff $rc); "
+        [ -z "${LR[${th}_$rc]:-}" ] \
+          || ratios+="$(calc "$rate / ${LR[${th}_$rc]}" | xargs printf '%.2f') (cutoff $rc); "
       done
       # shellcheck disable=SC2086
-      ROWS+=("| $N | granagg pppm $ACC, coulomb.every = $ev | $(sed 's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' "$rate") | ${ratios%; } | $(range ${R[g${th}_$ev]}) |")
+      ROWS+=("| $N | granagg pppm $ACC, coulomb.every = $ev | $(sed \
+        's/.*r_cut = \([0-9.]*\).*/\1/' "$TMP/g_coulomb_$N.txt") | $th | $(printf '%.3g' \
+        "$rate") | ${ratios%; } | $(range ${R[g${th}_$ev]}) |")
     done
   done
   NOTES+=("- N = $N, granagg: $(cat "$TMP/g_coulomb_$N.txt")")
@@ -344,9 +380,12 @@ for N in $SIZES; do
 done
 
 if [ -n "$SIZES" ]; then
-  echo "Throughput: phi = $PHI, K = $K, fixed +-1 charges (zero net), dt = $DT, skin $SKIN, clamped Hertz (E = $E, D = $D), T(0) = 1; rates over steps n1..n2 from the fastest of $REPEATS runs of each kind (LAMMPS cutoff scan: one run each)"
+  echo "Throughput: phi = $PHI, K = $K, fixed +-1 charges (zero net), dt = $DT, skin $SKIN," \
+    "clamped Hertz (E = $E, D = $D), T(0) = 1; rates over steps n1..n2 from the fastest of" \
+    "$REPEATS runs of each kind (LAMMPS cutoff scan: one run each)"
   echo
-  echo "| N | code, Coulomb set-up | real-space cutoff | cores (threads or ranks) | particle-steps/s | granagg / LAMMPS on as many cores | range over repeats |"
+  echo "| N | code, Coulomb set-up | real-space cutoff | cores (threads or ranks) |" \
+    "particle-steps/s | granagg / LAMMPS on as many cores | range over repeats |"
   echo "|---|---|---|---|---|---|---|"
   printf '%s\n' "${ROWS[@]}"
   echo

@@ -70,8 +70,9 @@ granagg_output_toml >> "$TMP/base.toml"
 run_time() {  # method N steps -> wall seconds of the whole process; the set-up into $TMP/coul
   local t0 t1
   t0=$(now)
-  OMP_NUM_THREADS=$THREADS "$G" md --config "$TMP/base.toml" --set system.N="$2" --set coulomb.method="$1" \
-    --set run.t_end="$(calc "$3 * $DT")" --threads "$THREADS" --out "$TMP/out" --force --profile \
+  OMP_NUM_THREADS=$THREADS "$G" md --config "$TMP/base.toml" --set system.N="$2" \
+    --set coulomb.method="$1" --set run.t_end="$(calc "$3 * $DT")" --threads "$THREADS" \
+    --out "$TMP/out" --force --profile \
     > "$TMP/log" 2>&1 || { cat "$TMP/log" >&2; exit 1; }
   t1=$(now)
   # steps, box and the Coulomb parameters from profile.csv (machine-readable; the log is for
@@ -92,17 +93,26 @@ PY
 }
 steps_for() {  # method N -> "n1 n2": about 1-2 s of timed work where affordable
   if [ "$1" = ewald ]; then
-    if [ "$2" -le 250 ]; then echo "10 210"; elif [ "$2" -le 1000 ]; then echo "2 12"; elif [ "$2" -le 2828 ]; then echo "1 5"; else echo "1 3"; fi
+    if [ "$2" -le 250 ]; then echo "10 210"
+    elif [ "$2" -le 1000 ]; then echo "2 12"
+    elif [ "$2" -le 2828 ]; then echo "1 5"
+    else echo "1 3"; fi
   else
-    if [ "$2" -le 2000 ]; then echo "20 220"; elif [ "$2" -le 20000 ]; then echo "10 60"; else echo "3 13"; fi
+    if [ "$2" -le 2000 ]; then echo "20 220"
+    elif [ "$2" -le 20000 ]; then echo "10 60"
+    else echo "3 13"; fi
   fi
 }
 
 mkdir -p "$(dirname "$CSV")"
-echo "method,N,L,threads,alpha,r_cut,mesh_or_kmax,order,n1,n2,seconds_per_step,range_low,range_high" > "$CSV"
-echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs); granagg $("$G" --version 2>&1 | head -n 1); $THREADS thread(s); load at start $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "method,N,L,threads,alpha,r_cut,mesh_or_kmax,order,n1,n2,seconds_per_step,range_low,\
+range_high" > "$CSV"
+echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs);" \
+  "granagg $("$G" --version 2>&1 | head -n 1); $THREADS thread(s);" \
+  "load at start $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
-echo "| method | N | parameters (granagg's choice for accuracy $ACC) | steps timed | s per step | range over $REPEATS repeats |"
+echo "| method | N | parameters (granagg's choice for accuracy $ACC) | steps timed | s per step |" \
+  "range over $REPEATS repeats |"
 echo "|---|---|---|---|---|---|"
 for method in pppm ewald; do
   sizes=$PPPM_SIZES; [ "$method" = pppm ] || sizes=$EWALD_SIZES
@@ -122,10 +132,12 @@ for method in pppm ewald; do
       coul="ewald: alpha = $alpha, r_cut = $rc, k_max $mk"
     fi
     echo "$method,$N,$L,$THREADS,$alpha,$rc,$mk,$order,$n1,$n2,$best,$best,$worst" >> "$CSV"
-    printf '| %s | %s | %s | %s..%s | %.4g | %.3g-%.3g |\n' "$method" "$N" "$coul" "$n1" "$n2" "$best" "$best" "$worst"
+    printf '| %s | %s | %s | %s..%s | %.4g | %.3g-%.3g |\n' "$method" "$N" "$coul" "$n1" "$n2" \
+      "$best" "$best" "$worst"
     echo "  $method N = $N: $best s/step (load $(cut -d' ' -f1 /proc/loadavg))" >&2
     if [ "$method" = ewald ] && awk "BEGIN {exit !($best > $EWALD_MAX_STEP_S)}"; then
-      echo "  plain Ewald took $best s per step at N = $N: stopping the series (EWALD_MAX_STEP_S = $EWALD_MAX_STEP_S)" >&2
+      echo "  plain Ewald took $best s per step at N = $N: stopping the series" \
+        "(EWALD_MAX_STEP_S = $EWALD_MAX_STEP_S)" >&2
       break
     fi
   done

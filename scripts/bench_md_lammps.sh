@@ -8,8 +8,10 @@
 #
 #   usage: bash scripts/bench_md_lammps.sh [GRANAGG_BINARY]      (default build/bin/granagg)
 #   environment: SIZES="10000 100000"  STEPS_10000="200 2000"  STEPS_100000="100 500"
-#                DT=0.002  SKIN=0.3  REPEATS=3  THREADS="1 2"  LMP_RANKS="1 2"  SKIP_TWO_BODY=1 (skip the mapping check)
-#                LMP_FIXES="nve nve/sphere" (LAMMPS integrators timed; the ratio is against the fastest)
+#                DT=0.002  SKIN=0.3  REPEATS=3  THREADS="1 2"  LMP_RANKS="1 2"
+#                SKIP_TWO_BODY=1 (skip the mapping check)
+#                LMP_FIXES="nve nve/sphere" (LAMMPS integrators timed; the ratio is against the
+#                fastest)
 #                PAPER_SCALE=1: also the paper-scale neutral run end to end (N = 50016 to t = 1000,
 #                `--preset paper`, seed 1, 2 threads), on the fixed "auto" step and on
 #                integrator.dt = "adaptive", interleaved, the fastest of REPEATS each (~5 min)
@@ -58,7 +60,8 @@ LMP_FIXES=${LMP_FIXES:-"nve nve/sphere"}
 KN=$(calc "2 * $E"); GN=$(calc "4 * $D")
 
 bench_need_lmp bench_md_lammps
-if ! command -v mpirun >/dev/null 2>&1; then  # Debian's lammps pulls in Open MPI; without it, serial only
+# Debian's lammps pulls in Open MPI; without it, serial only
+if ! command -v mpirun >/dev/null 2>&1; then
   LMP_RANKS=1
 fi
 
@@ -67,7 +70,9 @@ trap 'rm -rf "$TMP"' EXIT
 
 steps_for() {  # N -> "n1 n2": STEPS_<N> if set, else 200 2000 up to N = 2e4 and 100 500 above
   local var="STEPS_$1"
-  if [ -n "${!var:-}" ]; then echo "${!var}"; elif [ "$1" -le 20000 ]; then echo "200 2000"; else echo "100 500"; fi
+  if [ -n "${!var:-}" ]; then echo "${!var}"
+  elif [ "$1" -le 20000 ]; then echo "200 2000"
+  else echo "100 500"; fi
 }
 
 # ---------------------------------------------------------------------------------------------
@@ -85,28 +90,34 @@ if [ -z "${SKIP_TWO_BODY:-}" ]; then
   declare -A EG
   for c in clamped unclamped; do
     flag=""; [ $c = unclamped ] && flag=--unclamped
-    while IFS=, read -r v e _; do EG[$c,$v]=$e; done < <("$G" kinetic restitution --v "$(echo "$VS" | tr ' ' ,)" $flag 2>/dev/null | grep -v '^#' | tail -n +2)
+    while IFS=, read -r v e _; do EG[$c,$v]=$e; done \
+      < <("$G" kinetic restitution --v "$(echo "$VS" | tr ' ' ,)" $flag 2>/dev/null \
+          | grep -v '^#' | tail -n +2)
   done
   lmp_e() {  # v clamp dt -> e
-    (cd "$TMP" && "$LMP" -in "$ROOT/scripts/lammps/two_body.in" -var v "$1" -var clamp "$2" -var dt "$3" -log none -nocite -echo none) \
+    (cd "$TMP" && "$LMP" -in "$ROOT/scripts/lammps/two_body.in" -var v "$1" -var clamp "$2" \
+      -var dt "$3" -log none -nocite -echo none) \
       | sed -n 's/^TWO_BODY .* e=\([-0-9.e]*\) .*/\1/p'
   }
-  echo "Two-body head-on collision, restitution e(v): LAMMPS pair gran/hertz/history (kn = 2E, gamma_n = 4D) against \`granagg kinetic restitution\`"
+  echo "Two-body head-on collision, restitution e(v): LAMMPS pair gran/hertz/history" \
+    "(kn = 2E, gamma_n = 4D) against \`granagg kinetic restitution\`"
   echo
-  echo "| v | granagg clamped | LAMMPS limit_damping, dt=1e-5 | LAMMPS limit_damping, dt=$DT | granagg unclamped (\`--unclamped\`) | LAMMPS without limit_damping, dt=1e-5 |"
+  echo "| v | granagg clamped | LAMMPS limit_damping, dt=1e-5 | LAMMPS limit_damping, dt=$DT |" \
+    "granagg unclamped (\`--unclamped\`) | LAMMPS without limit_damping, dt=1e-5 |"
   echo "|---|---|---|---|---|---|"
   for v in $VS; do
     printf '| %s | %.6f | %s | %s | %.6f | %s |\n' "$v" "${EG[clamped,$v]:-nan}" \
-      "$(lmp_e "$v" 1 1e-5)" "$(lmp_e "$v" 1 "$DT")" "${EG[unclamped,$v]:-nan}" "$(lmp_e "$v" 0 1e-5)"
+      "$(lmp_e "$v" 1 1e-5)" "$(lmp_e "$v" 1 "$DT")" "${EG[unclamped,$v]:-nan}" \
+      "$(lmp_e "$v" 0 1e-5)"
   done
   echo
 fi
 
 # ---------------------------------------------------------------------------------------------
 # Throughput
-gen_state() {  # N -> $TMP/state_N.csv (granagg) and $TMP/state_N.data (LAMMPS): random non-overlapping
-  # positions (random sequential addition, cell list) and Gaussian velocities with zero momentum
-  # rescaled to T_g = (1/3N) sum v^2 = 1 exactly, like granagg's own random state.
+gen_state() {  # N -> $TMP/state_N.csv (granagg) and $TMP/state_N.data (LAMMPS): random
+  # non-overlapping positions (random sequential addition, cell list) and Gaussian velocities with
+  # zero momentum rescaled to T_g = (1/3N) sum v^2 = 1 exactly, like granagg's own random state.
   /usr/bin/python3 "$ROOT/scripts/lammps/make_state.py" "$1" "$PHI" "$TMP"
 }
 
@@ -149,7 +160,8 @@ ROWS=()
 NOTES=()
 for N in $SIZES; do
   read -r n1 n2 <<< "$(steps_for "$N")"
-  echo "N = $N: generating the initial state, timing steps $n1..$n2 ($REPEATS repeats; load $(cut -d' ' -f1 /proc/loadavg))" >&2
+  echo "N = $N: generating the initial state, timing steps $n1..$n2" \
+    "($REPEATS repeats; load $(cut -d' ' -f1 /proc/loadavg))" >&2
   gen_state "$N"
   declare -A T=() R=()
   for rep in $(seq "$REPEATS"); do
@@ -163,7 +175,10 @@ for N in $SIZES; do
       ta=$(granagg_time "$N" "$n1" "$th"); tb=$(granagg_time "$N" "$n2" "$th")
       T[a$th]+="$ta "; T[b$th]+="$tb "; R[g$th]+="$(calc "$N * ($n2 - $n1) / ($tb - $ta)") "
     done
-    echo "  repeat $rep: load $(cut -d' ' -f1 /proc/loadavg); rates so far: LAMMPS $(for np in $LMP_RANKS; do for fix in $LMP_FIXES; do printf '%s ranks %s: %s; ' "$np" "$fix" "${R[l$np$fix]}"; done; done)granagg $(for th in $THREADS; do printf '%s threads: %s; ' "$th" "${R[g$th]}"; done)" >&2
+    echo "  repeat $rep: load $(cut -d' ' -f1 /proc/loadavg); rates so far: LAMMPS $(
+      for np in $LMP_RANKS; do for fix in $LMP_FIXES; do
+        printf '%s ranks %s: %s; ' "$np" "$fix" "${R[l$np$fix]}"; done; done)granagg $(
+      for th in $THREADS; do printf '%s threads: %s; ' "$th" "${R[g$th]}"; done)" >&2
   done
   # rate from the fastest run of each kind (load only ever slows a run down)
   declare -A LR=()
@@ -174,7 +189,8 @@ for N in $SIZES; do
       # the ratio is against the fastest LAMMPS set-up on as many cores
       LR[$np]=$(awk -v a="${LR[$np]:-0}" -v b="$lr" 'BEGIN {print (b > a) ? b : a}')
       # shellcheck disable=SC2086
-      ROWS+=("| $N | LAMMPS gran/hertz/history + fix $fix, $([ "$np" -eq 1 ] && echo serial || echo "MPI") | $np | $(printf '%.3g' "$lr") | | | $(range ${R[l$np$fix]}) |")
+      ROWS+=("| $N | LAMMPS gran/hertz/history + fix $fix, $([ "$np" -eq 1 ] && echo serial \
+        || echo "MPI") | $np | $(printf '%.3g' "$lr") | | | $(range ${R[l$np$fix]}) |")
     done
   done
   for th in $THREADS; do
@@ -191,12 +207,14 @@ for N in $SIZES; do
       paired=$(printf '%s\n' "${lists[@]}" | awk -v g="${R[g$th]}" '
         {n = split($0, a, " "); for (k = 1; k <= n; ++k) if (a[k] > best[k]) best[k] = a[k]}
         END {m = split(g, b, " "); for (k = 1; k <= m; ++k) r[k] = b[k] / best[k]
-             for (i = 1; i <= m; ++i) for (j = i + 1; j <= m; ++j) if (r[j] < r[i]) {t = r[i]; r[i] = r[j]; r[j] = t}
+             for (i = 1; i <= m; ++i) for (j = i + 1; j <= m; ++j)
+               if (r[j] < r[i]) {t = r[i]; r[i] = r[j]; r[j] = t}
              med = (m % 2) ? r[(m + 1) / 2] : 0.5 * (r[m / 2] + r[m / 2 + 1])
              printf "%.2f (%.2f-%.2f)", med, r[1], r[m]}')
     fi
     # shellcheck disable=SC2086
-    ROWS+=("| $N | granagg, OpenMP | $th | $(printf '%.3g' "$rate") | $ratio | $paired | $(range ${R[g$th]}) |")
+    ROWS+=("| $N | granagg, OpenMP | $th | $(printf '%.3g' "$rate") | $ratio | $paired | $(range \
+      ${R[g$th]}) |")
   done
   # what the window looks like (temperature at n1 and n2, rebuilds, time split), from the log of
   # the last LAMMPS run on the fewest ranks
@@ -207,14 +225,22 @@ for N in $SIZES; do
   temp2=$(awk '/^Loop time/ {t = prev} {prev = $2} END {print t}' "$log")
   builds=$(grep 'Neighbor list builds' <<< "$last" | awk '{print $NF}')
   brk=$(lammps_time_split "$log")
-  NOTES+=("- N = $N, steps $n1..$n2: LAMMPS temperature $temps -> $temp2, $builds neighbour-list builds; LAMMPS time split (last run on $(basename "$log" .log | sed "s/lmp_//") rank(s)): $brk")
+  NOTES+=("- N = $N, steps $n1..$n2: LAMMPS temperature $temps -> $temp2, $builds neighbour-list \
+builds; LAMMPS time split (last run on $(basename "$log" .log | sed "s/lmp_//") rank(s)): $brk")
   np1=$(printf '%s\n' $LMP_RANKS | sort -n | head -n 1)
-  NOTES+=("  temperature at step $n2 by LAMMPS integrator (the same trajectory): $(for fix in $LMP_FIXES; do printf 'fix %s %s; ' "$fix" "$(awk '/^Loop time/ {t = prev} {prev = $2} END {print t}' "$TMP/lmp_${np1}_${fix//\//_}.log")"; done)")
+  NOTES+=("  temperature at step $n2 by LAMMPS integrator (the same trajectory): $(
+    for fix in $LMP_FIXES; do printf 'fix %s %s; ' "$fix" "$(awk \
+      '/^Loop time/ {t = prev} {prev = $2} END {print t}' "$TMP/lmp_${np1}_${fix//\//_}.log")"
+    done)")
 done
 
-echo "Throughput: phi = $PHI, dt = $DT, skin $SKIN, clamped Hertz (E = $E, D = $D), T(0) = 1; rates over steps n1..n2 from the fastest of $REPEATS runs of each kind; ratios against the faster LAMMPS integrator on as many cores, from the fastest runs and, per repeat, from the runs of the same repeat (median, min-max)"
+echo "Throughput: phi = $PHI, dt = $DT, skin $SKIN, clamped Hertz (E = $E, D = $D), T(0) = 1;" \
+  "rates over steps n1..n2 from the fastest of $REPEATS runs of each kind; ratios against the" \
+  "faster LAMMPS integrator on as many cores, from the fastest runs and, per repeat, from the" \
+  "runs of the same repeat (median, min-max)"
 echo
-echo "| N | code | cores (threads or ranks) | particle-steps/s | granagg / LAMMPS, fastest runs | granagg / LAMMPS per repeat: median (range) | range over repeats |"
+echo "| N | code | cores (threads or ranks) | particle-steps/s | granagg / LAMMPS, fastest runs |" \
+  "granagg / LAMMPS per repeat: median (range) | range over repeats |"
 echo "|---|---|---|---|---|---|---|"
 printf '%s\n' "${ROWS[@]}"
 echo

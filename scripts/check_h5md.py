@@ -48,7 +48,8 @@ class Checker:
         self.warnings.append(msg)
 
     def series(self, grp, name, inner, required=False):
-        """Checks a time-dependent element {value, step, time}; returns (value, step, time) or None."""
+        ("""Checks a time-dependent element {value, step, time}; """
+         """returns (value, step, time) or None.""")
         path = f"{grp.name}/{name}"
         if name not in grp:
             if required:
@@ -64,7 +65,8 @@ class Checker:
                 return None
         value, step, time = g["value"], g["step"], g["time"]
         if value.ndim != 1 + len(inner) or tuple(value.shape[1:]) != tuple(inner):
-            self.fail(f"{path}/value has shape {value.shape}, expected (frames, {', '.join(map(str, inner))})")
+            self.fail(f"{path}/value has shape {value.shape}, "
+                      f"expected (frames, {', '.join(map(str, inner))})")
         if step.ndim == 1 and not np.issubdtype(step.dtype, np.integer):
             self.fail(f"{path}/step has type {step.dtype}, expected an integer type")
         if step.ndim == 1 and step.shape[0] < value.shape[0] - 1:
@@ -72,7 +74,8 @@ class Checker:
         if time.ndim == 1 and time.shape[0] < value.shape[0] - 1:
             self.fail(f"{path}/time has {time.shape[0]} entries for {value.shape[0]} values")
         if "unit" in value.attrs:
-            self.warn(f"{path}/value has a unit attribute ({as_str(value.attrs['unit'])}); granagg writes reduced units")
+            self.warn(f"{path}/value has a unit attribute ({as_str(value.attrs['unit'])}); "
+                      "granagg writes reduced units")
         return value, step, time
 
 
@@ -156,7 +159,8 @@ def check(path, group_name=None, verbose=True, paraview=False):
             b = p["box"]
             dim = b.attrs.get("dimension")
             if dim is None or int(np.asarray(dim).ravel()[0]) != 3:
-                c.fail(f"{b.name} dimension attribute is {dim}, expected 3 (MDAnalysis refuses anything else)")
+                c.fail(f"{b.name} dimension attribute is {dim}, "
+                       "expected 3 (MDAnalysis refuses anything else)")
             bnd = b.attrs.get("boundary")
             if bnd is None:
                 c.fail(f"{b.name} has no boundary attribute")
@@ -184,7 +188,8 @@ def check(path, group_name=None, verbose=True, paraview=False):
                             c.fail(f"{ev.name} has non-positive or non-finite edges")
                         box_L = diag[:, 0]
             else:
-                c.warn(f"{b.name}/edges is a fixed dataset; MDAnalysis' H5MD reader expects a 3x3 matrix per frame")
+                c.warn(f"{b.name}/edges is a fixed dataset; "
+                       "MDAnalysis' H5MD reader expects a 3x3 matrix per frame")
                 box_L = np.full(frames, float(np.asarray(b["edges"]).ravel()[0]))
 
         # positions finite and wrapped into [0, L)
@@ -205,13 +210,15 @@ def check(path, group_name=None, verbose=True, paraview=False):
         if "observables" in f:
             for key, g in f["observables"].items():
                 if not isinstance(g, h5py.Group) or "value" not in g:
-                    c.fail(f"/observables/{key} is not a time series group; MDAnalysis would fail on it")
+                    c.fail(f"/observables/{key} is not a time series group; "
+                           "MDAnalysis would fail on it")
                 elif g["value"].shape[0] != frames:
-                    c.fail(f"/observables/{key} has {g['value'].shape[0]} samples for {frames} frames; "
-                           "MDAnalysis indexes it by frame")
+                    c.fail(f"/observables/{key} has {g['value'].shape[0]} samples "
+                           f"for {frames} frames; MDAnalysis indexes it by frame")
         if "granagg" in f and "observables" in f["granagg"]:
             for key, g in f["granagg"]["observables"].items():
-                if not isinstance(g, h5py.Group) or any(d not in g for d in ("value", "step", "time")):
+                if not isinstance(g, h5py.Group) or any(
+                        d not in g for d in ("value", "step", "time")):
                     c.fail(f"/granagg/observables/{key} is not a {{value, step, time}} group")
                 elif not (g["value"].shape[0] <= g["step"].shape[0] + 1 and g["value"].ndim == 1):
                     c.fail(f"/granagg/observables/{key} has inconsistent lengths")
@@ -247,22 +254,27 @@ def check_xdmf(c, path, n, frames, paraview=False):
     if len(grids) > frames:
         c.fail(f"{xdmf} describes {len(grids)} frames, the file has {frames}")
     elif len(grids) < frames:  # a running writer refreshes the sidecar every 100 frames past 1000
-        c.warn(f"{xdmf} describes {len(grids)} of {frames} frames (stale until the writer flushes or closes)")
+        c.warn(f"{xdmf} describes {len(grids)} of {frames} frames "
+               "(stale until the writer flushes or closes)")
     base = os.path.dirname(os.path.abspath(xdmf))
     with h5py.File(path, "r") as f:
         for g in grids[:1] + grids[-1:]:
             topo = g.find("Topology")
-            if topo is None or topo.get("TopologyType") != "Polyvertex" or topo.get("NumberOfElements") != str(n):
-                c.fail(f"{xdmf} grid {g.get('Name')}: expected a Polyvertex topology of {n} elements")
+            if (topo is None or topo.get("TopologyType") != "Polyvertex"
+                    or topo.get("NumberOfElements") != str(n)):
+                c.fail(f"{xdmf} grid {g.get('Name')}: "
+                       f"expected a Polyvertex topology of {n} elements")
             for item in g.iter("DataItem"):
                 if item.get("Format") != "HDF":
                     continue
                 fname, _, dset = item.text.strip().partition(":")
-                if os.path.normpath(os.path.join(base, fname)) != os.path.normpath(os.path.abspath(path)):
+                if (os.path.normpath(os.path.join(base, fname))
+                        != os.path.normpath(os.path.abspath(path))):
                     c.fail(f"{xdmf} refers to {fname}, not {os.path.basename(path)}")
                 elif dset not in f:
                     c.fail(f"{xdmf} refers to missing dataset {dset}")
-                elif [int(x) for x in item.get("Dimensions").split()][1:] != list(f[dset].shape[1:]):
+                elif ([int(x) for x in item.get("Dimensions").split()][1:]
+                      != list(f[dset].shape[1:])):
                     c.fail(f"{xdmf}: Dimensions of {dset} do not match the file")
     if not paraview:
         return
@@ -291,7 +303,8 @@ def check_xdmf(c, path, n, frames, paraview=False):
     if d.GetNumberOfPoints() != n or ref is None or not np.array_equal(pts, ref):
         c.fail(f"ParaView's XDMF Reader does not reproduce the last frame's positions from {xdmf}")
     else:
-        print(f"ParaView XDMF Reader: {frames} time steps, {d.GetNumberOfPoints()} points, last frame exact")
+        print(f"ParaView XDMF Reader: {frames} time steps, {d.GetNumberOfPoints()} points, "
+              "last frame exact")
 
 
 def mdanalysis_check(c, path, n, frames):
@@ -333,10 +346,12 @@ def report(c, path, n, frames, box_L, verbose):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("file", help="H5MD trajectory (traj.h5)")
-    ap.add_argument("--group", default=None, help="particle group under /particles (default: the first)")
+    ap.add_argument("--group", default=None,
+                    help="particle group under /particles (default: the first)")
     ap.add_argument("--quiet", action="store_true", help="print problems only")
     ap.add_argument("--paraview", action="store_true",
-                    help="also load the XDMF sidecar with ParaView's XDMF Reader (needs paraview's Python module)")
+                    help="also load the XDMF sidecar with ParaView's XDMF Reader "
+                         "(needs paraview's Python module)")
     args = ap.parse_args()
     sys.exit(check(args.file, args.group, verbose=not args.quiet, paraview=args.paraview))
 

@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Writes a synthetic H5MD 1.1 trajectory for benchmarking `granagg analyze` (scripts/bench_analysis.sh).
+"""Writes a synthetic H5MD 1.1 trajectory for benchmarking `granagg analyze` \
+(scripts/bench_analysis.sh).
 
 N particles at filling fraction phi in a cubic periodic box, Maxwell velocities (T = 1), ballistic
 motion (positions wrapped with image counts), small random charges, F log-spaced frames. A
@@ -31,11 +32,13 @@ def main():
     blob = 50
     nb = int(0.2 * n) // blob
     side = int(np.ceil(blob ** (1 / 3)))
-    lattice = 1.02 * np.array([(i, j, k) for i in range(side) for j in range(side) for k in range(side)])[:blob]
+    lattice = 1.02 * np.array([(i, j, k) for i in range(side) for j in range(side)
+                               for k in range(side)])[:blob]
     for b in range(nb):
         x0[b * blob:(b + 1) * blob] = rng.uniform(0, L, 3) + lattice
     v = rng.normal(0, 1, (n, 3))
-    v[: nb * blob] = np.repeat(rng.normal(0, 1 / np.sqrt(blob), (nb, 3)), blob, axis=0)  # blobs move rigidly
+    # blobs move rigidly
+    v[: nb * blob] = np.repeat(rng.normal(0, 1 / np.sqrt(blob), (nb, 3)), blob, axis=0)
     q = rng.normal(0, 0.1, n)
     if spacing == "linear":
         times = 5.0 * np.arange(frames)

@@ -18,11 +18,14 @@ BIN=${GRANAGG_BIN:-build/bin/granagg}
 THREADS=${THREADS:-2}
 T_END=${T_END:-1000}
 mkdir -p "$(dirname "$OUT")"
-[ -f "$OUT.legs.csv" ] || echo "leg,start_utc,end_utc,wall_s,t_start,t_end,status,granagg" > "$OUT.legs.csv"
+[ -f "$OUT.legs.csv" ] \
+  || echo "leg,start_utc,end_utc,wall_s,t_start,t_end,status,granagg" > "$OUT.legs.csv"
 leg=$(( $(wc -l < "$OUT.legs.csv") ))
 t_start=0
 if [ -f "$OUT/checkpoint.h5" ]; then
-  t_start=$(/usr/bin/python3 -c "import h5py,sys; print(float(h5py.File(sys.argv[1],'r')['state'].attrs['time']))" "$OUT/checkpoint.h5")
+  t_start=$(/usr/bin/python3 -c \
+    "import h5py,sys; print(float(h5py.File(sys.argv[1],'r')['state'].attrs['time']))" \
+    "$OUT/checkpoint.h5")
   cmd=("$BIN" md --restart "$OUT" --set run.t_end="$T_END" --profile --threads "$THREADS")
 else
   cmd=("$BIN" md --preset paper --set coulomb.K=5 --set charging.Q=0.05 --set run.t_end="$T_END"
@@ -35,8 +38,11 @@ OMP_NUM_THREADS=$THREADS "${cmd[@]}" >> "$OUT.log" 2>&1
 rc=$?
 set -e
 s1=$(date +%s.%N)
-t_end=$(/usr/bin/python3 -c "import h5py,sys; print(float(h5py.File(sys.argv[1],'r')['state'].attrs['time']))" "$OUT/checkpoint.h5" 2>/dev/null || echo nan)
-echo "$leg,$start,$(date -u +%FT%TZ),$(echo "$s1 - $s0" | bc),$t_start,$t_end,$rc,$("$BIN" --version | head -n 1 | tr ',' ' ')" >> "$OUT.legs.csv"
+t_end=$(/usr/bin/python3 -c \
+  "import h5py,sys; print(float(h5py.File(sys.argv[1],'r')['state'].attrs['time']))" \
+  "$OUT/checkpoint.h5" 2>/dev/null || echo nan)
+echo "$leg,$start,$(date -u +%FT%TZ),$(echo "$s1 - $s0" | bc),$t_start,$t_end,$rc,$(
+  "$BIN" --version | head -n 1 | tr ',' ' ')" >> "$OUT.legs.csv"
 [ -f "$OUT/profile.csv" ] && cp "$OUT/profile.csv" "$OUT.profile-leg$leg.csv"
 exit $rc
 }

@@ -22,12 +22,14 @@ from granagg_tables import read  # noqa: E402
 def main():
     d = sys.argv[1]
     S, thermo, msd = read(f"{d}/S_t.csv"), read(f"{d}/thermo.csv"), read(f"{d}/msd.csv")
-    speed, ng, npart = read(f"{d}/speed_dist.csv"), read(f"{d}/N_s_grid.csv"), read(f"{d}/N_s_particle.csv")
+    speed, ng, npart = (read(f"{d}/speed_dist.csv"), read(f"{d}/N_s_grid.csv"),
+                        read(f"{d}/N_s_particle.csv"))
     fig, ax = plt.subplots(2, 3, figsize=(15, 8.5))
     a = ax[0, 0]
     for name, label in (("S_grid_mean", "grid"), ("S_particle_mean", "particle")):
         m = S["t"] > 0
-        a.errorbar(S["t"][m], S[name][m], yerr=S[name.replace("_mean", "_se")][m], label=f"S(t), {label}", fmt=".-")
+        a.errorbar(S["t"][m], S[name][m], yerr=S[name.replace("_mean", "_se")][m],
+                   label=f"S(t), {label}", fmt=".-")
     a.set(xscale="log", yscale="log", xlabel="t", ylabel="S", title="mean cluster size")
     a.legend()
     a = ax[0, 1]
@@ -52,7 +54,8 @@ def main():
             v = 0.5 * (speed["v_low"][m] + speed["v_high"][m])
             a.plot(v, speed["f_mean"][m], ".", label=f"t = {t:.3g}")
         m = speed["t"] == times[0]
-        a.plot(0.5 * (speed["v_low"][m] + speed["v_high"][m]), speed["f_maxwell_mean"][m], "k-", label="Maxwellian")
+        a.plot(0.5 * (speed["v_low"][m] + speed["v_high"][m]), speed["f_maxwell_mean"][m], "k-",
+               label="Maxwellian")
         a.set(xlabel="v~ = v / <v^2>^(1/2)", ylabel="f(v~)", title="speed distribution")
         a.legend()
     a = ax[1, 1]
@@ -63,7 +66,8 @@ def main():
     a.set(xlabel="t", title="temperature and charge")
     a.legend()
     a2 = a.twinx()
-    a2.errorbar(thermo["t"][m], thermo["a2_mean"][m], yerr=thermo["a2_err_mean"][m], fmt="r.", label="a2")
+    a2.errorbar(thermo["t"][m], thermo["a2_mean"][m], yerr=thermo["a2_err_mean"][m], fmt="r.",
+                label="a2")
     a2.set_ylabel("a2", color="r")
     a = ax[1, 2]
     if msd is not None:

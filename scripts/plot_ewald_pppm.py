@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Log-log plot of granagg's time per MD step, PPPM against plain Ewald (scripts/bench_ewald_pppm.sh).
+"""Log-log plot of granagg's time per MD step, PPPM against plain Ewald \
+(scripts/bench_ewald_pppm.sh).
 
     /usr/bin/python3 scripts/plot_ewald_pppm.py docs/img/ewald_pppm.csv docs/img/ewald_pppm.png
 
@@ -55,18 +56,21 @@ def main():
         t = np.array([p[1] for p in data["pppm"]])
         c = float(np.sum(t * n * np.log(n)) / np.sum((n * np.log(n)) ** 2))
         res = np.sqrt(np.mean((np.log(t) - np.log(c * n * np.log(n))) ** 2))
-        print(f"| pppm | {int(n.min())}-{int(n.max())} | t = c N ln N | {c:.3g} | (rms log residual {res:.2f}) |")
+        print(f"| pppm | {int(n.min())}-{int(n.max())} | t = c N ln N | {c:.3g} | "
+              f"(rms log residual {res:.2f}) |")
         # PPPM exponent over the upper half of the sizes only (cache / fixed costs at small N)
         big = n >= 1e4
         if big.sum() >= 2:
             a2, b2 = fit_power(n[big], t[big])
-            print(f"| pppm | {int(n[big].min())}-{int(n.max())} | power law | {a2:.3g} | {b2:.3f} |")
+            print(f"| pppm | {int(n[big].min())}-{int(n.max())} | power law | {a2:.3g} | "
+                  f"{b2:.3f} |")
     print()
     if "pppm" in fits and "ewald" in fits:
         (ap, bp), (ae, be) = fits["pppm"], fits["ewald"]
         if be != bp:
             nx = (ap / ae) ** (1.0 / (be - bp))
-            print(f"Crossover of the two power-law fits: N = {nx:.3g} (plain Ewald faster below, PPPM above); "
+            print(f"Crossover of the two power-law fits: N = {nx:.3g} "
+                  "(plain Ewald faster below, PPPM above); "
                   f"time per step there {ap * nx ** bp:.3g} s")
         common = sorted(set(n for n, _ in data["pppm"]) & set(n for n, _ in data["ewald"]))
         for n in common:
@@ -89,7 +93,8 @@ def main():
         ax.loglog([p[0] for p in pts], [p[1] for p in pts], mk, color=col, label=lab)
         if m in fits:
             a, b = fits[m]
-            ax.loglog(grid, a * grid ** b, "-", color=col, lw=1, alpha=0.7, label=f"fit $\\propto N^{{{b:.2f}}}$")
+            ax.loglog(grid, a * grid ** b, "-", color=col, lw=1, alpha=0.7,
+                      label=f"fit $\\propto N^{{{b:.2f}}}$")
     if "ewald" in data:
         n0, t0 = data["ewald"][0]
         ax.loglog(grid, t0 * (grid / n0) ** 1.5, "--", color="C3", lw=1, alpha=0.6,
@@ -99,8 +104,8 @@ def main():
         nx = (ap / ae) ** (1.0 / (be - bp))
         if grid[0] <= nx <= grid[-1]:
             ax.axvline(nx, color="gray", lw=0.8, ls=":")
-            ax.annotate(f"crossover N ≈ {nx:.2g}", (nx, ap * nx ** bp), textcoords="offset points",
-                        xytext=(6, -14), fontsize=8, color="gray")
+            ax.annotate(f"crossover N ≈ {nx:.2g}", (nx, ap * nx ** bp),
+                        textcoords="offset points", xytext=(6, -14), fontsize=8, color="gray")
     ax.set_xlabel("N (particles)")
     ax.set_ylabel("wall time per MD step [s]")
     ax.set_title("granagg Coulomb, K = 5, ±1 charges, φ = 0.076, accuracy 1e-4", fontsize=10)

@@ -44,7 +44,8 @@ FAILED = []
 
 def note(ax, text):
     """Marks a panel whose input is missing."""
-    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", fontsize=9, color="0.3", wrap=True)
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", fontsize=9,
+            color="0.3", wrap=True)
 
 
 class Study:
@@ -59,7 +60,8 @@ class Study:
             self.ks = [(e["name"], float(e["K"])) for e in ens]
         else:  # no summary: the analysis folders
             names = sorted(os.listdir(f"{d}/analysis")) if os.path.isdir(f"{d}/analysis") else []
-            self.ks = [(n, float(n[1:])) for n in names if n.startswith("K") and os.path.isdir(f"{d}/analysis/{n}")]
+            self.ks = [(n, float(n[1:])) for n in names
+                       if n.startswith("K") and os.path.isdir(f"{d}/analysis/{n}")]
 
     def table(self, name, kname):
         return read(f"{self.d}/analysis/{kname}/{name}.csv")
@@ -119,7 +121,8 @@ def reported_z(e):
     zi = e.get("z_analyze") or {}
     if e.get("regime") == "scaling" and zi.get("value") is not None:
         return dict(status="power law", window=e.get("z_analyze_window"), **zi)
-    return {"status": e.get("regime", "unknown"), "text": f"regime: {e.get('regime', 'unknown')}, no z"}
+    return {"status": e.get("regime", "unknown"),
+            "text": f"regime: {e.get('regime', 'unknown')}, no z"}
 
 
 def colors(i):
@@ -142,7 +145,8 @@ def fig1(st, fig):
         if th is None:
             continue
         m = th["t"] > 0
-        ax.errorbar(th["t"][m], th["T_g_mean"][m], yerr=th["T_g_se"][m], fmt="o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
+        ax.errorbar(th["t"][m], th["T_g_mean"][m], yerr=th["T_g_se"][m], fmt="o", ms=3,
+                    color=colors(i), label=f"MD, {st.label(k)}")
         any_md = True
     if cool is not None:
         m = cool["t"] > 0
@@ -154,7 +158,8 @@ def fig1(st, fig):
         note(ax, "meanfield/cooling.csv missing (granagg kinetic cooling)")
     if not any_md:
         note(ax, "no analysis/K*/thermo.csv: no MD ensemble analysed")
-    ax.set(xscale="log", yscale="log", xlabel="t", ylabel=r"$T_g$", title="Fig. 1: granular temperature")
+    ax.set(xscale="log", yscale="log", xlabel="t", ylabel=r"$T_g$",
+           title="Fig. 1: granular temperature")
     ax.legend(fontsize=8)
 
 
@@ -171,7 +176,8 @@ def load_frames(path, wanted):
         out = []
         for t in wanted:
             i = int(np.argmin(np.abs(times - t)))
-            q = charge[i] if charge is not None and charge.ndim == 2 and i < charge.shape[0] else None
+            q = (charge[i] if charge is not None and charge.ndim == 2 and i < charge.shape[0]
+                 else None)
             out.append((times[i], pos["value"][i], q))
         return L, out
 
@@ -202,8 +208,9 @@ def fig2(st, fig):
             axes.append(ax)
             slab = np.abs(x[:, 2] - L / 2) < 2.0
             # particles drawn at their true size (diameter 1 in data units)
-            ec = EllipseCollection(np.ones(slab.sum()), np.ones(slab.sum()), np.zeros(slab.sum()), units="xy",
-                                   offsets=x[slab, :2], offset_transform=ax.transData, edgecolors="k", linewidths=0.3)
+            ec = EllipseCollection(np.ones(slab.sum()), np.ones(slab.sum()), np.zeros(slab.sum()),
+                                   units="xy", offsets=x[slab, :2], offset_transform=ax.transData,
+                                   edgecolors="k", linewidths=0.3)
             if coloured:
                 ec.set_array(q[slab])
                 ec.set_cmap("coolwarm")
@@ -219,7 +226,8 @@ def fig2(st, fig):
         if coloured:
             cb = fig.colorbar(ec, ax=axes, shrink=0.8, pad=0.02)
             cb.set_label("charge q (same scale for the three times)")
-    fig.suptitle("Fig. 2: slab |z - L/2| < 2 d of run 0 projected on (x, y); particles at their true size")
+    fig.suptitle("Fig. 2: slab |z - L/2| < 2 d of run 0 projected on (x, y); "
+                 "particles at their true size")
 
 
 def fig3(st, fig):
@@ -231,13 +239,16 @@ def fig3(st, fig):
             continue
         ids = [n for n in ns.dtype.names if n.startswith("n_stick_id") and n.endswith("_mean")]
         for j, n in enumerate(ids):
-            ax.plot(ns["t"], ns[n], "-", color=colors(i), alpha=0.25, lw=0.8, label=f"tracked particles, {st.label(k)}" if j == 0 else None)
+            ax.plot(ns["t"], ns[n], "-", color=colors(i), alpha=0.25, lw=0.8,
+                    label=f"tracked particles, {st.label(k)}" if j == 0 else None)
         if "n_stick_mean_mean" in ns.dtype.names:
-            ax.plot(ns["t"], ns["n_stick_mean_mean"], "o-", ms=3, color=colors(i), label=f"mean over tracked, {st.label(k)}")
+            ax.plot(ns["t"], ns["n_stick_mean_mean"], "o-", ms=3, color=colors(i),
+                    label=f"mean over tracked, {st.label(k)}")
         drawn = True
     if not drawn:
         note(ax, "no analysis/K*/nstick.csv")
-    ax.set(xscale="log", xlabel="t", ylabel=r"$N_{stick}$", title="Fig. 3: contacts of tracked particles")
+    ax.set(xscale="log", xlabel="t", ylabel=r"$N_{stick}$",
+           title="Fig. 3: contacts of tracked particles")
     ax.legend(fontsize=8)
 
 
@@ -252,7 +263,8 @@ def fig4(st, fig):
             continue
         m = th["t"] > 0
         t, q = th["t"][m], th["mean_abs_q_mean"][m]
-        ax1.errorbar(t, q, yerr=th["mean_abs_q_se"][m], fmt="o-", ms=3, color=colors(i + 1), label=st.label(k))
+        ax1.errorbar(t, q, yerr=th["mean_abs_q_se"][m], fmt="o-", ms=3, color=colors(i + 1),
+                     label=st.label(k))
         rate = np.diff(q) / np.diff(t)
         tm = np.sqrt(t[1:] * t[:-1])
         good = rate > 0
@@ -284,13 +296,15 @@ def fig4(st, fig):
         for j, t in enumerate(pick):
             m = (ng["t"] == t) & (ng["N_s_mean"] > 0)
             # each time its own marker and line style: the legend tells them apart
-            ax3.loglog(ng["s"][m], ng["N_s_mean"][m], marker="os^"[j % 3], ls=["-", "--", ":"][j % 3], ms=4,
+            ax3.loglog(ng["s"][m], ng["N_s_mean"][m], marker="os^"[j % 3],
+                       ls=["-", "--", ":"][j % 3], ms=4,
                        mfc="none" if j == 1 else colors(i), lw=1.2, color=colors(i),
                        label=f"{st.label(k)}, t = {t:.3g}")
         drawn = True
     if not drawn:
         note(ax3, "no analysis/K*/N_s_grid.csv")
-    ax3.set(xlabel="s (grid sites)", ylabel=r"$N_s$ (clusters per frame)", title="cluster-size distribution")
+    ax3.set(xlabel="s (grid sites)", ylabel=r"$N_s$ (clusters per frame)",
+            title="cluster-size distribution")
     ax3.legend(fontsize=7, loc="upper right", handlelength=3)
     for a in (ax1, ax2, ax3):
         a.tick_params(labelsize=8)
@@ -307,7 +321,8 @@ def powerfit(t, S, lo, hi):
 
 def fig5(st, fig):
     # the local slope in a panel of its own below (an inset covered the late-time data)
-    ax, ins = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1], "hspace": 0.06})
+    ax, ins = fig.subplots(2, 1, sharex=True,
+                           gridspec_kw={"height_ratios": [2.2, 1], "hspace": 0.06})
     drawn = False
     ens = {e["name"]: e for e in st.summary.get("ensembles", [])}
     for i, k in enumerate(st.ks):
@@ -321,15 +336,18 @@ def fig5(st, fig):
         # A power-law line only where the summary reports a z (a flat local slope, an interval
         # above 0); otherwise the legend says why there is none.
         why = "" if zr.get("status") == "power law" or not zr.get("text") else f"; z: {zr['text']}"
-        ax.errorbar(t, s, yerr=S["S_grid_se"][m], fmt="o", ms=3, color=colors(i), label=f"MD, {st.label(k)}{why}")
+        ax.errorbar(t, s, yerr=S["S_grid_se"][m], fmt="o", ms=3, color=colors(i),
+                    label=f"MD, {st.label(k)}{why}")
         win = zr.get("window") or [None, None]
         if zr.get("status") == "power law" and None not in win:
             f = powerfit(t, s, win[0], win[1])
             if f:
                 _, c, tw = f
                 z = zr["value"]
-                c = np.mean(np.log(s[(t >= tw[0]) & (t <= tw[-1])]) - z * np.log(tw))  # the reported z
-                lab = f"power law over t = {win[0]:.3g}..{win[1]:.3g}: z = {z:.3g} [{zr['low']:.3g}, {zr['high']:.3g}]"
+                c = np.mean(np.log(s[(t >= tw[0]) & (t <= tw[-1])])
+                            - z * np.log(tw))  # the reported z
+                lab = (f"power law over t = {win[0]:.3g}..{win[1]:.3g}: "
+                       f"z = {z:.3g} [{zr['low']:.3g}, {zr['high']:.3g}]")
                 ax.plot(tw, np.exp(c) * tw**z, "-", color=colors(i), lw=2, label=lab)
         fc = read(f"{st.d}/fit/{k[0]}/fit_curve.csv")
         if beta_determined(e) and fc is not None and col(fc, "S_mf_fitted") is not None:
@@ -363,7 +381,8 @@ def fig6(st, fig):
         e = ens.get(k[0], {})
         if fc is not None and col(fc, "S_md") is not None and beta_determined(e):
             ax.plot(fc["t"], fc["S_md"], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)}")
-            ax.plot(fc["t"], fc["S_mf_fitted"], "-", color=colors(i), label=beta_label(e) + " (S_c, tau_c fitted)")
+            ax.plot(fc["t"], fc["S_mf_fitted"], "-", color=colors(i),
+                    label=beta_label(e) + " (S_c, tau_c fitted)")
             drawn = True
         elif S is not None:
             # no fitted beta (fit-beta not run, or beta at a bound of its range): the MD data alone
@@ -371,7 +390,8 @@ def fig6(st, fig):
             if fc is not None:
                 undetermined.append(f"K = {k[1]:g}")
             m = S["t"] > 0
-            ax.plot(S["t"][m], S["S_grid_mean"][m], "o", ms=3, color=colors(i), label=f"MD, {st.label(k)} ({why})")
+            ax.plot(S["t"][m], S["S_grid_mean"][m], "o", ms=3, color=colors(i),
+                    label=f"MD, {st.label(k)} ({why})")
         msd = st.table("msd", k[0])
         if msd is not None:
             m = msd["t"] > 0
@@ -382,7 +402,8 @@ def fig6(st, fig):
         if mf is not None and not drawn:
             ax2 = ax2 or ax.twiny()
             m = (mf["t"] > 0) & (mf["S"] < 1e4)
-            ax2.loglog(mf["t"][m], mf["S"][m], "k" + ls, label=f"mean field beta = {b} (top axis: t in 1/(K0 n1(0)))")
+            ax2.loglog(mf["t"][m], mf["S"][m], "k" + ls,
+                       label=f"mean field beta = {b} (top axis: t in 1/(K0 n1(0)))")
             ax2.legend(fontsize=7, loc="lower right")
     if not drawn:
         note(ax, (f"beta not determined ({', '.join(undetermined)}): no fitted mean-field curve"
@@ -391,7 +412,8 @@ def fig6(st, fig):
     ins.set(xlabel="t", ylabel=r"MSD / $d^2$", title="mean squared displacement")
     if ins.lines:
         ins.legend(fontsize=7)
-    ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S (grid sites)", title="Fig. 6: MD against mean-field S(t)")
+    ax.set(xscale="log", yscale="log", xlabel="t", ylabel="S (grid sites)",
+           title="Fig. 6: MD against mean-field S(t)")
     readable_log(ax)
     ax.legend(fontsize=8, loc="upper left")
 
@@ -407,15 +429,16 @@ def fig7(st, fig):
         for j, t in enumerate([ts[0], ts[-1]] if len(ts) > 1 else ts):
             m = sp["t"] == t
             v = 0.5 * (sp["v_low"][m] + sp["v_high"][m])
-            ax.plot(v, sp["f_mean"][m], "o" if j else "s", ms=3, mfc="none" if j == 0 else colors(i), color=colors(i),
+            ax.plot(v, sp["f_mean"][m], "o" if j else "s", ms=3,
+                    mfc="none" if j == 0 else colors(i), color=colors(i),
                     label=f"{st.label(k)}, t = {t:.3g}")
             if not drawn:
                 ax.plot(v, sp["f_maxwell_mean"][m], "k-", label="Maxwellian")
             drawn = True
     if not drawn:
         note(ax, "no analysis/K*/speed_dist.csv")
-    ax.set(yscale="log", ylim=(1e-4, 2), xlabel=r"$\tilde v = v/\langle v^2\rangle^{1/2}$", ylabel=r"$f(\tilde v)$",
-           title="Fig. 7: speed distribution against the Maxwellian")
+    ax.set(yscale="log", ylim=(1e-4, 2), xlabel=r"$\tilde v = v/\langle v^2\rangle^{1/2}$",
+           ylabel=r"$f(\tilde v)$", title="Fig. 7: speed distribution against the Maxwellian")
     ax.legend(fontsize=8)
 
 
@@ -431,13 +454,15 @@ def fig8(st, fig):
         drawn = True
     if not drawn:
         note(ax, "no charged ensemble (K > 0): no charge-speed data")
-    ax.set(xlabel=r"$\tilde q = q/\langle q^2\rangle^{1/2}$", ylabel=r"$\tilde v$", title="Fig. 8: charge-speed scatter")
+    ax.set(xlabel=r"$\tilde q = q/\langle q^2\rangle^{1/2}$", ylabel=r"$\tilde v$",
+           title="Fig. 8: charge-speed scatter")
     if drawn:
         ax.legend(fontsize=8)
 
 
-FIGURES = [("fig1_temperature", fig1, (7, 5)), ("fig2_snapshots", fig2, (12, 8)), ("fig3_nstick", fig3, (7, 5)),
-           ("fig4_charge", fig4, (16, 4.8)), ("fig5_growth", fig5, (7.5, 7)), ("fig6_meanfield", fig6, (12, 5)),
+FIGURES = [("fig1_temperature", fig1, (7, 5)), ("fig2_snapshots", fig2, (12, 8)),
+           ("fig3_nstick", fig3, (7, 5)), ("fig4_charge", fig4, (16, 4.8)),
+           ("fig5_growth", fig5, (7.5, 7)), ("fig6_meanfield", fig6, (12, 5)),
            ("fig7_speed", fig7, (7, 5)), ("fig8_charge_speed", fig8, (6, 5))]
 
 

@@ -32,7 +32,8 @@ def plot_S(out):
             ax.loglog(d["t"][ok], d["S"][ok], ls, color=colors[beta], label=f"beta={beta} {method}")
             z = d["z_local"]
             good = ok & np.isfinite(z)
-            az.semilogx(d["S"][good], z[good], ls, color=colors[beta], label=f"beta={beta} {method}")
+            az.semilogx(d["S"][good], z[good], ls, color=colors[beta],
+                        label=f"beta={beta} {method}")
         zinf = 3 * beta / (beta + 3)
         az.axhline(zinf, color=colors[beta], lw=0.6)
     # the paper's mean-field values (Singh & Mazza 2018): local slopes near S ~ 250 and ~ 1650
@@ -114,7 +115,8 @@ def plot_md(out):
     theory = read(os.path.join(out, "cooling.csv"))
     if theory is not None:
         names = theory.dtype.names
-        ax.loglog(theory[names[0]], theory["T"], "--", label="kinetic theory, exact e(v), Enskog rate")
+        ax.loglog(theory[names[0]], theory["T"], "--",
+                  label="kinetic theory, exact e(v), Enskog rate")
     ax.set_xlabel("t  [sqrt(m d^2/T0)]")
     ax.set_ylabel("T_g / T0")
     ax.set_xlim(left=0.05)

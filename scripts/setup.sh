@@ -24,7 +24,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   echo "granagg setup: installing ${missing[*]}"
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null
 fi
 
 [ "${GRANAGG_SETUP_NO_BUILD:-0}" = 1 ] && exit 0

@@ -12,7 +12,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${1:-build}
 [ -x "$B/tests/test_md" ] \
-  || { echo "write_reference_states.sh: no $B/tests/test_md (build the CPU tests first)" >&2; exit 2; }
+  || { echo "write_reference_states.sh: no $B/tests/test_md (build the CPU tests first)" >&2
+       exit 2; }
 "$B/tests/test_md" --write-reference "[backend]"
 "$B/tests/test_md" "[backend]"
 git status --short tests/data/backend

@@ -158,7 +158,8 @@ TEST_CASE("S without the largest cluster leaves out one largest cluster",
   CHECK(ClusterSizes::fromSizes({7}).largest_share == 1.0);
 }
 
-TEST_CASE("a mesh kept between frames gives each frame's S(k) to the bit", "[analysis][structure]") {
+TEST_CASE("a mesh kept between frames gives each frame's S(k) to the bit",
+          "[analysis][structure]") {
   // A trajectory's frames share one StructureFactorMesh (FrameObservables); the buffers are
   // cleared and the plan reused, so each frame's result must equal a fresh mesh's exactly, also
   // after a frame of another box size (another M) in between.

@@ -137,7 +137,8 @@ TEST_CASE("every docs/model.md section cited exists", "[common][repository]") {
   CHECK(*sections.begin() == 1);
   CHECK(*sections.rbegin() == static_cast<int>(sections.size()));
 
-  // "model.md section 7", "model.md sections 1, 11 and 12", "model.md §3-§7", "model.md §9, §12"
+  // "model.md section 7", "model.md sections 1, 11 and 12", "model.md §3-§7",
+  // "model.md §9, §12"
   const std::regex citation(R"(^model\.md,?\s+(?:sections?\s+|§ ?))"
                             R"((\d+(?:\s*(?:,\s*|and\s+|-|–)\s*(?:and\s+)?(?:§)?\d+)*))");
   const std::regex number(R"(\d+)");
