@@ -11,16 +11,16 @@
 #
 # part       what                                                         cost on 2 cores (measured)
 # neutral    K = 0, N = 50016, 20 runs to t = 1000 (data/pair/validate-neutral.toml)   ~30 min
-# charged5   K = 5, N = 1e4, Q = 0.05, 5 runs to t = 150 (validate-charged.toml)      ~52 min
+# charged5   K = 5, N = 1e4, Q = 0.05, 5 runs to t = 150 (validate-charged.toml)       ~9 min
 # box        K = 0, N = 400128 (L = 140), 1 run to t = 1000 (validate-box.toml)      ~45 min
 # box3000    K = 0, N = 400128 (L = 140) to t = 3000 on the adaptive time step: 2 runs with new
 #            seeds (102-103), frames every 50 (else as box): the large box past the paper's time
 #            (issue 30); also issue 29's L = 140 benchmark (the md log times each run)
-# charged1   K = 1, as charged5                                                       ~52 min
-# charged025 K = 0.25, as charged5                                                    ~52 min
-# qscan      K = 5 with Q = 0.025 and 0.1, 2 runs each to t = 100 (else as charged5)   ~26 min
+# charged1   K = 1, as charged5                                                        ~7 min
+# charged025 K = 0.25, as charged5                                                     ~7 min
+# qscan      K = 5 with Q = 0.025 and 0.1, 2 runs each to t = 100 (else as charged5)    ~3 min
 # charged5big  K = 5 at the paper's N = 50016 (L = 70.1), 5 runs to t = 150 (else as
-#            charged5): the size dependence of the onset (issue 15 made it affordable) ~50 min
+#            charged5): the size dependence of the onset (issue 15 made it affordable) ~40 min
 # charged5paper  K = 5 at the paper's N = 50016 to the paper's t = 1000: 5 runs with new seeds
 #            (100-104), frames every 50 (else as charged5); the verdict's charged ensemble at the
 #            paper's size and time (issue 30)                                   ~1 h per run
