@@ -46,7 +46,8 @@ while [ $# -gt 0 ]; do
     --n) N=$2; shift 2 ;;
     --jobs) JOBS=$2; shift 2 ;;
     -h|--help) sed -n '2,/^{/p' "$0" | grep '^#' | sed -E 's/^# ?//'; exit 0 ;;
-    ref|default|fast|follow|fastfollow|rfast25|rfast20|rfast20cap32|rfast20cap64) SETS+=("$1"); shift ;;
+    ref|default|fast|follow|fastfollow|rfast25|rfast20|rfast20cap32|rfast20cap64)
+      SETS+=("$1"); shift ;;
     *) echo "coulomb_accuracy.sh: unknown setting or option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

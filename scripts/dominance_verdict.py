@@ -12,8 +12,9 @@ For 4 and 6, `value` is the mean local slope over the flattest window of at leas
 local slope in that window, and zloc_min, zloc_max the range over all frames with t >= T_MIN.
 Flattest: the smallest range relative to the midrange (max + min) / 2; flat: a range of at most
 25 % of the midrange (the rule of the z rows, validation_report.py). For 5, `value` is the mean
-share at the last frame and low, high its 95 % interval (1.96 standard errors over the runs). `paper` is the paper's z (1.21 neutral, 1.49
-charged) for 4 and nan otherwise: the paper reports no such quantity.
+share at the last frame and low, high its 95 % interval (1.96 standard errors over the runs).
+`paper` is the paper's z (1.21 neutral, 1.49 charged) for 4 and nan otherwise: the paper reports
+no such quantity.
 
     /usr/bin/python3 scripts/dominance_verdict.py ROOT
 

@@ -41,13 +41,13 @@ def at(table, t):
 
 
 def welch(m1, s1, m2, s2, n):
-    """Welch's t and two-sided p for two means with standard errors s1, s2 of n runs each."""
-    v = s1 * s1 + s2 * s2
-    if not v > 0:
+    """Welch's t of m2 - m1 and its two-sided p, for two means with standard errors s1, s2 of n
+    runs each (scipy's test from summary statistics, as scripts/ensemble_welch.py uses it)."""
+    if not s1 * s1 + s2 * s2 > 0:
         return math.nan, math.nan
-    t = (m2 - m1) / math.sqrt(v)
-    dof = v * v / ((s1 ** 4 + s2 ** 4) / (n - 1))
-    return t, 2.0 * stats.t.sf(abs(t), dof)
+    r = stats.ttest_ind_from_stats(m2, s2 * math.sqrt(n), n, m1, s1 * math.sqrt(n), n,
+                                   equal_var=False)
+    return float(r.statistic), float(r.pvalue)
 
 
 def main():

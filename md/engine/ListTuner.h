@@ -38,8 +38,6 @@ class ListTuner {
   void tuneContact(NeighborList& nl, double dt) const;
   /// Sets the skin of the Coulomb list about to be rebuilt (`every` steps of dt per use).
   void tuneCoulomb(NeighborList& nl, double dt, int every) const;
-  /// The Coulomb list's skin cap (its skin when fixed).
-  double coulombCap() const { return m_coulomb.cap; }
 
   /// Re-stores the particles of `p`, and the per-slot arrays `followers`, in `nl`'s cell order.
   /// The caller rebuilds the lists. Returns false if nothing was sorted (boxes too small for
