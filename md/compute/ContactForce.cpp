@@ -15,6 +15,7 @@
 
 #include <thrust/reduce.h>
 
+#include "md/compute/ContactParts.h"
 #include "md/coulomb/RealSpace.h"
 #include "md/engine/Launch.h"
 #include "md/integrate/VelocityVerlet.h"
@@ -27,38 +28,44 @@ void ContactWork::resize(std::size_t n) { f.resize(n); }
 
 namespace {
 
-/// CHARGING: the charge exchange at new contacts is compiled in (dq non-null); without it the
-/// neutral pass keeps the random-number code out of its registers.
-/// ADVANCE: the pass also advances the step (ContactStep::advance_dt).
+/// The force pass over one list (ContactForce.h), composed of ContactParts.h's parts and the
+/// contact law (Potential::normalForce). The functor owns the loop shapes -- the row pass
+/// (operator()) and the pair form's two passes (pairs(), gather()) -- and the composition of one
+/// contact (contact()); the parts do the rest. It holds the parts' fields in one flat record, in
+/// the order the loops read them, and hands out each part as a view over its own fields
+/// (ContactParts.h says why). The switches compile parts in or out:
+/// - EXT: slow forces (SlowForce);
+/// - FAST_COULOMB: the fast Coulomb force (FastCoulomb), with the row pass's two-loop shape;
+/// - CHARGING: the charge exchange at new contacts (Charging; dq non-null);
+/// - ADVANCE: the step completed in the same pass (StepAdvance; ContactStep::advance_dt).
 template <class Potential, bool EXT, bool FAST_COULOMB, bool CHARGING, bool ADVANCE = false>
 struct ContactForceFunctor {
   using value_type = StepAccum;
-  const Scalar4* pos;
-  const Vec3* vel;    // drift velocities u = v(t - dt/2) of the step just taken
-  const Vec3* f_old;  // f(t - dt), which kicked u
+  const Scalar4* pos;  // Geometry
+  const Vec3* vel;     // StepState
+  const Vec3* f_old;   // StepState
   const int *rows, *counts;
   int cap;
   // the same list in compressed pair form (NeighborList::keepPairs), for pairs() and gather();
   // null: operator() only
   const int *pair_offsets, *pair_owners, *pair_partners, *entry_offsets, *entry_owners,
       *entry_pairs, *pair_entries;
-  common::Box box;
-  typename Potential::Params params;
-  double h_pred, dt_prev;
-  Vec3* f_new;  // f(t), written
-  // collisional charging (null dq: off): the charge each particle gains at its new contacts
+  common::Box box;                    // Geometry
+  typename Potential::Params params;  // the contact law's
+  double h_pred, dt_prev;             // StepState
+  Vec3* f_new;                        // f(t), written
+  // Charging
   const int* id;
   ChargeExchange::Params charging;
   std::int64_t step;
   double* dq;
-  // slow forces (EXT only; ContactStep): weight in this step's force, and in the predicted velocity
+  // SlowForce
   const double *ext_fx, *ext_fy, *ext_fz;
   double ext_force_scale, ext_predict_scale;
-  // fast part of the Coulomb force (FAST_COULOMB only): S(r) K q_i q_j / r^2, tabulated, zero
-  // from fast_r2sq = r2^2 on
+  // FastCoulomb
   double K, fast_r2sq;
   PairTable fast_table;
-  // ADVANCE only: where the next positions and drift velocities go, the image counts, dt
+  // StepAdvance
   Scalar4* next_pos;
   Vec3* next_vel;
   int *ix, *iy, *iz;
@@ -68,21 +75,27 @@ struct ContactForceFunctor {
   unsigned char* entry_hit;  // in contact, per entry
   Vec3* pair_f;              // force on the owner (where in contact)
   double* pair_dq;           // charge the owner gains (CHARGING, where in contact)
-  double* pair_next;         // displacement bound up to which each pair cannot be in contact
-  double bound;  // the displacement bound of this pass (ContactStep::displacement_bound)
+  // PairScreen
+  double* pair_next;
+  double bound;
 
-  /// predicted full-step velocity of particle k (ContactForce.h): u + (dt/2) f_old, corrected for
-  /// a multiple-time-step impulse given or about to be given (ContactStep::ext_predict_scale)
+  // the parts, as views over the fields above
+  HD_INLINE contact::Geometry geometry() const { return {pos, box}; }
+  HD_INLINE contact::StepState stepState() const { return {vel, f_old, h_pred, dt_prev}; }
+  HD_INLINE contact::SlowForce<EXT> slowForce() const {
+    return {ext_fx, ext_fy, ext_fz, ext_force_scale, ext_predict_scale};
+  }
+  HD_INLINE contact::Charging<CHARGING> charge() const { return {id, charging, step, dq}; }
+  HD_INLINE contact::FastCoulomb fastCoulomb() const { return {K, fast_r2sq, fast_table}; }
+  HD_INLINE contact::StepAdvance<ADVANCE> stepAdvance() const {
+    return {next_pos, next_vel, ix, iy, iz, advance_dt};
+  }
+  HD_INLINE contact::PairScreen pairScreen() const { return {pair_next, bound}; }
+
+  /// Predicted full-step velocity of particle k (ContactForce.h), with the slow forces' impulse.
   HD void predicted(int k, double& a, double& b, double& c) const {
-    const Vec3 u = vel[k], f = f_old[k];
-    a = u.x + h_pred * f.x;
-    b = u.y + h_pred * f.y;
-    c = u.z + h_pred * f.z;
-    if (EXT && ext_predict_scale != 0.0) {
-      a += ext_predict_scale * ext_fx[k];
-      b += ext_predict_scale * ext_fy[k];
-      c += ext_predict_scale * ext_fz[k];
-    }
+    stepState().predicted(k, a, b, c);
+    slowForce().addToPrediction(k, a, b, c);
   }
 
   /// The contact of pair (i, j) at separation r = (rx, ry, rz), r2 = |r|^2 < 1: adds its force on i
@@ -104,28 +117,18 @@ struct ContactForceFunctor {
     f1 += F * ny;
     f2 += F * nz;
     mx = xi > mx ? xi : mx;
-    // a collision is the first step at which the pair overlaps after not overlapping; the
-    // separation one step earlier is r - dt (u_i - u_j), the drift undone (antisymmetric in i
-    // and j to the last bit, so both partners agree, as they must for the charge exchange)
-    const Vec3 ui = vel[i], uj = vel[j];
-    const double px = rx - dt_prev * (ui.x - uj.x), py = ry - dt_prev * (ui.y - uj.y),
-                 pz = rz - dt_prev * (ui.z - uj.z);
-    if (px * px + py * py + pz * pz >= 1.0) {
+    // a collision is the first step at which the pair overlaps after not overlapping
+    if (stepState().apartBefore(i, j, rx, ry, rz)) {
       if (j > i) ++nnew;  // each collision counted once
-      if (CHARGING)       // xi_dot is the same for both partners (g and n both change sign)
-        dqi += ChargeExchange::transferTo(charging, step, static_cast<std::uint32_t>(id[i]),
-                                          static_cast<std::uint32_t>(id[j]), xi_dot);
+      if (CHARGING) dqi += charge().transfer(i, j, xi_dot);
     }
   }
 
-  /// Separation r_i - r_j (minimum image; positions are wrapped into [0, L), so one conditional
-  /// shift per component is enough) and its square.
+  /// Separation r_i - r_j and its square (Geometry). This forwarding method and predicted() stay:
+  /// g++'s inlining of the passes depends on them (docs/ARCHITECTURE.md, "The contact pass").
   HD double separation(const Scalar4& ri, const Scalar4& rj, double& rx, double& ry,
                        double& rz) const {
-    rx = box.minimumImageWrapped(ri.x - rj.x);
-    ry = box.minimumImageWrapped(ri.y - rj.y);
-    rz = box.minimumImageWrapped(ri.z - rj.z);
-    return rx * rx + ry * ry + rz * rz;
+    return geometry().separation(ri, rj, rx, ry, rz);
   }
 
   /// Particle i over its row: returns the collisions of pairs (i, j > i) that started this step,
@@ -149,7 +152,7 @@ struct ContactForceFunctor {
         const Scalar4 rj = pos[row[k]];
         double rx, ry, rz;
         const double r2 = separation(ri, rj, rx, ry, rz);
-        const double fr = K * ri.w * rj.w * fast_table(r2 < fast_r2sq ? r2 : fast_r2sq);
+        const double fr = fastCoulomb().overR(ri, rj, r2);
         c0 += fr * rx;
         c1 += fr * ry;
         c2 += fr * rz;
@@ -172,8 +175,7 @@ struct ContactForceFunctor {
         if (r2 < 1.0) contact(i, j, rx, ry, rz, r2, f0, f1, f2, mx, nnew, dqi);
       }
     }
-    // applied by the next kick pass (charges are read by others now)
-    if (CHARGING && dqi != 0.0) dq[i] = dqi;
+    charge().store(i, dqi);
     StepAccum res;
     res.collisions = nnew;
     res.max_overlap = mx;
@@ -199,11 +201,7 @@ struct ContactForceFunctor {
   /// zero contact force, and finite forces keep velocities and positions finite).
   template <bool PROBE_ALL>
   HD_INLINE void finish(int i, double f0, double f1, double f2, StepAccum& res) const {
-    if (EXT && ext_force_scale != 0.0) {
-      f0 += ext_force_scale * ext_fx[i];
-      f1 += ext_force_scale * ext_fy[i];
-      f2 += ext_force_scale * ext_fz[i];
-    }
+    slowForce().addToForce(i, f0, f1, f2);
     f_new[i] = Vec3{f0, f1, f2};
     const Scalar4 ri = pos[i];
     if (PROBE_ALL)
@@ -211,9 +209,7 @@ struct ContactForceFunctor {
     else if (EXT)
       res.probe += f0 + f1 + f2;
     if (ADVANCE) {  // this step's closing kick, the next step's opening kick and drift (kickDrift)
-      const double u2 = kickDriftParticle(box, 0.5 * advance_dt, advance_dt, true, Vec3{f0, f1, f2},
-                                          vel[i], ri, CHARGING ? dq + i : nullptr, ix[i], iy[i],
-                                          iz[i], next_vel[i], next_pos[i]);
+      const double u2 = stepAdvance().apply(box, i, f0, f1, f2, vel[i], ri, charge().of(i));
       res.max_u2 = u2 > res.max_u2 ? u2 : res.max_u2;
     }
   }
@@ -237,11 +233,9 @@ struct ContactForceFunctor {
     for (int c0 = pair_offsets[first]; c0 < end; c0 += CHUNK) {
       const int c1 = c0 + CHUNK < end ? c0 + CHUNK : end;
       int ndue = 0, nhit = 0;
-      // pairs that may be in contact; the others are not, and were not at the last pass (a pair
-      // in contact is due at the next pass), so their hit flags are zero already
       for (int p = c0; p < c1; ++p) {
         due[ndue] = p;
-        ndue += !(pair_next[p] >= bound);
+        ndue += pairScreen().due(p);
       }
       for (int k = 0; k < ndue; ++k) {
         const int p = due[k];
@@ -257,9 +251,7 @@ struct ContactForceFunctor {
         }
         hit[nhit] = p;
         nhit += in_contact;
-        // the gap r - 1 closes by at most twice the growth of the displacement bound; NEXT_MARGIN
-        // covers the rounding of the separations (ulps of L) at this pass and the next
-        pair_next[p] = bound + 0.5 * (sqrt(r2) - 1.0) - NEXT_MARGIN;
+        pairScreen().defer(p, r2);
       }
       for (int h = 0; h < nhit; ++h) {
         const int p = hit[h], i = pair_owners[p], j = pair_partners[p];
@@ -279,7 +271,6 @@ struct ContactForceFunctor {
     res.probe = probe;
     return res;
   }
-  static constexpr double NEXT_MARGIN = 1e-12;
 
   /// Compressed pair form, second pass: each particle of [first, last) sums the forces of its pairs
   /// in contact over its row, in row (id) order from zero -- the owner's force for pairs it owns,
