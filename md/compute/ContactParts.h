@@ -15,9 +15,9 @@
 /// functor's own fields, made at the call and folded away by the compiler (every method here is
 /// HD_INLINE). Views refer to the functor's fields and never copy them: an out-of-line call
 /// (the charge exchange's random numbers, in the row passes) would otherwise get a copy built on
-/// the stack at every contact. Thus the loops compile to the instructions of a functor written
-/// without parts, register names aside; compositions that stored the parts as members changed
-/// the record's layout, and with it the neutral passes' code, and cost 2-14 %
+/// the stack at every contact. So the passes compile to the instructions of the functor written
+/// without parts, up to register allocation and the order of a few instructions
+/// (scripts/contact_codegen.py); a record regrouped by part changed the neutral passes' code
 /// (docs/ARCHITECTURE.md, "The contact pass"). A part that a pass does not use is compiled out by
 /// its template switch (ON = false). Device source (Thrust types): included by ContactForce.cpp.
 #include <cstdint>
