@@ -79,7 +79,7 @@ struct Engine::Impl {
   ParticleData p;
   NeighborList nl;
   ContactWork work;
-  ListTuner tuner;          // the storage order and the skins that follow the gas
+  ListTuner tuner;         // the storage order and the skins that follow the gas
   DVec<double> block_max;  // kickDrift's per-block maximum speeds
   double dt = 0.0;
   double dt_auto = 0.0;  // the "auto" step (Engine::chooseTimeStep): the adaptive step's reference
@@ -106,13 +106,12 @@ struct Engine::Impl {
   // when the slow force was evaluated and is next due (md/integrate/SlowSchedule.h); the next
   // interval is chosen at each evaluation (chooseEvery)
   SlowSchedule slow;
-  std::int64_t slow_evaluations = 0;  // in this process (Engine::slowEvaluations)
+  std::int64_t slow_evaluations = 0;          // in this process (Engine::slowEvaluations)
   std::unique_ptr<SlowCoulomb> slow_coulomb;  // the solvers and the last evaluation's force
   std::unique_ptr<NeighborList> nl_coul;      // pppm: reaches r_cut + coulomb.skin
   double drift_since_coul_build = 0.0;        // as drift_since_build, for nl_coul
   ContactModel contact;  // the contact model and its parameters (md/potentials/ContactModels.h)
   PhaseTimer timer;      // Engine::enableProfile
-
 
   explicit Impl(const MdConfig& c);
 

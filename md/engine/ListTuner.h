@@ -21,9 +21,9 @@ namespace granagg::md {
 
 /// How one list's skin is chosen (followingSkin's arguments, less the displacement).
 struct SkinRule {
-  bool follows = false;       ///< false: the list keeps the skin it was built with
-  double reach = 0.0;         ///< the range the list serves (r in Skin.h)
-  double build_over_use = 0;  ///< cost of a build over the cost of one use
+  bool follows = false;         ///< false: the list keeps the skin it was built with
+  double reach = 0.0;           ///< the range the list serves (r in Skin.h)
+  double build_over_use = 0.0;  ///< cost of a build over the cost of one use
   double min = 0.0, cap = 0.0;
 };
 

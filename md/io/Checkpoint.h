@@ -36,9 +36,9 @@ namespace granagg::md {
 /// The run's own fields (md::Simulation's, the same whatever the engine): the configuration, the
 /// seed and the frames in the trajectory (the next scheduled frame follows from the step).
 struct RunFields {
-  std::string config_toml;             ///< TOML text of the resolved configuration
-  std::uint64_t seed = 0;              ///< RNG seed (Philox key; no RNG state is stored)
-  std::uint64_t frames_written = 0;    ///< frames already in the trajectory file
+  std::string config_toml;           ///< TOML text of the resolved configuration
+  std::uint64_t seed = 0;            ///< RNG seed (Philox key; no RNG state is stored)
+  std::uint64_t frames_written = 0;  ///< frames already in the trajectory file
 };
 
 /// The state an engine defines for itself, beyond particles and forces: named integers (counters,

@@ -75,10 +75,9 @@ bool sameCheckpoint(const Checkpoint& a, const Checkpoint& b) {
          sameBits(s.vy, t.vy) && sameBits(s.vz, t.vz) && sameBits(s.charge, t.charge) &&
          sameBits(s.ix, t.ix) && sameBits(s.iy, t.iy) && sameBits(s.iz, t.iz) &&
          sameBits(e.forces.x, f.forces.x) && sameBits(e.forces.y, f.forces.y) &&
-         sameBits(e.forces.z, f.forces.z) &&
-         sameBits(e.dt, f.dt) && e.run.config_toml == f.run.config_toml &&
-         e.run.seed == f.run.seed && e.run.frames_written == f.run.frames_written &&
-         e.engine.ints == f.engine.ints &&
+         sameBits(e.forces.z, f.forces.z) && sameBits(e.dt, f.dt) &&
+         e.run.config_toml == f.run.config_toml && e.run.seed == f.run.seed &&
+         e.run.frames_written == f.run.frames_written && e.engine.ints == f.engine.ints &&
          e.engine.reals.size() == f.engine.reals.size() &&
          std::equal(e.engine.reals.begin(), e.engine.reals.end(), f.engine.reals.begin(),
                     [](const auto& p, const auto& q) {
