@@ -115,8 +115,10 @@ std::vector<pid_t> descendantsNamed(pid_t root, const std::string& name) {
     const pid_t p = todo.back();
     todo.pop_back();
     for (pid_t c : children[p]) {
-      if (names[c] == name.substr(0, 15)) found.push_back(c);
-      todo.push_back(c);
+      if (names[c] == name.substr(0, 15))
+        found.push_back(c);  // not below it: its forks carry its name until they exec
+      else
+        todo.push_back(c);
     }
   }
   std::sort(found.begin(), found.end());

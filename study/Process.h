@@ -21,6 +21,9 @@ pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& l
 
 /// The processes under `root` (its children, their children, ...) whose name is `name`
 /// (/proc/PID/comm: the executed file's name, cut at 15 characters), found in /proc (Linux).
+/// Only the outermost: the search does not go below a process it found. A process that forks
+/// (a rank starting a helper) has a child of its own name until the child's exec, and that
+/// child is not a rank.
 std::vector<pid_t> descendantsNamed(pid_t root, const std::string& name);
 
 /// `a` quoted for a POSIX shell where it needs to be ('...' with ' escaped).

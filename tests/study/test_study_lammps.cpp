@@ -357,7 +357,9 @@ TEST_CASE(
 
 TEST_CASE("descendantsNamed finds a launcher's ranks by name, below any depth", "[study]") {
   const fs::path dir = tempDir("study_descendants");
-  executable(dir / "granagg-lammps", "#!/bin/sh\nwhile :; do sleep 0.05; done\n");
+  // each rank has a child of its own name (a subshell: forked, never exec'd), which is not a rank
+  executable(dir / "granagg-lammps",
+             "#!/bin/sh\n(while :; do sleep 0.05; done) &\nwhile :; do sleep 0.05; done\n");
   executable(dir / "outer.sh", "#!/bin/sh\n" + (dir / "granagg-lammps").string() + " &\n" +
                                    "/bin/sh -c '" + (dir / "granagg-lammps").string() +
                                    "; true' &\nwait\n");
@@ -367,13 +369,14 @@ TEST_CASE("descendantsNamed finds a launcher's ranks by name, below any depth", 
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     ranks = descendantsNamed(pid, "granagg-lammps");
   }
-  CHECK(ranks.size() == 2);                          // a child and a grandchild
+  CHECK(ranks.size() == 2);                          // a child and a grandchild, not their forks
   CHECK(descendantsNamed(pid, "outer.sh").empty());  // the root itself is not its descendant
   CHECK(::getpgid(pid) == pid);  // spawn's child leads a process group of its own
   for (pid_t r : ranks) ::kill(r, SIGTERM);
   int st = 0;
   REQUIRE(::waitpid(pid, &st, 0) == pid);
   CHECK(descendantsNamed(pid, "granagg-lammps").empty());
+  ::kill(-pid, SIGKILL);  // the ranks' subshells, orphaned, are still in the launcher's group
   fs::remove_all(dir);
 }
 
