@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -19,6 +20,7 @@
 #include "md/engine/Engine.h"
 #include "md/run/RunLog.h"
 #include "md/run/Simulation.h"
+#include "study/insitu/InSituAnalysis.h"
 
 namespace granagg::cli {
 
@@ -35,6 +37,7 @@ struct MdArgs {
   bool force = false;
   bool quiet = false;
   bool profile = false;
+  bool analyze = false;
 };
 
 /// The log on stderr, one line each (stdout stays empty: md writes no table).
@@ -75,12 +78,18 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
       throw std::invalid_argument(
           "--restart continues a run with its own configuration: do not "
           "combine it with --config, --preset or --seed.");
+    if (a.analyze)
+      throw std::invalid_argument(
+          "--analyze cannot be combined with --restart: the in-situ analysis starts with its run "
+          "(a run started with --analyze continues its analysis by itself); analyse this one with "
+          "granagg analyze " + a.restart);
     sim.emplace(md::Simulation::resume(a.restart, a.set, options));
   } else {
     if (!a.config.empty() && !a.preset.empty())
       throw std::invalid_argument("give one of --config FILE and --preset NAME, not both.");
     std::vector<std::string> overrides = a.set;
     if (!a.seed.empty()) overrides.push_back("system.seed=" + checkedSeed(a.seed));
+    if (a.analyze) overrides.push_back("output.analyze=true");
     // neither: every key has a default (docs/config.md), --set changes them
     const md::MdConfig cfg =
         a.config.empty() && a.preset.empty()
@@ -90,7 +99,19 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                   overrides);
     const std::string out = a.out.empty() ? "md-out" : a.out;
     common::checkOutputFolder(out);  // before the initial state and the engine are built
+    if (cfg.output.analyze) insitu::analysisOptions(cfg);  // bad [analysis]: exit 2, nothing written
     sim.emplace(md::Simulation::start(cfg, out, options));
+    if (cfg.output.analyze) insitu::InSituAnalysis::removeOutputs(out);  // of a run --force replaced
+  }
+  if (sim->finished() && sim->config().output.analyze &&
+      !std::filesystem::exists(insitu::InSituAnalysis::resultFolder(sim->folder()))) {
+    // stopped after its last checkpoint but before its analysis was written (a kill, a full
+    // disk): the state of the last step finishes it
+    insitu::InSituAnalysis analysis(*sim, ctx.command_line);
+    const auto folder = analysis.writeResults(*sim);
+    std::fprintf(stderr, "md: the run in %s is complete; wrote its in-situ analysis (%zu frames) "
+                 "to %s\n", sim->folder().c_str(), analysis.frames(), folder.c_str());
+    return;
   }
   if (sim->finished()) {  // --restart of a run at its run.t_end: say so, write nothing
     std::fprintf(stderr,
@@ -101,6 +122,15 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
                  common::formatReal(sim->config().run.t_end).c_str());
     return;
   }
+  std::shared_ptr<insitu::InSituAnalysis> analysis;
+  if (sim->config().output.analyze) {
+    analysis = std::make_shared<insitu::InSituAnalysis>(
+        *sim, ctx.command_line,
+        [&a](const std::string& line) {
+          if (!a.quiet) std::fprintf(stderr, "%s\n", line.c_str());
+        });
+    sim->addReporter(analysis);
+  }
   if (!sim->clearedStaleLock().empty() && !a.quiet)
     std::fprintf(stderr, "md: cleared the stale lock of %s\n", sim->clearedStaleLock().c_str());
   if (!a.quiet) {
@@ -110,6 +140,12 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   const md::RunSummary s = sim->run();
   if (a.profile) log(md::profileLines(sim->engine(), s.steps, s.loop_seconds));
   if (!a.quiet) log(md::runSummaryLines(*sim, s));
+  if (analysis && !s.stopped) {
+    const auto folder = analysis->writeResults(*sim);
+    if (!a.quiet)
+      std::fprintf(stderr, "md: in-situ analysis of %zu frames written to %s\n", analysis->frames(),
+                   folder.c_str());
+  }
   if (s.stopped) {
     const int sig = *stopSignal();
     char t[32];
@@ -147,6 +183,10 @@ void registerMdCommand(CLI::App& app, const CliContext& ctx) {
   md->add_flag("--force", a->force,
                "Overwrite an existing output folder; clear a stale lock (of a run that was "
                "killed) with --out or --restart. A folder in use is never taken");
+  md->add_flag("--analyze", a->analyze,
+               "Analyse every frame during the run ([analysis] options, those of granagg analyze)"
+               " into OUT/analysis, as granagg analyze OUT --out OUT/analysis would; with --set "
+               "output.trajectory=false no particle frame is stored (output.analyze = true)");
   md->add_flag("-q,--quiet", a->quiet, "No progress line or summary");
   md->add_flag(
       "--profile", a->profile,

@@ -7,9 +7,12 @@
 #
 #   usage: bash scripts/campaign_L280.sh [DIR]        (default results/campaign-L280)
 #   environment: GRANAGG_BIN (default build/bin/granagg), THREADS (2), T_END (3000),
-#                SEEDS ("201 202"), NICE (19: the campaign yields the cores to builds and tests)
-# Each run writes a trajectory with velocities (log-spaced, 10 frames per decade: about 57 frames
-# of 0.2 GB) for `granagg analyze RUN`; in-situ analysis (issue 45, part 1) is not built yet.
+#                SEEDS ("201 202"), NICE (19: the campaign yields the cores to builds and tests),
+#                TRAJECTORY (true: also store the particle frames)
+# Each run is analysed while it runs (`granagg md --analyze`: RUN/analysis at the end, the tables
+# of `granagg analyze RUN`). With TRAJECTORY=true it also stores its frames with velocities
+# (log-spaced, 10 frames per decade: about 57 frames of 0.2 GB), from which a later analysis can
+# be redone and a lost analysis state rebuilt.
 #
 # SIGTERM or SIGINT stops the run in progress with a checkpoint (granagg md's own handling);
 # the next call continues it. docs/validation.md ("The box of L = 280") records the outcome.
@@ -22,6 +25,7 @@ THREADS=${THREADS:-2}
 T_END=${T_END:-3000}
 SEEDS=${SEEDS:-201 202}
 NICE=${NICE:-19}
+TRAJECTORY=${TRAJECTORY:-true}
 N=3201024
 mkdir -p "$DIR"
 LEGS="$DIR/legs.csv"
@@ -51,7 +55,7 @@ for seed in $SEEDS; do
   else
     cmd=("$BIN" md --preset paper --set system.N=$N --set run.t_end="$T_END"
          --set integrator.dt=adaptive --seed "$seed" --threads "$THREADS"
-         --out "$run")
+         --analyze --set output.trajectory="$TRAJECTORY" --out "$run")
   fi
   leg=$(grep -c "^$seed," "$LEGS" || true)
   start=$(date -u +%FT%TZ); s0=$(date +%s.%N)

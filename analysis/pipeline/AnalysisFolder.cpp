@@ -50,6 +50,53 @@ void checkAnalysisFolderRequest(const AnalysisFolderRequest& request) {
         "' exists and is not empty; choose another --out or pass --force to overwrite it");
 }
 
+namespace {
+
+/// The tables of analysed runs into `out` (per_run/ must exist) and `file`, which it closes.
+AnalysisFolder writeTables(const fs::path& out, AnalysisFile& file, std::vector<RunResult> results,
+                           const AnalysisOptions& o, const std::string& command_line, bool force) {
+  const std::vector<Table> ensemble = analyzeEnsemble(results, o);
+  const common::Provenance prov = analysisProvenance(command_line, o, results);
+
+  // Per-run tables (long format, leading run column) and ensemble tables.
+  for (const Table& t : results.front().tables) {
+    std::vector<const Table*> all;
+    for (const auto& r : results)
+      if (r.hasTable(t.name)) all.push_back(&r.table(t.name));
+    writeCsv(stackRuns(all), (out / "per_run" / (t.name + ".csv")).string(), prov, force);
+  }
+  for (const Table& t : ensemble) writeCsv(t, (out / (t.name + ".csv")).string(), prov, force);
+
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    const auto& r = results[k];
+    const std::string g = "runs/" + std::to_string(k);
+    for (const auto& t : r.tables) file.writeTable(g, t);
+    std::map<std::string, std::string> attrs{
+        {"source", r.source},
+        {"format", r.format},
+        {"frames", std::to_string(r.frames)},
+        {"particles", std::to_string(r.particles)},
+        {"partial", r.partial ? r.partial_reason : "no"},
+        {"kappa", common::formatReal(r.kappa) + " (" + r.kappa_source + ")"},
+        {"grid_cells_per_side", std::to_string(r.grid_cells)},
+        {"grid_cell_size", common::formatReal(r.grid_cell_size)},
+        {"grid_min_count", common::formatReal(r.grid_min_count)}};
+    std::string notes;
+    for (const auto& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
+    attrs["notes"] = notes;
+    for (const auto& [key, v] : r.parameters) attrs["parameters." + key] = v;
+    file.writeAttributes(g, attrs);
+  }
+  for (const auto& t : ensemble) file.writeTable("ensemble", t);
+  std::map<std::string, std::string> root;
+  for (const auto& [key, v] : prov.parameters()) root[key] = v;
+  file.writeAttributes("ensemble", root);
+  file.close();
+  return {std::move(results), ensemble};
+}
+
+}  // namespace
+
 AnalysisFolder analyseIntoFolder(
     const AnalysisFolderRequest& request, const AnalysisOptions& o,
     const std::function<void(std::size_t, std::size_t, std::size_t)>& progress) {
@@ -89,45 +136,33 @@ AnalysisFolder analyseIntoFolder(
     }
     throw;
   }
-  const std::vector<Table> ensemble = analyzeEnsemble(results, o);
-  const common::Provenance prov = analysisProvenance(request.command_line, o, results);
+  return writeTables(out, *file, std::move(results), o, request.command_line, request.force);
+}
 
-  // Per-run tables (long format, leading run column) and ensemble tables.
-  for (const Table& t : results.front().tables) {
-    std::vector<const Table*> all;
-    for (const auto& r : results)
-      if (r.hasTable(t.name)) all.push_back(&r.table(t.name));
-    writeCsv(stackRuns(all), (out / "per_run" / (t.name + ".csv")).string(), prov, request.force);
+AnalysisFolder writeRunAnalysis(const std::string& out_path, RunResult result,
+                                const AnalysisOptions& o, const std::string& command_line) {
+  const fs::path out(out_path);
+  if (fs::exists(out))
+    throw std::invalid_argument("analysis folder '" + out.string() +
+                                "' exists already: the in-situ analysis never overwrites one");
+  // written beside its name and renamed at the end: a failure leaves no half-written folder
+  fs::path tmp = out;
+  tmp += ".partial";
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  try {
+    fs::create_directories(tmp / "per_run");
+    AnalysisFile file((tmp / "analysis.h5").string(), false,
+                      analysisProvenance(command_line, o, {}));
+    std::vector<RunResult> results;
+    results.push_back(std::move(result));
+    AnalysisFolder folder = writeTables(tmp, file, std::move(results), o, command_line, false);
+    fs::rename(tmp, out);
+    return folder;
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
   }
-  for (const Table& t : ensemble)
-    writeCsv(t, (out / (t.name + ".csv")).string(), prov, request.force);
-
-  for (std::size_t k = 0; k < results.size(); ++k) {
-    const auto& r = results[k];
-    const std::string g = "runs/" + std::to_string(k);
-    for (const auto& t : r.tables) file->writeTable(g, t);
-    std::map<std::string, std::string> attrs{
-        {"source", r.source},
-        {"format", r.format},
-        {"frames", std::to_string(r.frames)},
-        {"particles", std::to_string(r.particles)},
-        {"partial", r.partial ? r.partial_reason : "no"},
-        {"kappa", common::formatReal(r.kappa) + " (" + r.kappa_source + ")"},
-        {"grid_cells_per_side", std::to_string(r.grid_cells)},
-        {"grid_cell_size", common::formatReal(r.grid_cell_size)},
-        {"grid_min_count", common::formatReal(r.grid_min_count)}};
-    std::string notes;
-    for (const auto& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
-    attrs["notes"] = notes;
-    for (const auto& [key, v] : r.parameters) attrs["parameters." + key] = v;
-    file->writeAttributes(g, attrs);
-  }
-  for (const auto& t : ensemble) file->writeTable("ensemble", t);
-  std::map<std::string, std::string> root;
-  for (const auto& [key, v] : prov.parameters()) root[key] = v;
-  file->writeAttributes("ensemble", root);
-  file->close();
-  return {std::move(results), ensemble};
 }
 
 common::Provenance analysisProvenance(const std::string& command_line, const AnalysisOptions& o,

@@ -38,6 +38,12 @@ AnalysisFolder analyseIntoFolder(
     const AnalysisFolderRequest& request, const AnalysisOptions& options,
     const std::function<void(std::size_t, std::size_t, std::size_t)>& progress = {});
 
+/// One run analysed elsewhere (during the run: study/insitu) written as `granagg analyze` writes
+/// it: the same files, tables and columns in the folder `out`, which must not exist. It is
+/// written as `out`.partial and renamed, so that a failure leaves no folder behind.
+AnalysisFolder writeRunAnalysis(const std::string& out, RunResult result,
+                                const AnalysisOptions& options, const std::string& command_line);
+
 /// The provenance of every table: the command line, each run's source and grid, and every
 /// option's value.
 common::Provenance analysisProvenance(const std::string& command_line,

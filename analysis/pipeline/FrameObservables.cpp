@@ -21,7 +21,76 @@ std::vector<double> lsColumns(const std::map<std::uint64_t, std::uint64_t>& n_s,
   return {f.valid ? f.tau : NaN, f.valid ? f.tau_err : NaN, static_cast<double>(f.bins)};
 }
 
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : "\n") + n;
+  return out;
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = text.find('\n', start);
+    out.push_back(text.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    if (end == std::string::npos) return out;
+    start = end + 1;
+  }
+}
+
 }  // namespace
+
+// ---- state between frames ----------------------------------------------------------------------
+
+void ObservableState::putTable(const Table& t) {
+  const std::string key = "table." + t.name;
+  std::vector<double> flat;
+  flat.reserve(t.rows.size() * t.columns.size());
+  for (const auto& row : t.rows) flat.insert(flat.end(), row.begin(), row.end());
+  reals[key] = std::move(flat);
+  integers[key + ".shape"] = {static_cast<std::int64_t>(t.rows.size()),
+                              static_cast<std::int64_t>(t.columns.size())};
+  texts[key + ".columns"] = joined(t.columns);
+}
+
+void ObservableState::getTable(Table& t, bool adopt_columns) const {
+  const std::string key = "table." + t.name;
+  const std::vector<std::string> columns = split(text(key + ".columns"));
+  if (!adopt_columns && columns != t.columns)
+    throw std::runtime_error("the saved table " + t.name + " has the columns '" +
+                             joined(columns) + "', this analysis '" + joined(t.columns) + "'");
+  const auto& shape = integer(key + ".shape");
+  const auto& flat = real(key);
+  if (shape.size() != 2 || shape[1] != static_cast<std::int64_t>(columns.size()) || shape[0] < 0 ||
+      flat.size() != static_cast<std::size_t>(shape[0] * shape[1]))
+    throw std::runtime_error("the saved table " + t.name + " has an inconsistent shape");
+  t.columns = columns;
+  t.rows.assign(static_cast<std::size_t>(shape[0]), {});
+  const std::size_t nc = columns.size();
+  for (std::size_t r = 0; r < t.rows.size(); ++r)
+    t.rows[r].assign(flat.begin() + static_cast<long>(r * nc),
+                     flat.begin() + static_cast<long>((r + 1) * nc));
+}
+
+namespace {
+template <class Map>
+const typename Map::mapped_type& lookup(const Map& m, const std::string& key) {
+  const auto it = m.find(key);
+  if (it == m.end()) throw std::runtime_error("the saved analysis state has no '" + key + "'");
+  return it->second;
+}
+}  // namespace
+
+const std::vector<double>& ObservableState::real(const std::string& key) const {
+  return lookup(reals, key);
+}
+const std::vector<std::int64_t>& ObservableState::integer(const std::string& key) const {
+  return lookup(integers, key);
+}
+const std::string& ObservableState::text(const std::string& key) const {
+  return lookup(texts, key);
+}
 
 const std::vector<std::string> FISHER_COLUMNS = {
     "t",           "tau_grid",        "tau_grid_err",        "xmin_grid",
@@ -115,6 +184,9 @@ ClusterObservables::Row ClusterObservables::add(const Frame& f, const RunCallbac
     row.occupied_fraction = m_grid.occupiedFraction();
     addSizes(m_ns_grid, t, m_grid.result());
     grid_ns = &m_grid.result().n_s;
+    m_grid_cells = m_grid.cellsPerSide();
+    m_grid_cell_size = m_grid.cellSize();
+    m_grid_min_count = m_grid.minCount();
     if (cb.grid) cb.grid(f, m_grid);
   }
   if (m_o.particle_clusters) {
@@ -139,9 +211,34 @@ ClusterObservables::Row ClusterObservables::add(const Frame& f, const RunCallbac
 
 void ClusterObservables::describe(RunResult& r) const {
   if (!m_o.grid_clusters) return;
-  r.grid_cells = m_grid.cellsPerSide();
-  r.grid_cell_size = m_grid.cellSize();
-  r.grid_min_count = m_grid.minCount();
+  r.grid_cells = static_cast<int>(m_grid_cells);
+  r.grid_cell_size = m_grid_cell_size;
+  r.grid_min_count = m_grid_min_count;
+}
+
+void ClusterObservables::save(ObservableState& s) const {
+  s.putTable(m_ns_grid);
+  s.putTable(m_ns_particle);
+  s.putTable(m_fisher);
+  s.putTable(m_nstick);
+  s.integers["clusters.tracked"].assign(m_tracked.begin(), m_tracked.end());
+  s.reals["clusters.grid"] = {m_grid_cells, m_grid_cell_size, m_grid_min_count};
+  s.texts["clusters.nstick_description"] = m_nstick.description;
+}
+
+void ClusterObservables::restore(const ObservableState& s) {
+  s.getTable(m_ns_grid);
+  s.getTable(m_ns_particle);
+  s.getTable(m_fisher);
+  m_nstick.description = s.text("clusters.nstick_description");
+  s.getTable(m_nstick, /*adopt_columns=*/true);
+  const auto& tracked = s.integer("clusters.tracked");
+  m_tracked.assign(tracked.begin(), tracked.end());
+  const auto& g = s.real("clusters.grid");
+  if (g.size() != 3) throw std::runtime_error("the saved grid description is not 3 values");
+  m_grid_cells = g[0];
+  m_grid_cell_size = g[1];
+  m_grid_min_count = g[2];
 }
 
 // ---- structure factor --------------------------------------------------------------------------
@@ -153,13 +250,29 @@ StructureObservable::StructureObservable(const AnalysisOptions& o)
               "<|sum_j exp(-i k.r_j)|^2>/N over the shell (CIC mesh, FFTW, Jing's alias "
               "correction: analysis/stats/StructureFactor.h); modes: independent wave vectors in "
               "the shell",
-              {"t", "k", "S_k", "modes"}, 2) {}
+              {"t", "k", "S_k", "modes"}, 2),
+      m_velocity("S_u_k",
+                 "t: time; k: shell centre m 2 pi / L [1/d]; with u(k) = sum_j c_j exp(-i k.r_j) "
+                 "of the peculiar velocities c_j: S_par = <|k^.u|^2>/(N T_g) (longitudinal) and "
+                 "S_perp = <|u - k^(k^.u)|^2>/(2 N T_g) (transverse: shear, vorticity) over the "
+                 "shell, both 1 for uncorrelated velocities (the mesh and shells of S_k; "
+                 "analysis/stats/StructureFactor.h); modes: independent wave vectors",
+                 {"t", "k", "S_par", "S_perp", "modes"}, 2) {}
 
-double StructureObservable::add(const Frame& f) {
+StructureObservable::Lengths StructureObservable::add(const Frame& f) {
   const StructureFactor sk = structureFactor(f, m_o.structure, m_mesh);
   for (std::size_t m = 0; m < sk.k.size(); ++m)
     m_table.add({f.time, sk.k[m], sk.S[m], static_cast<double>(sk.modes[m])});
-  return sk.length;
+  Lengths l{sk.length, NaN, NaN};
+  if (f.hasVelocities()) {
+    const VelocityStructure su = velocityStructure(f, m_o.structure, m_mesh);
+    for (std::size_t m = 0; m < su.k.size(); ++m)
+      m_velocity.add({f.time, su.k[m], su.S_long[m], su.S_trans[m],
+                      static_cast<double>(su.modes[m])});
+    l.par = su.length_long;
+    l.perp = su.length_trans;
+  }
+  return l;
 }
 
 // ---- velocities, charges, displacements --------------------------------------------------------
@@ -274,6 +387,51 @@ void MotionObservables::finish(const std::string& path, RunResult& r) {
   }
 }
 
+void MotionObservables::save(ObservableState& s) const {
+  s.putTable(m_thermo);
+  s.putTable(m_msd);
+  s.putTable(m_speed);
+  s.integers["motion.flags"] = {m_have_vel, m_have_q};
+  s.reals["motion.mean_q"] = m_mean_q;
+  s.reals["motion.scatter_t"] = {m_scatter_t};
+  s.reals["motion.scatter_q"] = m_scatter_q;
+  s.reals["motion.scatter_v"] = m_scatter_v;
+  s.integers["motion.scatter_ids"] = m_scatter_ids;
+  const MsdFromOrigin::State m0 = m_msd0.state();
+  s.reals["msd0.origin"] = m0.origin;
+  s.reals["msd0.t"] = m0.t;
+  s.reals["msd0.msd"] = m0.msd;
+  const MsdAllOrigins::State ma = m_msd_all.state();
+  s.integers["msd_all.counts"] = {static_cast<std::int64_t>(ma.n),
+                                  static_cast<std::int64_t>(ma.frames), ma.available};
+  s.texts["msd_all.reason"] = ma.reason;
+  s.reals["msd_all.times"] = {ma.t0, ma.dt};
+  s.reals["msd_all.xyz"] = ma.xyz;
+}
+
+void MotionObservables::restore(const ObservableState& s) {
+  s.getTable(m_thermo);
+  s.getTable(m_msd);
+  s.getTable(m_speed);
+  const auto& flags = s.integer("motion.flags");
+  if (flags.size() != 2) throw std::runtime_error("the saved motion flags are not 2 values");
+  m_have_vel = flags[0] != 0;
+  m_have_q = flags[1] != 0;
+  m_mean_q = s.real("motion.mean_q");
+  m_scatter_t = s.real("motion.scatter_t").at(0);
+  m_scatter_q = s.real("motion.scatter_q");
+  m_scatter_v = s.real("motion.scatter_v");
+  m_scatter_ids = s.integer("motion.scatter_ids");
+  m_msd0.restore({s.real("msd0.origin"), s.real("msd0.t"), s.real("msd0.msd")});
+  const auto& counts = s.integer("msd_all.counts");
+  const auto& times = s.real("msd_all.times");
+  if (counts.size() != 3 || times.size() != 2)
+    throw std::runtime_error("the saved all-origins MSD is incomplete");
+  m_msd_all.restore({static_cast<std::size_t>(counts[0]), static_cast<std::size_t>(counts[1]),
+                     counts[2] != 0, s.text("msd_all.reason"), times[0], times[1],
+                     s.real("msd_all.xyz")});
+}
+
 // ---- S_t ---------------------------------------------------------------------------------------
 
 GrowthTable::GrowthTable()
@@ -285,15 +443,16 @@ GrowthTable::GrowthTable()
               "S_*_without_largest = (sum s^2 N_s - s_max^2) / (sum s N_s - s_max); "
               "largest_share_* = s_max / sum s N_s; l_density = 2 pi / k_1, k_1 the first moment "
               "of S(k) over k <= k_c (analysis/stats/StructureFactor.h; an ideal gas gives about "
-              "4 pi / k_c)",
+              "4 pi / k_c); l_par, l_perp: the same first moments of the velocity field's S_par and "
+              "S_perp (S_u_k: longitudinal and transverse, l_perp the vortex length)",
               {"t", "step", "S_grid", "S_particle", "clusters_grid", "clusters_particle",
                "largest_grid", "largest_particle", "occupied_fraction", "mean_contacts",
                "z_local_grid", "z_local_particle", "S_grid_without_largest",
                "S_particle_without_largest", "largest_share_grid", "largest_share_particle",
-               "l_density"}) {}
+               "l_density", "l_par", "l_perp"}) {}
 
 void GrowthTable::add(double t, std::int64_t step, const ClusterObservables::Row& c,
-                      double l_density) {
+                      const StructureObservable::Lengths& l) {
   m_t.push_back(t);
   m_S_grid.push_back(c.grid.S);
   m_S_particle.push_back(c.particle.S);
@@ -301,7 +460,14 @@ void GrowthTable::add(double t, std::int64_t step, const ClusterObservables::Row
   m_table.add({t, static_cast<double>(step), c.grid.S, c.particle.S, c.grid.clusters,
                c.particle.clusters, c.grid.largest, c.particle.largest, c.occupied_fraction,
                c.mean_contacts, NaN, NaN, c.grid.S_without_largest, c.particle.S_without_largest,
-               c.grid.largest_share, c.particle.largest_share, l_density});
+               c.grid.largest_share, c.particle.largest_share, l.density, l.par, l.perp});
+}
+
+void GrowthTable::restore(const ObservableState& s) {
+  s.getTable(m_table);
+  m_t = m_table.values("t");
+  m_S_grid = m_table.values("S_grid");
+  m_S_particle = m_table.values("S_particle");
 }
 
 void GrowthTable::finish(double slope_ratio) {

@@ -7,6 +7,7 @@
 
 #include "analysis/io/TrajectoryReader.h"
 #include "analysis/pipeline/FrameObservables.h"
+#include "analysis/pipeline/RunAnalysis.h"
 #include "analysis/stats/ChargeStats.h"
 #include "analysis/stats/GrowthMarkers.h"
 #include "analysis/stats/PowerLawFit.h"
@@ -22,26 +23,6 @@ const double NaN = std::numeric_limits<double>::quiet_NaN();
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
-}
-
-/// kappa from the options, else from the file's parameters, else the default.
-void resolveKappa(const AnalysisOptions& o, RunResult& r) {
-  if (std::isfinite(o.kappa)) {
-    r.kappa = o.kappa;
-    r.kappa_source = "option";
-    return;
-  }
-  for (const char* key : {"charging.kappa", "kappa"}) {
-    auto it = r.parameters.find(key);
-    double v;
-    if (it != r.parameters.end() && common::parseReal(it->second, v) && std::isfinite(v)) {
-      r.kappa = v;
-      r.kappa_source = std::string("file (") + key + ")";
-      return;
-    }
-  }
-  r.kappa = DEFAULT_KAPPA;
-  r.kappa_source = "default";
 }
 
 /// Growth-exponent window: the options, or the last decade of the data.
@@ -157,6 +138,36 @@ double standardErrorOfAll(const std::vector<double>& x) {
 
 }  // namespace
 
+std::pair<double, std::string> resolveKappa(const AnalysisOptions& o,
+                                            const std::map<std::string, std::string>& parameters) {
+  if (std::isfinite(o.kappa)) return {o.kappa, "option"};
+  for (const char* key : {"charging.kappa", "kappa"}) {
+    auto it = parameters.find(key);
+    double v;
+    if (it != parameters.end() && common::parseReal(it->second, v) && std::isfinite(v))
+      return {v, std::string("file (") + key + ")"};
+  }
+  return {DEFAULT_KAPPA, "default"};
+}
+
+Table runFits(const std::vector<double>& t, const std::vector<double>& S_grid,
+              const std::vector<double>& S_particle, const std::vector<double>* mean_abs_q,
+              double kappa, const AnalysisOptions& o) {
+  const auto [w0, w1] = fitWindow(o, t);
+  const PowerLawFitResult fit_g = fitPowerLaw(t, S_grid, w0, w1),
+                          fit_p = fitPowerLaw(t, S_particle, w0, w1);
+  PowerLawFitResult fit_q;
+  if (mean_abs_q) {
+    const auto [tr, rate] = chargingRate(t, *mean_abs_q);
+    fit_q = fitPowerLaw(tr, rate, o.charge_fit_t_min, o.charge_fit_t_max);
+  }
+  Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
+  fits.ensemble = false;
+  fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, kappa, o.charge_fit_t_min, o.charge_fit_t_max,
+                      1, onsetsOf(t, S_grid, S_particle, o), o));
+  return fits;
+}
+
 void AnalysisOptions::validate() const {
   require(slope_ratio > 1.0 && std::isfinite(slope_ratio),
           "--slope-ratio must be > 1 (got " + common::formatReal(slope_ratio) + ").");
@@ -200,83 +211,23 @@ bool RunResult::hasTable(const std::string& name) const {
 RunResult analyzeRun(const std::string& path, const AnalysisOptions& o, const RunCallbacks& cb) {
   o.validate();
   auto reader = openTrajectory(path, o.lammps_dt);
-  RunResult r;
-  r.source = path;
-  r.format = reader->format();
-  r.parameters = reader->parameters();
-  resolveKappa(o, r);
-
-  ClusterObservables clusters(o);
-  StructureObservable structure(o);
-  MotionObservables motion(o);
-  GrowthTable growth;
-
+  std::map<std::string, std::string> parameters = reader->parameters();
+  RunAnalysis analysis(o, path, reader->format(), std::move(parameters), cb);
   Frame f;
-  std::size_t n_particles = 0;
-  bool first = true;
   while (true) {
     try {
       if (!reader->next(f)) break;
-      if (first) {
-        n_particles = f.size();
-        r.box = f.box;
-      } else if (f.size() != n_particles) {
-        throw TrajectoryError(reader->path(), f.index,
-                              "has " + std::to_string(f.size()) +
-                                  " particles, the first frame had " + std::to_string(n_particles));
-      }
-      if (!first && !growth.times().empty() && !(f.time > growth.times().back()))
-        throw TrajectoryError(reader->path(), f.index,
-                              "time " + common::formatReal(f.time) + " does not increase");
+      analysis.add(f);
     } catch (const TrajectoryError& e) {
-      if (!o.allow_partial || r.frames == 0) throw;
-      r.partial = true;
-      r.partial_reason = e.what();
+      if (!o.allow_partial || analysis.frames() == 0) throw;
+      analysis.setPartial(e.what());
       break;
     }
-    if (first) {
-      clusters.first(f);
-      motion.first(f, r);
-      first = false;
-    }
-    const ClusterObservables::Row c = clusters.add(f, cb);
-    const double l = o.structure_factor ? structure.add(f) : NaN;
-    growth.add(f.time, f.step, c, l);
-    motion.add(f);
-    ++r.frames;
-    if (cb.progress) cb.progress(r.frames, reader->frameCountHint());
+    if (cb.progress) cb.progress(analysis.frames(), reader->frameCountHint());
   }
-  if (r.frames == 0) throw std::invalid_argument("trajectory '" + path + "' holds no frames");
-  r.particles = n_particles;
-  clusters.describe(r);
-  growth.finish(o.slope_ratio);
-
-  // the growth exponents over the window, the charging rate and the onsets
-  const std::vector<double>& t = growth.times();
-  const auto [w0, w1] = fitWindow(o, t);
-  const PowerLawFitResult fit_g = fitPowerLaw(t, growth.sGrid(), w0, w1),
-                          fit_p = fitPowerLaw(t, growth.sParticle(), w0, w1);
-  PowerLawFitResult fit_q;
-  if (motion.hasCharges()) {
-    const auto [tr, rate] = chargingRate(t, motion.meanAbsCharge());
-    fit_q = fitPowerLaw(tr, rate, o.charge_fit_t_min, o.charge_fit_t_max);
-  }
-  Table fits("fits", FITS_DESCRIPTION, FITS_COLUMNS, 0);
-  fits.ensemble = false;
-  fits.add(fitColumns(fit_g, fit_p, w0, w1, fit_q, r.kappa, o.charge_fit_t_min, o.charge_fit_t_max,
-                      1, onsetsOf(t, growth.sGrid(), growth.sParticle(), o), o));
-
-  // the tables in the order of the output
-  r.tables.push_back(std::move(growth.table()));
-  if (o.grid_clusters) r.tables.push_back(std::move(clusters.nsGrid()));
-  if (o.particle_clusters) r.tables.push_back(std::move(clusters.nsParticle()));
-  if (o.structure_factor) r.tables.push_back(std::move(structure.table()));
-  r.tables.push_back(std::move(clusters.fisher()));
-  motion.finish(path, r);
-  if (o.particle_clusters && clusters.tracks()) r.tables.push_back(std::move(clusters.nstick()));
-  r.tables.push_back(std::move(fits));
-  if (r.partial) r.notes.push_back("partial: " + r.partial_reason);
-  return r;
+  if (analysis.frames() == 0)
+    throw std::invalid_argument("trajectory '" + path + "' holds no frames");
+  return analysis.finish();
 }
 
 void checkSameSystem(const RunResult& a, const RunResult& b) {

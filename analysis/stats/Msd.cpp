@@ -39,6 +39,26 @@ void MsdFromOrigin::reset() {
   m_msd.clear();
 }
 
+void MsdFromOrigin::restore(State s) {
+  if (s.t.size() != s.msd.size() || s.origin.size() % 3 != 0)
+    throw std::invalid_argument("MsdFromOrigin::restore: inconsistent state");
+  m_origin = std::move(s.origin);
+  m_t = std::move(s.t);
+  m_msd = std::move(s.msd);
+}
+
+void MsdAllOrigins::restore(State s) {
+  if (s.xyz.size() != 3 * s.n * s.frames && s.available)
+    throw std::invalid_argument("MsdAllOrigins::restore: inconsistent state");
+  m_n = s.n;
+  m_frames = s.frames;
+  m_available = s.available;
+  m_reason = std::move(s.reason);
+  m_t0 = s.t0;
+  m_dt = s.dt;
+  m_xyz = std::move(s.xyz);
+}
+
 MsdAllOrigins::MsdAllOrigins(std::size_t max_bytes) : m_max_bytes(max_bytes) {}
 
 void MsdAllOrigins::giveUp(const std::string& why) {

@@ -12,6 +12,7 @@
 /// from a zero-padded FFT (FFTW) and S1 from a running sum, O(F log F) per particle.
 /// It keeps every frame's unwrapped positions (24 N F bytes), within a memory budget.
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "analysis/io/Frame.h"
@@ -27,6 +28,12 @@ class MsdFromOrigin {
   /// MSD per frame, in d^2.
   const std::vector<double>& msd() const { return m_msd; }
   void reset();
+  /// What it carries between frames (RunAnalysis::saveState), and back.
+  struct State {
+    std::vector<double> origin, t, msd;
+  };
+  State state() const { return {m_origin, m_t, m_msd}; }
+  void restore(State s);
 
  private:
   std::vector<double> m_origin, m_t, m_msd;
@@ -48,6 +55,16 @@ class MsdAllOrigins {
   /// unavailable.
   std::vector<double> compute(std::vector<double>& lag) const;
   void reset();
+  /// What it carries between frames (RunAnalysis::saveState), and back (the budget stays).
+  struct State {
+    std::size_t n = 0, frames = 0;
+    bool available = true;
+    std::string reason;
+    double t0 = 0.0, dt = 0.0;
+    std::vector<double> xyz;
+  };
+  State state() const { return {m_n, m_frames, m_available, m_reason, m_t0, m_dt, m_xyz}; }
+  void restore(State s);
 
  private:
   void giveUp(const std::string& why);

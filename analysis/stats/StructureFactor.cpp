@@ -28,9 +28,15 @@ inline std::size_t wrap(long i, long M) { return static_cast<std::size_t>(((i % 
 
 struct StructureFactorMesh::Buffers {
   long M = 0;
-  std::unique_ptr<double, decltype(&fftw_free)> rho{nullptr, fftw_free};
-  std::unique_ptr<fftw_complex, decltype(&fftw_free)> rk{nullptr, fftw_free};
+  // one in-place real-to-complex transform: M x M x 2 (M/2 + 1) reals, the last dimension
+  // padded as FFTW's in-place layout wants, so that the density and its transform share memory
+  std::unique_ptr<double, decltype(&fftw_free)> data{nullptr, fftw_free};
   std::unique_ptr<fftw_plan_s, PlanDeleter> plan;
+  // velocityStructure: k^.u(k) accumulated over the three components, in single precision (the
+  // mesh's memory at M = 512 is 1.1 GB per double buffer; a statistic needs no more digits)
+  std::vector<std::complex<float>> longitudinal;
+  double* rho() { return data.get(); }
+  fftw_complex* rk() { return reinterpret_cast<fftw_complex*>(data.get()); }
 };
 
 StructureFactorMesh::StructureFactorMesh() : m_buffers(std::make_unique<Buffers>()) {}
@@ -40,48 +46,40 @@ StructureFactorMesh::Buffers& StructureFactorMesh::forSize(long M) {
   Buffers& b = *m_buffers;
   if (b.M == M && b.plan) return b;
   b.plan.reset();
-  const std::size_t cells = static_cast<std::size_t>(M) * M * M;
-  b.rho.reset(fftw_alloc_real(cells));
-  b.rk.reset(fftw_alloc_complex(static_cast<std::size_t>(M) * M * (M / 2 + 1)));
-  if (!b.rho || !b.rk) throw std::runtime_error("structure factor: no memory for the mesh");
+  std::vector<std::complex<float>>().swap(b.longitudinal);
+  b.data.reset(fftw_alloc_real(static_cast<std::size_t>(M) * M * 2 * (M / 2 + 1)));
+  if (!b.data) throw std::runtime_error("structure factor: no memory for the mesh");
   // (FFTW_ESTIMATE does not touch the arrays)
   b.plan.reset(fftw_plan_dft_r2c_3d(static_cast<int>(M), static_cast<int>(M), static_cast<int>(M),
-                                    b.rho.get(), b.rk.get(), FFTW_ESTIMATE));
+                                    b.rho(), b.rk(), FFTW_ESTIMATE));
   if (!b.plan) throw std::runtime_error("structure factor: FFTW could not plan the mesh");
   b.M = M;
   return b;
 }
 
-StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o) {
-  StructureFactorMesh mesh;
-  return structureFactor(f, o, mesh);
+namespace {
+
+/// The mesh of a frame: M even with h = L / M <= h_max, at most max_mesh.
+long meshSize(const Frame& f, const StructureFactorOptions& o, const char* what) {
+  if (f.size() == 0) throw std::invalid_argument(std::string(what) + ": the frame has no particles");
+  if (!(f.box > 0.0) || !std::isfinite(f.box))
+    throw std::invalid_argument(std::string(what) + ": the box edge must be positive");
+  if (!(o.h_max > 0.0) || !(o.k_cut > 0.0) || o.max_mesh < 8)
+    throw std::invalid_argument(std::string(what) +
+                                ": h_max and k_cut must be > 0, max_mesh >= 8");
+  long M = static_cast<long>(std::ceil(f.box / o.h_max));
+  M += M % 2;
+  return std::clamp<long>(M, 8, static_cast<long>(o.max_mesh) - static_cast<long>(o.max_mesh % 2));
 }
 
-StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o,
-                                StructureFactorMesh& mesh) {
-  const std::size_t N = f.size();
-  const double L = f.box;
-  if (N == 0) throw std::invalid_argument("structure factor: the frame has no particles");
-  if (!(L > 0.0) || !std::isfinite(L))
-    throw std::invalid_argument("structure factor: the box edge must be positive");
-  if (!(o.h_max > 0.0) || !(o.k_cut > 0.0) || o.max_mesh < 8)
-    throw std::invalid_argument("structure factor: h_max and k_cut must be > 0, max_mesh >= 8");
-  const double dk = 2.0 * PI / L;
-  // an even mesh with h = L / M <= h_max, at most max_mesh
-  long M = static_cast<long>(std::ceil(L / o.h_max));
-  M += M % 2;
-  M = std::clamp<long>(M, 8, static_cast<long>(o.max_mesh) - static_cast<long>(o.max_mesh % 2));
-  const double h = L / static_cast<double>(M);
-
-  // cloud-in-cell assignment of unit masses (cell centres at (i + 1/2) h are not needed: a shift
-  // of the mesh changes only the phase of rho_k)
-  const std::size_t cells = static_cast<std::size_t>(M) * M * M;
-  const long Mz = M / 2 + 1;
-  StructureFactorMesh::Buffers& buffers = mesh.forSize(M);
-  double* rho = buffers.rho.get();
-  const fftw_complex* rk = buffers.rk.get();
-  std::fill(rho, rho + cells, 0.0);
-  for (std::size_t j = 0; j < N; ++j) {
+/// Cloud-in-cell assignment of the weights w_j (unit masses when `weights` is null) onto the
+/// padded mesh (cell centres at (i + 1/2) h are not needed: a shift of the mesh changes only the
+/// phase of the transform).
+void assign(const Frame& f, long M, double h, const double* weights, std::size_t stride,
+            double* rho) {
+  const long P = 2 * (M / 2 + 1);
+  std::fill(rho, rho + static_cast<std::size_t>(M) * M * P, 0.0);
+  for (std::size_t j = 0; j < f.size(); ++j) {
     long i0[3];
     double w1[3];
     for (int a = 0; a < 3; ++a) {
@@ -90,22 +88,25 @@ StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o,
       i0[a] = static_cast<long>(fl);
       w1[a] = u - fl;
     }
+    const double q = weights ? weights[stride * j] : 1.0;
     for (int dx = 0; dx < 2; ++dx)
       for (int dy = 0; dy < 2; ++dy)
         for (int dz = 0; dz < 2; ++dz) {
           const double w =
               (dx ? w1[0] : 1.0 - w1[0]) * (dy ? w1[1] : 1.0 - w1[1]) * (dz ? w1[2] : 1.0 - w1[2]);
-          rho[(wrap(i0[0] + dx, M) * M + wrap(i0[1] + dy, M)) * M + wrap(i0[2] + dz, M)] += w;
+          rho[(wrap(i0[0] + dx, M) * M + wrap(i0[1] + dy, M)) * P + wrap(i0[2] + dz, M)] += q * w;
         }
   }
-  fftw_execute(buffers.plan.get());
+}
 
-  // complete shells below the Nyquist wavenumber pi / h: every component |n_a| < M / 2
-  const long shells = static_cast<long>(std::floor(static_cast<double>(M) / 2.0 - 0.5));
-  std::vector<double> sum(static_cast<std::size_t>(shells) + 1, 0.0);
-  std::vector<std::size_t> count(sum.size(), 0);
+/// Calls visit(index, m, nx, ny, nz, window) for one of each pair +-k of the mesh's wave vectors
+/// in the complete shells m = 1 .. shells below the Nyquist wavenumber pi / h (every |n_a| <
+/// M / 2); `index` addresses the transform, `window` is the CIC window's aliased sum for
+/// uncorrelated positions (Jing 2005, eq. 20).
+template <class Visit>
+void forEachMode(long M, double h, double dk, long shells, Visit&& visit) {
+  const long Mz = M / 2 + 1;
   auto component = [M](long i) { return i <= M / 2 ? i : i - M; };
-  // the CIC window's aliased sum for uncorrelated positions, per axis (Jing 2005, eq. 20)
   auto alias = [h](double k) {
     const double s = std::sin(0.5 * k * h);
     return 1.0 - (2.0 / 3.0) * s * s;
@@ -115,38 +116,131 @@ StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o,
     for (long iy = 0; iy < M; ++iy) {
       const long ny = component(iy);
       for (long nz = 0; nz < Mz; ++nz) {
-        // one of each pair +-k: rho_{-k} is the conjugate of rho_k
+        // one of each pair +-k: the transform at -k is the conjugate of that at k
         if (nz == 0 && !(nx > 0 || (nx == 0 && ny > 0))) continue;
         const double n2 = static_cast<double>(nx * nx + ny * ny + nz * nz);
         const long m = std::lround(std::sqrt(n2));
         if (m < 1 || m > shells) continue;
-        const fftw_complex& c = rk[(static_cast<std::size_t>(ix) * M + iy) * Mz + nz];
-        const double power = c[0] * c[0] + c[1] * c[1];
         const double window = alias(dk * nx) * alias(dk * ny) * alias(dk * nz);
-        sum[static_cast<std::size_t>(m)] += power / (static_cast<double>(N) * window);
-        ++count[static_cast<std::size_t>(m)];
+        visit((static_cast<std::size_t>(ix) * M + iy) * Mz + nz, m, nx, ny, nz, window);
       }
     }
   }
+}
+
+/// The first moment k_1 = sum k_m S_m / sum S_m over the shells up to k_cut.
+double firstMoment(const std::vector<double>& k, const std::vector<double>& S, double k_cut) {
+  double moment = 0.0, norm = 0.0;
+  for (std::size_t m = 0; m < k.size(); ++m)
+    if (k[m] <= k_cut * (1.0 + 1e-12)) {
+      moment += k[m] * S[m];
+      norm += S[m];
+    }
+  return norm > 0.0 ? moment / norm : std::nan("");
+}
+
+}  // namespace
+
+StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o) {
+  StructureFactorMesh mesh;
+  return structureFactor(f, o, mesh);
+}
+
+StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o,
+                                StructureFactorMesh& mesh) {
+  const std::size_t N = f.size();
+  const long M = meshSize(f, o, "structure factor");
+  const double L = f.box, dk = 2.0 * PI / L, h = L / static_cast<double>(M);
+  StructureFactorMesh::Buffers& buffers = mesh.forSize(M);
+  assign(f, M, h, nullptr, 0, buffers.rho());
+  fftw_execute(buffers.plan.get());
+  const fftw_complex* rk = buffers.rk();
+
+  const long shells = static_cast<long>(std::floor(static_cast<double>(M) / 2.0 - 0.5));
+  std::vector<double> sum(static_cast<std::size_t>(shells) + 1, 0.0);
+  std::vector<std::size_t> count(sum.size(), 0);
+  forEachMode(M, h, dk, shells, [&](std::size_t i, long m, long, long, long, double window) {
+    const double power = rk[i][0] * rk[i][0] + rk[i][1] * rk[i][1];
+    sum[static_cast<std::size_t>(m)] += power / (static_cast<double>(N) * window);
+    ++count[static_cast<std::size_t>(m)];
+  });
 
   StructureFactor r;
   r.mesh = static_cast<std::size_t>(M);
   r.k_cut = std::min(o.k_cut, dk * static_cast<double>(shells));
-  double moment = 0.0, norm = 0.0;
   for (long m = 1; m <= shells; ++m) {
     const auto mm = static_cast<std::size_t>(m);
     if (count[mm] == 0) continue;
-    const double km = dk * static_cast<double>(m), S = sum[mm] / static_cast<double>(count[mm]);
-    r.k.push_back(km);
-    r.S.push_back(S);
+    r.k.push_back(dk * static_cast<double>(m));
+    r.S.push_back(sum[mm] / static_cast<double>(count[mm]));
     r.modes.push_back(count[mm]);
-    if (km <= r.k_cut * (1.0 + 1e-12)) {
-      moment += km * S;
-      norm += S;
-    }
   }
-  r.k1 = norm > 0.0 ? moment / norm : std::nan("");
+  r.k1 = firstMoment(r.k, r.S, r.k_cut);
   r.length = 2.0 * PI / r.k1;
+  return r;
+}
+
+VelocityStructure velocityStructure(const Frame& f, const StructureFactorOptions& o,
+                                    StructureFactorMesh& mesh) {
+  if (!f.hasVelocities())
+    throw std::invalid_argument("velocity structure: the frame has no velocities");
+  const std::size_t N = f.size();
+  const long M = meshSize(f, o, "velocity structure");
+  const double L = f.box, dk = 2.0 * PI / L, h = L / static_cast<double>(M);
+  // peculiar velocities c = v - <v> and T_g = <|c|^2> / 3
+  double mean[3] = {0, 0, 0};
+  for (std::size_t j = 0; j < N; ++j)
+    for (int a = 0; a < 3; ++a) mean[a] += f.velocity[3 * j + a];
+  for (double& m : mean) m /= static_cast<double>(N);
+  std::vector<double> c(3 * N);
+  double c2 = 0.0;
+  for (std::size_t j = 0; j < 3 * N; ++j) {
+    c[j] = f.velocity[j] - mean[j % 3];
+    c2 += c[j] * c[j];
+  }
+  VelocityStructure r;
+  r.T_g = c2 / (3.0 * static_cast<double>(N));
+  StructureFactorMesh::Buffers& buffers = mesh.forSize(M);
+  const long shells = static_cast<long>(std::floor(static_cast<double>(M) / 2.0 - 0.5));
+  std::vector<double> total(static_cast<std::size_t>(shells) + 1, 0.0), along(total);
+  std::vector<std::size_t> count(total.size(), 0);
+  buffers.longitudinal.assign(static_cast<std::size_t>(M) * M * (M / 2 + 1), {0.0f, 0.0f});
+  std::complex<float>* D = buffers.longitudinal.data();
+  for (int a = 0; a < 3; ++a) {
+    assign(f, M, h, c.data() + a, 3, buffers.rho());
+    fftw_execute(buffers.plan.get());
+    const fftw_complex* uk = buffers.rk();
+    forEachMode(M, h, dk, shells, [&](std::size_t i, long m, long nx, long ny, long nz,
+                                      double window) {
+      const double power = uk[i][0] * uk[i][0] + uk[i][1] * uk[i][1];
+      total[static_cast<std::size_t>(m)] += power / window;
+      if (a == 0) ++count[static_cast<std::size_t>(m)];
+      const double n[3] = {static_cast<double>(nx), static_cast<double>(ny),
+                           static_cast<double>(nz)};
+      const double khat = n[a] / std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      D[i] += std::complex<float>(static_cast<float>(khat * uk[i][0]),
+                                  static_cast<float>(khat * uk[i][1]));
+    });
+  }
+  forEachMode(M, h, dk, shells, [&](std::size_t i, long m, long, long, long, double window) {
+    along[static_cast<std::size_t>(m)] += static_cast<double>(std::norm(D[i])) / window;
+  });
+  std::vector<std::complex<float>>().swap(buffers.longitudinal);  // 0.5 GB at M = 512
+
+  r.mesh = static_cast<std::size_t>(M);
+  r.k_cut = std::min(o.k_cut, dk * static_cast<double>(shells));
+  const double norm = static_cast<double>(N) * r.T_g;
+  for (long m = 1; m <= shells; ++m) {
+    const auto mm = static_cast<std::size_t>(m);
+    if (count[mm] == 0) continue;
+    const double n = static_cast<double>(count[mm]) * norm;
+    r.k.push_back(dk * static_cast<double>(m));
+    r.S_long.push_back(along[mm] / n);
+    r.S_trans.push_back((total[mm] - along[mm]) / (2.0 * n));
+    r.modes.push_back(count[mm]);
+  }
+  r.length_long = 2.0 * PI / firstMoment(r.k, r.S_long, r.k_cut);
+  r.length_trans = 2.0 * PI / firstMoment(r.k, r.S_trans, r.k_cut);
   return r;
 }
 

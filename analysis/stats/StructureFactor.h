@@ -40,7 +40,7 @@ namespace granagg::analysis {
 struct StructureFactorOptions {
   double h_max = 0.5;                     ///< largest mesh spacing [d]
   double k_cut = 3.14159265358979323846;  ///< k_c of the first moment [1/d]
-  std::size_t max_mesh = 512;  ///< largest M (memory: ~12 M^3 bytes); h may then exceed h_max
+  std::size_t max_mesh = 512;  ///< largest M (memory: ~8 M^3 bytes); h may then exceed h_max
 };
 
 /// S(k) in spherical shells, and l.
@@ -54,7 +54,8 @@ struct StructureFactor {
   double length = 0.0;  ///< l = 2 pi / k_1
 };
 
-/// The FFTW mesh of structureFactor (density and transform buffers, ~12 M^3 bytes, and the plan),
+/// The FFTW mesh of structureFactor (one in-place transform buffer, ~8 M^3 bytes, and the plan;
+/// velocityStructure adds ~4 M^3 bytes while it runs),
 /// kept between calls of the same mesh size M, so that a trajectory's frames share one pair of
 /// buffers. Allocated afresh per frame, they grow glibc's heap by about their size at every frame
 /// (its mmap threshold rises to the freed size, and smaller allocations in between take the freed
@@ -79,5 +80,35 @@ StructureFactor structureFactor(const Frame& frame, const StructureFactorOptions
                                 StructureFactorMesh& mesh);
 /// The same on a mesh of its own (one frame).
 StructureFactor structureFactor(const Frame& frame, const StructureFactorOptions& options = {});
+
+/// The structure of the velocity field, on the mesh and in the shells of S(k): with the peculiar
+/// velocities c_j = v_j - <v> and u(k) = sum_j c_j exp(-i k . r_j), its longitudinal part
+/// k^ (k^ . u) and its transverse (shear, vorticity) part u - k^ (k^ . u) give
+///
+///     S_par(k) = < |k^ . u|^2 > / (N T_g),   S_perp(k) = < |u - k^ (k^ . u)|^2 > / (2 N T_g),
+///
+/// both 1 for velocities uncorrelated with each other and with the positions (an ideal gas);
+/// T_g = <|c|^2> / 3. The shells' first moments over k_m <= k_c give the lengths l_par and l_perp
+/// (the vortex length) as l = 2 pi / k_1 does for S(k) (van Noije, Ernst, Brito & Orza, PRL 79,
+/// 411 (1997): vorticity dominates the velocity correlations of the cooling gas; Orza et al.
+/// (1997): the mean vortex diameter grows as t^(1/2)). Each component is assigned by CIC with its
+/// velocity as weight and corrected by Jing's aliased window as S(k) is (exact in expectation for
+/// uncorrelated particles). k^ . u is accumulated in single precision.
+struct VelocityStructure {
+  std::vector<double> k;        ///< shell centres k_m = m 2 pi / L
+  std::vector<double> S_long;   ///< S_par(k_m)
+  std::vector<double> S_trans;  ///< S_perp(k_m)
+  std::vector<std::size_t> modes;
+  std::size_t mesh = 0;
+  double k_cut = 0.0;
+  double T_g = 0.0;           ///< granular temperature of the frame
+  double length_long = 0.0;   ///< l_par = 2 pi / k_1 of S_par
+  double length_trans = 0.0;  ///< l_perp = 2 pi / k_1 of S_perp
+};
+
+/// S_par, S_perp and their lengths for `frame` (which must hold velocities), on `mesh`'s buffers
+/// (shared with structureFactor). Throws std::invalid_argument for a frame without velocities.
+VelocityStructure velocityStructure(const Frame& frame, const StructureFactorOptions& options,
+                                    StructureFactorMesh& mesh);
 
 }  // namespace granagg::analysis

@@ -91,7 +91,8 @@ const std::vector<Section>& schema() {
        {GRANAGG_KEY(output, frames_per_decade), GRANAGG_KEY(output, frame_interval),
         GRANAGG_KEY(output, observable_interval), GRANAGG_KEY(output, checkpoint_interval),
         GRANAGG_KEY(output, checkpoint_wall_seconds), GRANAGG_KEY(output, write_velocities),
-        GRANAGG_KEY(output, write_forces)}},
+        GRANAGG_KEY(output, write_forces), GRANAGG_KEY(output, trajectory),
+        GRANAGG_KEY(output, analyze)}},
   };
   return s;
 }
@@ -148,10 +149,13 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
   return "";
 }
 
+/// The section md stores as TOML text without reading it (MdConfig::analysis).
+constexpr const char* OPAQUE_SECTION = "analysis";
+
 std::string sectionList() {
   std::string out;
   for (const auto& s : schema()) out += (out.empty() ? "" : ", ") + s.name;
-  return out;
+  return out + ", " + OPAQUE_SECTION;
 }
 
 std::string keyList(const Section& section) {
@@ -353,6 +357,35 @@ std::string assign(const Key& key, const std::string& full, const toml::node& no
   return "";
 }
 
+// A value of the opaque section as TOML text: a number, a boolean, a string or an array of
+// numbers (what the options of granagg analyze take); returns "" or an error message.
+std::string opaqueText(const std::string& full, const toml::node& node, std::string& text) {
+  if (auto v = node.as_integer()) {
+    text = std::to_string(v->get());
+  } else if (auto v = node.as_floating_point()) {
+    text = tomlReal(v->get());
+  } else if (auto v = node.as_boolean()) {
+    text = v->get() ? "true" : "false";
+  } else if (auto v = node.as_string()) {
+    text = quote(v->get());
+  } else if (auto a = node.as_array()) {
+    text = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::node& e = *a->get(i);
+      std::string item;
+      if (e.is_array() || e.is_table() || !opaqueText(full, e, item).empty())
+        return full + " must be a number, a boolean, a string or an array of numbers, got an "
+                      "array holding " + describe(e);
+      text += (i ? ", " : "") + item;
+    }
+    text += "]";
+  } else {
+    return full + " must be a number, a boolean, a string or an array of numbers, got " +
+           describe(node);
+  }
+  return "";
+}
+
 toml::table parseToml(const std::string& text, const std::string& source_name) {
 #if TOML_EXCEPTIONS
   try {
@@ -381,6 +414,26 @@ void readTable(const toml::table& root, const std::string& source_name, MdConfig
   };
   for (auto&& [skey, snode] : root) {
     const std::string sname(skey.str());
+    if (sname == OPAQUE_SECTION) {
+      const toml::table* table = snode.as_table();
+      if (!table) {
+        report(skey.source(), "'" + sname + "' must be a table ([" + sname + "]), got " +
+                                  describe(snode), sname);
+        continue;
+      }
+      for (auto&& [kkey, knode] : *table) {
+        const std::string full = sname + "." + std::string(kkey.str());
+        std::string text;
+        const std::string error = opaqueText(full, knode, text);
+        if (!error.empty()) {
+          report(knode.source(), error, full);
+          continue;
+        }
+        config.analysis[std::string(kkey.str())] = text;
+        origin[full] = where(knode.source(), source_name);
+      }
+      continue;
+    }
     const Section* section = findSection(sname);
     if (!section) {
       report(skey.source(),
@@ -432,6 +485,30 @@ void applyOverride(const std::string& raw, MdConfig& config,
   const auto dot = full.find('.');
   if (dot == std::string::npos) throw ConfigError(prefix + unknownKeyMessage("", full), full);
   const std::string sname = full.substr(0, dot), kname = full.substr(dot + 1);
+  if (sname == OPAQUE_SECTION) {  // stored as TOML text: a bare word becomes a string
+    toml::table parsed;
+    const std::string value_doc = "v = " + text;
+#if TOML_EXCEPTIONS
+    try {
+      parsed = toml::parse(std::string_view(value_doc), std::string_view("--set"));
+    } catch (const toml::parse_error&) {
+      parsed = toml::table{};
+    }
+#else
+    if (auto res = toml::parse(std::string_view(value_doc), std::string_view("--set")))
+      parsed = std::move(res).table();
+#endif
+    const toml::node* node = parsed.get("v");
+    toml::value<std::string> as_text(text);
+    if (!node || node->is_date() || node->is_time() || node->is_date_time()) node = &as_text;
+    std::string stored;
+    const std::string error = kname.empty() ? full + ": a key is missing after 'analysis.'"
+                                            : opaqueText(full, *node, stored);
+    if (!error.empty()) throw ConfigError(prefix + error, full);
+    config.analysis[kname] = stored;
+    origin[full] = "--set " + raw;
+    return;
+  }
   const Section* section = findSection(sname);
   if (!section) throw ConfigError(prefix + unknownKeyMessage(sname, ""), full);
   const Key* key = findKey(*section, kname);
@@ -650,6 +727,10 @@ std::string toToml(const MdConfig& config) {
     out += "\n[" + s.name + "]\n";
     for (const auto& k : s.keys) out += k.name + " = " + valueText(k, config, true) + "\n";
   }
+  if (!config.analysis.empty()) {
+    out += std::string("\n[") + OPAQUE_SECTION + "]\n";
+    for (const auto& [key, text] : config.analysis) out += key + " = " + text + "\n";
+  }
   return out;
 }
 
@@ -658,6 +739,8 @@ std::vector<std::pair<std::string, std::string>> flatten(const MdConfig& config)
   for (const auto& s : schema())
     for (const auto& k : s.keys)
       out.emplace_back(s.name + "." + k.name, valueText(k, config, false));
+  for (const auto& [key, text] : config.analysis)
+    out.emplace_back(std::string(OPAQUE_SECTION) + "." + key, text);
   return out;
 }
 

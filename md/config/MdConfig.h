@@ -20,7 +20,12 @@
 ///                   numbers), every, every_max, skin, r_fast
 ///     [run]         t_end, max_overlap
 ///     [output]      frames_per_decade, frame_interval, observable_interval, checkpoint_interval,
-///                   checkpoint_wall_seconds, write_velocities, write_forces
+///                   checkpoint_wall_seconds, write_velocities, write_forces, trajectory,
+///                   analyze
+///     [analysis]    the options of `granagg analyze` for the analysis during the run
+///                   (output.analyze), under their names with '_' (grid_spacing, tolerance, ...;
+///                   docs/config.md). md keeps them as TOML text and does not read them: the
+///                   in-situ analysis (study/insitu) checks them before the first step.
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -142,6 +147,11 @@ struct OutputConfig {
   bool write_velocities = true;
   bool write_forces =
       false;  ///< per-particle total forces in every frame (/particles/all/force), for checks
+  /// particle frames in traj.h5 at the frame times; false: observables and checkpoints only (the
+  /// frame times still drive the in-situ analysis)
+  bool trajectory = true;
+  /// analyse every frame during the run ([analysis]) into OUT/analysis (granagg md --analyze)
+  bool analyze = false;
 };
 
 struct MdConfig {
@@ -154,6 +164,9 @@ struct MdConfig {
   CoulombConfig coulomb;
   RunConfig run;
   OutputConfig output;
+  /// [analysis]: key -> its value as TOML text (2.0, "cic", [10.0, 100.0]), in key order. Opaque
+  /// to md: carried through toToml and flatten so that a restart and /parameters keep it.
+  std::map<std::string, std::string> analysis;
   /// Where each key the user gave was set: "section.key" -> "run.toml:3:1" or "--set
   /// system.N=4" (the parser fills it; keys left at their defaults are absent). Not a key itself:
   /// toToml and flatten leave it out. A file-given initial state refuses a system.N or system.phi

@@ -43,6 +43,10 @@ double lammpsSkin(const MdConfig& c, double dt) {
 }  // namespace
 
 void checkLammpsCanRun(const MdConfig& c) {
+  if (c.output.analyze)
+    cannot("output.analyze", "true",
+           "the in-situ analysis runs in granagg md; analyse the run's traj.h5 with granagg "
+           "analyze");
   if (c.integrator.adaptive)
     cannot("integrator.dt", "\"adaptive\"",
            "the adaptive step is granagg md's; use \"auto\" or a number");

@@ -87,16 +87,18 @@ TrajectoryReporter::TrajectoryReporter(RunEngine& engine, const MdConfig& cfg, f
 void TrajectoryReporter::create(const std::vector<std::pair<std::string, std::string>>& params,
                                 const std::string& config_toml, bool overwrite,
                                 const Observables& o) {
-  const Frame f = outputFrame(m_engine, m_cfg);
+  // (collective; not needed when no frame is stored)
+  const Frame f = m_cfg.output.trajectory ? outputFrame(m_engine, m_cfg) : Frame{};
   if (m_engine.writesFiles()) {
     m_writer = std::make_unique<H5mdWriter>(m_file.string(), m_engine.size(), params, config_toml,
                                             overwrite, m_cfg.output.write_velocities,
                                             m_cfg.output.write_forces);
     m_writer->writeObservables(o.step, o.time, observableRow(o, m_engine.dt()));
-    m_writer->writeFrame(f);
+    if (m_cfg.output.trajectory) m_writer->writeFrame(f);
     watch();
   }
-  m_frames_written = 1;
+  m_frames_written = m_cfg.output.trajectory ? 1 : 0;
+  m_frame_step = m_engine.step();
   // the schedule's frames up to this step are this one
   m_next_frame = static_cast<std::size_t>(
       std::upper_bound(m_frame_steps.begin(), m_frame_steps.end(), m_engine.step()) -
@@ -139,6 +141,8 @@ void TrajectoryReporter::report(const Simulation& sim) {
 }
 
 void TrajectoryReporter::writeFrame() {
+  m_frame_step = m_engine.step();
+  if (!m_cfg.output.trajectory) return;  // a frame time without a stored frame
   const Frame f = outputFrame(m_engine, m_cfg);  // (collective)
   if (m_writer) m_writer->writeFrame(f);
   ++m_frames_written;
@@ -235,6 +239,7 @@ void CheckpointReporter::report(const Simulation&) {
 }
 
 void CheckpointReporter::save() {
+  if (m_before) m_before(m_engine.step());
   m_trajectory.flush();
   RunFields run;
   run.config_toml = toToml(m_cfg);

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -34,7 +35,8 @@ std::vector<std::pair<std::string, std::string>> trajectoryParameters(
 
 /// traj.h5: the observables (with the step dt in force) every output.observable_interval steps
 /// and at the run's last step, the frames at `frame_steps` (Simulation::frameSteps; with an
-/// adaptive step, addFrameStep). Between chunks it checks that the file
+/// adaptive step, addFrameStep). With output.trajectory = false the frame steps still come and
+/// go (frameStep(): for the in-situ analysis) but no frame is stored. Between chunks it checks that the file
 /// is still the one it writes; after closing, that it reads back whole. A trajectory changed
 /// behind the run's back (removed, replaced, truncated by another program; other granagg commands
 /// are kept out by the folder lock) stops the run with std::runtime_error: a run never reports
@@ -75,6 +77,8 @@ class TrajectoryReporter : public Reporter {
 
   const std::filesystem::path& file() const { return m_file; }
   std::size_t framesWritten() const;
+  /// The step of the last frame time reached (stored or not); -1 before the first.
+  std::int64_t frameStep() const { return m_frame_step; }
 
  private:
   [[noreturn]] void damaged(const std::string& what) const;
@@ -88,6 +92,7 @@ class TrajectoryReporter : public Reporter {
   std::size_t m_next_frame;
   std::size_t m_frames_written;  // counted on every rank
   std::int64_t m_last_step;
+  std::int64_t m_frame_step = -1;
   std::unique_ptr<H5mdWriter> m_writer;  // on the writing rank
   struct stat m_stat {};                 // the file as this run last left it
   std::filesystem::path m_checkpoint_file;
@@ -104,6 +109,9 @@ class CheckpointReporter : public Reporter {
   /// step of the checkpoint the run continues (-1 for a new run).
   CheckpointReporter(RunEngine& engine, const MdConfig& cfg, std::filesystem::path folder,
                      TrajectoryReporter& trajectory, std::int64_t last_step);
+  /// Called before every checkpoint with its step (Simulation: Reporter::beforeCheckpoint of
+  /// every reporter), so that what is saved beside the checkpoint is saved first.
+  void setBeforeSave(std::function<void(std::int64_t)> before) { m_before = std::move(before); }
 
   std::int64_t nextStep(const Simulation& sim) const override;
   void report(const Simulation& sim) override;
@@ -121,6 +129,7 @@ class CheckpointReporter : public Reporter {
   TrajectoryReporter& m_trajectory;
   std::int64_t m_last_step;
   Clock::time_point m_last_time = Clock::now();
+  std::function<void(std::int64_t)> m_before;
 };
 
 /// profile.csv: one row, seconds per phase of the loop (`other` = the loop's time in no phase:

@@ -11,7 +11,9 @@ namespace granagg::md {
 class Simulation;
 
 /// Called by md::Simulation::run() after each chunk of steps, in order: the trajectory, the
-/// checkpoints, then the reporters added with Simulation::addReporter. A reporter never changes
+/// reporters added with Simulation::addReporter, then the checkpoints, so that a checkpoint
+/// follows every reporter's view of its step (an in-situ analysis has seen the frame a checkpoint
+/// is written at, and saves its own state in beforeCheckpoint). A reporter never changes
 /// the physics of the run; under MPI every rank holds the same reporters and calls them in the
 /// same order, so that their collective engine calls match.
 class Reporter {
@@ -25,8 +27,12 @@ class Reporter {
   }
   /// Called after each chunk of steps, with the engine at the chunk's end.
   virtual void report(const Simulation& sim) = 0;
-  /// Called once when run() ends (normally or not).
+  /// Called once when run() ends (normally or not), after the final checkpoint.
   virtual void finish(const Simulation&) {}
+  /// Called just before every checkpoint is written, with its step: a reporter that carries state
+  /// across a restart saves it here (a kill between the two leaves the previous checkpoint, so
+  /// keep the previous state as well). Under MPI, on every rank.
+  virtual void beforeCheckpoint(const Simulation&, std::int64_t /*step*/) {}
 };
 
 }  // namespace granagg::md

@@ -367,9 +367,17 @@ RunSummary Simulation::run() {
   const std::int64_t first_step = engine.step(), first_builds = engine.neighborBuilds(),
                      first_slow = engine.slowEvaluations();
   const auto loop_start = std::chrono::steady_clock::now();
-  // the run's outputs first, then the user's reporters
-  std::vector<Reporter*> all = {d.trajectory.get(), d.checkpoints.get()};
+  // the trajectory first, then the user's reporters, then the checkpoints (Reporter.h)
+  std::vector<Reporter*> all = {d.trajectory.get()};
   for (const auto& r : d.reporters) all.push_back(r.get());
+  all.push_back(d.checkpoints.get());
+  d.checkpoints->setBeforeSave([this](std::int64_t step) {
+    for (auto& r : m_impl->reporters) r->beforeCheckpoint(*this, step);
+  });
+  struct Unhook {  // no reporter is called back once run() is over
+    CheckpointReporter& c;
+    ~Unhook() { c.setBeforeSave({}); }
+  } unhook{*d.checkpoints};
   struct Finish {  // the user's reporters hear of the end however run() ends
     Simulation& sim;
     ~Finish() {
@@ -419,8 +427,13 @@ RunSummary Simulation::run() {
 }
 
 void Simulation::writeCheckpoint() {
-  if (!finished()) m_impl->checkpoints->save();
+  if (finished()) return;
+  // (outside run() the checkpoint reporter has no hook: call the reporters here)
+  for (auto& r : m_impl->reporters) r->beforeCheckpoint(*this, m_impl->engine->step());
+  m_impl->checkpoints->save();
 }
+
+std::int64_t Simulation::frameStep() const { return m_impl->trajectory->frameStep(); }
 
 const std::string& Simulation::clearedStaleLock() const {
   static const std::string none;

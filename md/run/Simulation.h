@@ -141,6 +141,11 @@ class Simulation {
   bool finished() const;
   /// Frames in the trajectory so far.
   std::size_t framesWritten() const;
+  /// The step of the last frame time the run reached (output.frames_per_decade,
+  /// output.frame_interval and the last step), whether traj.h5 stored the frame
+  /// (output.trajectory) or not; -1 before the first. A reporter sees a frame time when this
+  /// equals engine().step().
+  std::int64_t frameStep() const;
   /// The observables at the end of the last chunk of run() (what reporters should read: the
   /// engine's observables() may evaluate the Coulomb energy afresh); zeros before the first.
   const Observables& lastObservables() const;

@@ -279,11 +279,12 @@ TEST_CASE("unknown keys and sections are reported with file:line:col", "[md][con
       errorOf([&] { parseConfigString("[sytem]\nN = 2\n", "run.toml"); }) ==
       "run.toml:1:2: unknown section 'sytem' (known sections: input, system, contact, integrator, "
       "neighbor, charging, coulomb, run, "
-      "output); did you mean 'system'?");
+      "output, analysis); did you mean 'system'?");
   CHECK(errorOf([&] { parseConfigString("N = 2\n", "run.toml"); }) ==
         "run.toml:1:1: unknown key 'N' at top level (keys belong in a section; known sections: "
         "input, system, "
-        "contact, integrator, neighbor, charging, coulomb, run, output); did you mean 'system.N'?");
+        "contact, integrator, neighbor, charging, coulomb, run, output, analysis); did you mean "
+        "'system.N'?");
   // A nested table is an unknown key of its section.
   CHECK(errorOf([&] {
           parseConfigString("[system.extra]\nx = 1\n", "run.toml");
@@ -355,7 +356,7 @@ TEST_CASE("overrides (--set key=value) apply after the file and are validated", 
       {"sytem.N=2",
        "--set sytem.N=2: unknown section 'sytem' (known sections: input, system, contact, "
        "integrator, "
-       "neighbor, charging, coulomb, run, output); did you mean 'system'?"},
+       "neighbor, charging, coulomb, run, output, analysis); did you mean 'system'?"},
       {"N=2", "--set N=2: unknown key 'N' at top level"},
       {"system.N", "--set system.N: expected section.key=value"},
       {"system.N=abc", "--set system.N=abc: system.N must be an integer, got string \"abc\""},
@@ -462,7 +463,7 @@ TEST_CASE("flatten lists every key with round-trip numbers", "[md][config]") {
   MdConfig c;
   c.system.phi = 0.1 + 0.2;
   const auto f = flatten(c);
-  REQUIRE(f.size() == 44);
+  REQUIRE(f.size() == 46);
   CHECK(f.front() == std::make_pair(std::string("input.version"), std::string("1")));
   CHECK(f[1] == std::make_pair(std::string("system.N"), std::string("1000")));
   CHECK(f[2] == std::make_pair(std::string("system.phi"), std::string("0.30000000000000004")));
