@@ -16,6 +16,7 @@
 #include "cli/CliContext.h"
 #include "common/Csv.h"
 #include "common/ProgressLine.h"
+#include "study/insitu/InSituAnalysis.h"
 
 namespace granagg::cli {
 namespace an = granagg::analysis;
@@ -43,6 +44,8 @@ void runAnalyze(const AnalyzeArgs& a, const CliContext& ctx) {
   request.force = a.force;
   request.write_grid = a.write_grid;
   request.command_line = ctx.command_line;
+  // a run analysed while it ran that stored no frames: its in-situ tables
+  request.stored_result = [](const std::string& run) { return insitu::storedResult(run); };
   common::ProgressLine progress("analyze", !a.quiet);  // in place, or a line a minute in a log
   const an::AnalysisFolder folder =
       an::analyseIntoFolder(request, o, [&](std::size_t run, std::size_t frame, std::size_t hint) {

@@ -12,6 +12,7 @@
 #include "md/config/ConfigParser.h"
 #include "md/engine/Engine.h"
 #include "study/PairStudy.h"
+#include "study/insitu/InSituAnalysis.h"
 
 namespace granagg::cli {
 namespace fs = std::filesystem;
@@ -40,6 +41,7 @@ study::StudyServices services(const CliContext& ctx, const CLI::App* root) {
     md::MdConfig cfg = md::parseConfigFile(base, set);
     cfg.system.seed = 0;  // every run sets its own with --seed
     md::validateConfig(cfg);
+    if (cfg.output.analyze) insitu::analysisOptions(cfg);  // [analysis] args refused here
     study::MdPlan p;
     p.toml = md::toToml(cfg);
     p.N = cfg.system.N;
@@ -128,6 +130,9 @@ void registerPairCommand(CLI::App& app, const CliContext& ctx) {
                 "Run only the run with this index (k * runs + r); what batch array tasks call")
       ->group("");
   c->add_flag("--no-figures", a->request.no_figures, "Skip the figures and the report");
+  c->add_flag("--keep-trajectories", a->request.keep_trajectories,
+              "Store every run's particle frames (traj.h5) besides its analysis during the run "
+              "(granagg md's runs store none by default; Fig. 2's snapshots need them)");
   c->add_flag("-q,--quiet", a->request.quiet, "No progress line or summary");
   const CLI::App* root = &app;
   c->callback([a, ctx, root, c]() {

@@ -196,6 +196,10 @@ def fig2(st, fig):
 
         with h5py.File(path, "r") as f:
             times = f["particles/all/position/time"][:]
+        if len(times) == 0:  # analysed during the run, frames not kept
+            note(fig.add_subplot(len(rows), 1, r + 1),
+                 f"{path}: no particle frames stored (granagg pair --keep-trajectories keeps them)")
+            continue
         tt = times[times > 0]
         wanted = [tt[0], np.sqrt(tt[0] * tt[-1]), tt[-1]] if len(tt) else [times[0]]
         L, frames = load_frames(path, wanted)

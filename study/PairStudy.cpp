@@ -30,6 +30,41 @@ using common::formatReal;
 
 namespace {
 
+/// `granagg analyze` arguments ([analysis] args) as md's [analysis] assignments: "--grid-spacing
+/// 3" -> "analysis.grid_spacing=3", a flag "--no-grid" -> "analysis.no_grid=true", two values
+/// "--fit-window 100 1000" -> "analysis.fit_window=[100, 1000]". md checks the keys (exit 2).
+std::vector<std::string> analysisSets(const std::vector<std::string>& args) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < args.size();) {
+    std::string key = args[i];
+    if (key.rfind("--", 0) != 0)
+      throw std::invalid_argument("[analysis] args: expected an option (--name), got '" + key +
+                                  "'");
+    key = key.substr(2);
+    std::string value;
+    const auto eq = key.find('=');
+    std::vector<std::string> values;
+    if (eq != std::string::npos) {
+      values.push_back(key.substr(eq + 1));
+      key = key.substr(0, eq);
+    }
+    ++i;
+    while (i < args.size() && args[i].rfind("--", 0) != 0) values.push_back(args[i++]);
+    std::replace(key.begin(), key.end(), '-', '_');
+    if (values.empty()) {
+      value = "true";
+    } else if (values.size() == 1) {
+      value = values.front();
+    } else {
+      value = "[";
+      for (std::size_t k = 0; k < values.size(); ++k) value += (k ? ", " : "") + values[k];
+      value += "]";
+    }
+    out.push_back("analysis." + key + "=" + value);
+  }
+  return out;
+}
+
 /// "[0, 5]": the K values as the log shows them.
 std::string kList(const std::vector<double>& K) {
   std::string s;
@@ -129,6 +164,14 @@ PairStudy::PairStudy(PairConfig config, StudyRequest request, StudyServices serv
   for (std::size_t k = 0; k < m_c.K.size(); ++k) {
     const double K = m_c.K[k];
     std::vector<std::string> set = m_c.md_set;
+    if (!m_launch.lammps()) {
+      // analysed while they run (granagg md --analyze), with [analysis] args as [analysis] keys;
+      // the analysis stage then reads their tables, not their frames
+      set.push_back("output.analyze=true");
+      set.push_back(std::string("output.trajectory=") +
+                    (m_a.keep_trajectories ? "true" : "false"));
+      for (const std::string& a : analysisSets(m_c.analysis_args)) set.push_back(a);
+    }
     set.push_back("coulomb.K=" + formatReal(K));
     if (K > 0) {
       set.push_back("charging.Q=" + formatReal(m_c.charged_Q));

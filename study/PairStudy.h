@@ -74,6 +74,8 @@ struct StudyRequest {
   int run_index = -1;      ///< >= 0: run only this run (a batch array task)
   std::string launcher;    ///< "" : lammps.launcher; else the launcher of granagg-lammps runs
   bool force = false, quiet = false, no_figures = false;
+  /// granagg md's runs store their particle frames (traj.h5) besides their in-situ analysis
+  bool keep_trajectories = false;
 };
 
 /// One MD run of the study.

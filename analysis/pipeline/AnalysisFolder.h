@@ -6,6 +6,7 @@
 /// block the rerun.
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,9 @@ struct AnalysisFolderRequest {
   bool force = false;             ///< overwrite files in an existing non-empty folder
   bool write_grid = false;        ///< stream every frame's grid occupancy into analysis.h5
   std::string command_line;       ///< for the provenance
+  /// A run's result computed elsewhere (the in-situ analysis of a run that stored no frames:
+  /// study/insitu's storedResult), or none: then its trajectory is analysed.
+  std::function<std::optional<RunResult>(const std::string&)> stored_result;
 };
 
 struct AnalysisFolder {

@@ -1,13 +1,18 @@
 #include "analysis/stats/StructureFactor.h"
 
 #include <fftw3.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/Csv.h"
 
@@ -35,6 +40,7 @@ struct StructureFactorMesh::Buffers {
   // velocityStructure: k^.u(k) accumulated over the three components, in single precision (the
   // mesh's memory at M = 512 is 1.1 GB per double buffer; a statistic needs no more digits)
   std::vector<std::complex<float>> longitudinal;
+  int threads = 0;  // FFTW threads the plan was made with
   double* rho() { return data.get(); }
   fftw_complex* rk() { return reinterpret_cast<fftw_complex*>(data.get()); }
 };
@@ -42,18 +48,42 @@ struct StructureFactorMesh::Buffers {
 StructureFactorMesh::StructureFactorMesh() : m_buffers(std::make_unique<Buffers>()) {}
 StructureFactorMesh::~StructureFactorMesh() = default;
 
+namespace {
+/// FFTW's planner and fftw_init_threads are not thread-safe (md/fft/Fft3dFftw.cpp plans under its
+/// own lock in the same process: the planner's global state is shared, so this lock is held while
+/// planning and the thread count is set right before).
+std::mutex planner_lock;
+
+int fftwThreads() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+}  // namespace
+
 StructureFactorMesh::Buffers& StructureFactorMesh::forSize(long M) {
   Buffers& b = *m_buffers;
-  if (b.M == M && b.plan) return b;
+  const int threads = fftwThreads();
+  if (b.M == M && b.plan && b.threads == threads) return b;
   b.plan.reset();
   std::vector<std::complex<float>>().swap(b.longitudinal);
-  b.data.reset(fftw_alloc_real(static_cast<std::size_t>(M) * M * 2 * (M / 2 + 1)));
-  if (!b.data) throw std::runtime_error("structure factor: no memory for the mesh");
-  // (FFTW_ESTIMATE does not touch the arrays)
-  b.plan.reset(fftw_plan_dft_r2c_3d(static_cast<int>(M), static_cast<int>(M), static_cast<int>(M),
-                                    b.rho(), b.rk(), FFTW_ESTIMATE));
+  if (b.M != M) {
+    b.data.reset(fftw_alloc_real(static_cast<std::size_t>(M) * M * 2 * (M / 2 + 1)));
+    if (!b.data) throw std::runtime_error("structure factor: no memory for the mesh");
+  }
+  {
+    std::lock_guard<std::mutex> lock(planner_lock);
+    static const bool threads_ok = fftw_init_threads() != 0;
+    if (threads_ok) fftw_plan_with_nthreads(threads);
+    // (FFTW_ESTIMATE does not touch the arrays)
+    b.plan.reset(fftw_plan_dft_r2c_3d(static_cast<int>(M), static_cast<int>(M),
+                                      static_cast<int>(M), b.rho(), b.rk(), FFTW_ESTIMATE));
+  }
   if (!b.plan) throw std::runtime_error("structure factor: FFTW could not plan the mesh");
   b.M = M;
+  b.threads = threads;
   return b;
 }
 
@@ -99,34 +129,76 @@ void assign(const Frame& f, long M, double h, const double* weights, std::size_t
   }
 }
 
-/// Calls visit(index, m, nx, ny, nz, window) for one of each pair +-k of the mesh's wave vectors
-/// in the complete shells m = 1 .. shells below the Nyquist wavenumber pi / h (every |n_a| <
-/// M / 2); `index` addresses the transform, `window` is the CIC window's aliased sum for
-/// uncorrelated positions (Jing 2005, eq. 20).
+/// The wave vectors of the complete shells m = 1 .. shells below the Nyquist wavenumber pi / h
+/// (every |n_a| < M / 2), one of each pair +-k (the transform at -k is the conjugate of that at
+/// k), with the CIC window's aliased sum for uncorrelated positions (Jing 2005, eq. 20) from
+/// per-axis tables and the shell from a table of |n|^2.
+struct Modes {
+  long M, Mz, shells;
+  std::vector<double> alias;  // per index i: the window factor of component n(i)
+  std::vector<long> shell;    // per |n|^2: round(|n|), or 0 when out of the shells
+  Modes(long M_, double h, double dk, long shells_) : M(M_), Mz(M_ / 2 + 1), shells(shells_) {
+    alias.resize(static_cast<std::size_t>(M));
+    for (long i = 0; i < M; ++i) {
+      const double s = std::sin(0.5 * dk * static_cast<double>(component(i)) * h);
+      alias[static_cast<std::size_t>(i)] = 1.0 - (2.0 / 3.0) * s * s;
+    }
+    const long half = M / 2;
+    shell.assign(static_cast<std::size_t>(3 * half * half + 1), 0);
+    for (std::size_t n2 = 0; n2 < shell.size(); ++n2) {
+      const long m = std::lround(std::sqrt(static_cast<double>(n2)));
+      shell[n2] = m <= shells ? m : 0;
+    }
+  }
+  long component(long i) const { return i <= M / 2 ? i : i - M; }
+};
+
+/// Fixed blocks of the outermost mesh index: the per-shell sums are made per block and added in
+/// block order, so that the result does not depend on the number of threads.
+constexpr long MODE_BLOCKS = 64;
+
+/// Calls visit(block, index, m, nx, ny, nz, window) for every mode of `modes` (threads over the
+/// blocks); `index` addresses the transform.
 template <class Visit>
-void forEachMode(long M, double h, double dk, long shells, Visit&& visit) {
-  const long Mz = M / 2 + 1;
-  auto component = [M](long i) { return i <= M / 2 ? i : i - M; };
-  auto alias = [h](double k) {
-    const double s = std::sin(0.5 * k * h);
-    return 1.0 - (2.0 / 3.0) * s * s;
-  };
-  for (long ix = 0; ix < M; ++ix) {
-    const long nx = component(ix);
-    for (long iy = 0; iy < M; ++iy) {
-      const long ny = component(iy);
-      for (long nz = 0; nz < Mz; ++nz) {
-        // one of each pair +-k: the transform at -k is the conjugate of that at k
-        if (nz == 0 && !(nx > 0 || (nx == 0 && ny > 0))) continue;
-        const double n2 = static_cast<double>(nx * nx + ny * ny + nz * nz);
-        const long m = std::lround(std::sqrt(n2));
-        if (m < 1 || m > shells) continue;
-        const double window = alias(dk * nx) * alias(dk * ny) * alias(dk * nz);
-        visit((static_cast<std::size_t>(ix) * M + iy) * Mz + nz, m, nx, ny, nz, window);
+void forEachMode(const Modes& modes, Visit&& visit) {
+  const long M = modes.M, Mz = modes.Mz;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long block = 0; block < MODE_BLOCKS; ++block) {
+    const long begin = block * M / MODE_BLOCKS, end = (block + 1) * M / MODE_BLOCKS;
+    for (long ix = begin; ix < end; ++ix) {
+      const long nx = modes.component(ix);
+      const double ax = modes.alias[static_cast<std::size_t>(ix)];
+      for (long iy = 0; iy < M; ++iy) {
+        const long ny = modes.component(iy);
+        const double axy = ax * modes.alias[static_cast<std::size_t>(iy)];
+        const std::size_t row = (static_cast<std::size_t>(ix) * M + iy) * Mz;
+        for (long nz = (nx > 0 || (nx == 0 && ny > 0)) ? 0 : 1; nz < Mz; ++nz) {
+          const long m = modes.shell[static_cast<std::size_t>(nx * nx + ny * ny + nz * nz)];
+          if (m < 1) continue;
+          visit(block, row + static_cast<std::size_t>(nz), m, nx, ny, nz,
+                axy * modes.alias[static_cast<std::size_t>(nz)]);
+        }
       }
     }
   }
 }
+
+/// Per-block shell sums, added in block order.
+struct ShellSums {
+  std::size_t shells;
+  std::vector<double> v;  // [block][shell]
+  explicit ShellSums(long shells_)
+      : shells(static_cast<std::size_t>(shells_) + 1), v(MODE_BLOCKS * shells, 0.0) {}
+  double& at(long block, long m) {
+    return v[static_cast<std::size_t>(block) * shells + static_cast<std::size_t>(m)];
+  }
+  std::vector<double> total() const {
+    std::vector<double> t(shells, 0.0);
+    for (long b = 0; b < MODE_BLOCKS; ++b)
+      for (std::size_t m = 0; m < shells; ++m) t[m] += v[static_cast<std::size_t>(b) * shells + m];
+    return t;
+  }
+};
 
 /// The first moment k_1 = sum k_m S_m / sum S_m over the shells up to k_cut.
 double firstMoment(const std::vector<double>& k, const std::vector<double>& S, double k_cut) {
@@ -157,13 +229,16 @@ StructureFactor structureFactor(const Frame& f, const StructureFactorOptions& o,
   const fftw_complex* rk = buffers.rk();
 
   const long shells = static_cast<long>(std::floor(static_cast<double>(M) / 2.0 - 0.5));
-  std::vector<double> sum(static_cast<std::size_t>(shells) + 1, 0.0);
-  std::vector<std::size_t> count(sum.size(), 0);
-  forEachMode(M, h, dk, shells, [&](std::size_t i, long m, long, long, long, double window) {
+  const Modes modes(M, h, dk, shells);
+  ShellSums sums(shells), counts(shells);
+  forEachMode(modes, [&](long b, std::size_t i, long m, long, long, long, double window) {
     const double power = rk[i][0] * rk[i][0] + rk[i][1] * rk[i][1];
-    sum[static_cast<std::size_t>(m)] += power / (static_cast<double>(N) * window);
-    ++count[static_cast<std::size_t>(m)];
+    sums.at(b, m) += power / (static_cast<double>(N) * window);
+    counts.at(b, m) += 1.0;
   });
+  const std::vector<double> sum = sums.total(), count_real = counts.total();
+  std::vector<std::size_t> count(count_real.size());
+  for (std::size_t m = 0; m < count.size(); ++m) count[m] = static_cast<std::size_t>(count_real[m]);
 
   StructureFactor r;
   r.mesh = static_cast<std::size_t>(M);
@@ -202,19 +277,19 @@ VelocityStructure velocityStructure(const Frame& f, const StructureFactorOptions
   r.T_g = c2 / (3.0 * static_cast<double>(N));
   StructureFactorMesh::Buffers& buffers = mesh.forSize(M);
   const long shells = static_cast<long>(std::floor(static_cast<double>(M) / 2.0 - 0.5));
-  std::vector<double> total(static_cast<std::size_t>(shells) + 1, 0.0), along(total);
-  std::vector<std::size_t> count(total.size(), 0);
+  const Modes modes(M, h, dk, shells);
+  ShellSums total_sums(shells), along_sums(shells), counts(shells);
   buffers.longitudinal.assign(static_cast<std::size_t>(M) * M * (M / 2 + 1), {0.0f, 0.0f});
   std::complex<float>* D = buffers.longitudinal.data();
   for (int a = 0; a < 3; ++a) {
     assign(f, M, h, c.data() + a, 3, buffers.rho());
     fftw_execute(buffers.plan.get());
     const fftw_complex* uk = buffers.rk();
-    forEachMode(M, h, dk, shells, [&](std::size_t i, long m, long nx, long ny, long nz,
-                                      double window) {
+    forEachMode(modes, [&](long b, std::size_t i, long m, long nx, long ny, long nz,
+                           double window) {
       const double power = uk[i][0] * uk[i][0] + uk[i][1] * uk[i][1];
-      total[static_cast<std::size_t>(m)] += power / window;
-      if (a == 0) ++count[static_cast<std::size_t>(m)];
+      total_sums.at(b, m) += power / window;
+      if (a == 0) counts.at(b, m) += 1.0;
       const double n[3] = {static_cast<double>(nx), static_cast<double>(ny),
                            static_cast<double>(nz)};
       const double khat = n[a] / std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
@@ -222,10 +297,14 @@ VelocityStructure velocityStructure(const Frame& f, const StructureFactorOptions
                                   static_cast<float>(khat * uk[i][1]));
     });
   }
-  forEachMode(M, h, dk, shells, [&](std::size_t i, long m, long, long, long, double window) {
-    along[static_cast<std::size_t>(m)] += static_cast<double>(std::norm(D[i])) / window;
+  forEachMode(modes, [&](long b, std::size_t i, long m, long, long, long, double window) {
+    along_sums.at(b, m) += static_cast<double>(std::norm(D[i])) / window;
   });
   std::vector<std::complex<float>>().swap(buffers.longitudinal);  // 0.5 GB at M = 512
+  const std::vector<double> total = total_sums.total(), along = along_sums.total(),
+                            count_real = counts.total();
+  std::vector<std::size_t> count(count_real.size());
+  for (std::size_t m = 0; m < count.size(); ++m) count[m] = static_cast<std::size_t>(count_real[m]);
 
   r.mesh = static_cast<std::size_t>(M);
   r.k_cut = std::min(o.k_cut, dk * static_cast<double>(shells));

@@ -21,6 +21,7 @@
 #include "common/Csv.h"
 #include "md/config/ConfigParser.h"
 #include "md/engine/RunEngine.h"
+#include "md/io/Checkpoint.h"
 #include "md/run/OutputReporters.h"
 
 namespace granagg::insitu {
@@ -357,6 +358,34 @@ fs::path InSituAnalysis::writeResults(const md::Simulation& sim) {
   an::writeRunAnalysis(out.string(), std::move(result), m_options, m_command_line);
   fs::remove_all(old, ec);
   return out;
+}
+
+std::optional<an::RunResult> storedResult(const std::string& path) {
+  const fs::path run(path);
+  const fs::path cpath = run / "checkpoint.h5";
+  if (!fs::is_directory(run) || !fs::exists(cpath) ||
+      !(fs::exists(InSituAnalysis::stateFile(run)) ||
+        fs::exists(InSituAnalysis::previousStateFile(run))))
+    return std::nullopt;
+  const md::Checkpoint cp = md::readCheckpoint(cpath.string());
+  if (cp.run.frames_written > 0) return std::nullopt;  // frames to read: analyze does that
+  const md::MdConfig cfg = md::parseConfigString(cp.run.config_toml, cpath.string());
+  if (!cfg.output.analyze) return std::nullopt;
+  const an::AnalysisOptions options = analysisOptions(cfg);
+  std::map<std::string, std::string> parameters;
+  const auto reader = an::openTrajectory(run.string());
+  for (const auto& [k, v] : reader->parameters()) parameters[k] = v;
+  an::RunAnalysis analysis(options, path, "in-situ", parameters);
+  for (const fs::path& file : {InSituAnalysis::stateFile(run),
+                               InSituAnalysis::previousStateFile(run)}) {
+    if (!fs::exists(file) || an::RunAnalysis::stateTag(file.string()) != cp.state.step) continue;
+    analysis.restoreState(file.string());
+    return analysis.finish();
+  }
+  throw std::invalid_argument("run '" + path + "' stored no frames and its in-situ analysis "
+                              "state does not match its checkpoint (step " +
+                              std::to_string(cp.state.step) +
+                              "): continue it with granagg md --restart " + path);
 }
 
 }  // namespace granagg::insitu

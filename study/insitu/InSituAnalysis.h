@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "analysis/io/Frame.h"
@@ -39,6 +40,13 @@ analysis::AnalysisOptions analysisOptions(const md::MdConfig& config);
 /// it back (md/io/H5mdWriter.cpp, common/H5mdReader.cpp): positions wrapped into [0, L) with the
 /// crossings in the image counts, velocities, charges (zeros for a neutral gas), ids 0..N-1.
 analysis::Frame trajectoryFrame(const md::Frame& frame, std::size_t index);
+
+/// The result of a finished run that was analysed during the run and stored no frames
+/// (output.trajectory = false): its analysis state at the last checkpoint, finished, for
+/// `granagg analyze` and ensembles. Nothing (std::nullopt) for any other path: a trajectory, a
+/// folder with frames, a run without output.analyze. Throws std::invalid_argument for such a run
+/// whose state does not match its checkpoint.
+std::optional<analysis::RunResult> storedResult(const std::string& run);
 
 /// The reporter. Construct it after Simulation::start or resume and before run(); add it with
 /// Simulation::addReporter. A new run analyses its frame at t = 0 at once.

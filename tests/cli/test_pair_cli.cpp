@@ -105,6 +105,9 @@ TEST_CASE("pair on the tiny preset makes every output and resumes without redoin
       const fs::path rd = out / "runs" / k / ("run" + std::to_string(run));
       CHECK(fs::exists(rd / "traj.h5"));
       CHECK(fs::exists(rd / "done.json"));
+      // analysed while it ran: its tables, and no particle frame stored (--keep-trajectories)
+      CHECK(fs::exists(rd / "analysis" / "S_t.csv"));
+      CHECK(fs::file_size(rd / "traj.h5") < 2u * 1024u * 1024u);
     }
     for (const char* t : {"S_t", "N_s_grid", "N_s_particle", "fisher", "thermo", "msd",
                           "speed_dist", "nstick", "fits"})
