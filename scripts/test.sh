@@ -71,6 +71,20 @@ else
   echo "gpu_check dry run OK: $BUILD_DIR/gpu_check_dry/summary.md"
 fi
 
+# The GPU campaign's dry run (issue 45): the same two legs at test size on the CPU build
+echo "== scripts/gpu_campaign.sh --dry-run"
+TOTAL=$((TOTAL + 1))
+rm -rf "$BUILD_DIR/gpu_campaign_dry"
+if OUT="$BUILD_DIR/gpu_campaign_dry" BUDGET=120 GRANAGG_BIN="$BUILD_DIR/bin/granagg" \
+    bash scripts/gpu_campaign.sh --dry-run > "$BUILD_DIR/gpu_campaign_dry.log" 2>&1 &&
+    [ -f "$BUILD_DIR/gpu_campaign_dry/neutral-L280/analysis/S_t.csv" ]; then
+  echo "gpu_campaign dry run OK: $BUILD_DIR/gpu_campaign_dry/legs.csv"
+else
+  cat "$BUILD_DIR/gpu_campaign_dry.log"
+  echo "scripts/gpu_campaign.sh --dry-run failed"
+  FAILED=$((FAILED + 1)); CTEST_RC=1
+fi
+
 T_DRY=$((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA))
 echo "time: set-up and build ${T_BUILD} s, tests ${T_CTEST} s, CUDA build ${T_CUDA} s," \
   "GPU dry run ${T_DRY} s"

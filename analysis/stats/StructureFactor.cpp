@@ -137,6 +137,7 @@ struct Modes {
   long M, Mz, shells;
   std::vector<double> alias;  // per index i: the window factor of component n(i)
   std::vector<long> shell;    // per |n|^2: round(|n|), or 0 when out of the shells
+  std::vector<double> inv_norm;  // per |n|^2: 1 / |n| (0 for n = 0)
   Modes(long M_, double h, double dk, long shells_) : M(M_), Mz(M_ / 2 + 1), shells(shells_) {
     alias.resize(static_cast<std::size_t>(M));
     for (long i = 0; i < M; ++i) {
@@ -145,9 +146,12 @@ struct Modes {
     }
     const long half = M / 2;
     shell.assign(static_cast<std::size_t>(3 * half * half + 1), 0);
+    inv_norm.assign(shell.size(), 0.0);
     for (std::size_t n2 = 0; n2 < shell.size(); ++n2) {
-      const long m = std::lround(std::sqrt(static_cast<double>(n2)));
+      const double norm = std::sqrt(static_cast<double>(n2));
+      const long m = std::lround(norm);
       shell[n2] = m <= shells ? m : 0;
+      if (n2 > 0) inv_norm[n2] = 1.0 / norm;
     }
   }
   long component(long i) const { return i <= M / 2 ? i : i - M; }
@@ -290,9 +294,10 @@ VelocityStructure velocityStructure(const Frame& f, const StructureFactorOptions
       const double power = uk[i][0] * uk[i][0] + uk[i][1] * uk[i][1];
       total_sums.at(b, m) += power / window;
       if (a == 0) counts.at(b, m) += 1.0;
-      const double n[3] = {static_cast<double>(nx), static_cast<double>(ny),
-                           static_cast<double>(nz)};
-      const double khat = n[a] / std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      const long na = a == 0 ? nx : a == 1 ? ny : nz;
+      const double khat =
+          static_cast<double>(na) *
+          modes.inv_norm[static_cast<std::size_t>(nx * nx + ny * ny + nz * nz)];
       D[i] += std::complex<float>(static_cast<float>(khat * uk[i][0]),
                                   static_cast<float>(khat * uk[i][1]));
     });
