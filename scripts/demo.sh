@@ -8,7 +8,8 @@
 # time is in docs/validation.md, "The demo"). Both ensembles aggregate; the summary leads with the
 # verdict (what the demo showed, what the validation study concluded), then per ensemble the
 # growth, onset and regime, the local slope, and one z or why there is none. It ends with the
-# size of the results (about 0.6 GB, nearly all trajectories) and the command that deletes them.
+# size of the results (83 MiB: the runs are analysed during the run and store no particle frames)
+# and the command that deletes them.
 #   usage: bash scripts/demo.sh [OUTDIR]     (default: results/demo-<date>-<time>; never reused)
 #   GRANAGG_BUILD_DIR   build folder (default: build)
 set -euo pipefail
@@ -29,5 +30,5 @@ START=$(date +%s)
 
 echo "== done in $(( $(date +%s) - START )) s. The verdict: $OUT/summary.txt (printed above)"
 echo "   and $OUT/report.html (figures in $OUT/figures/, every number in $OUT/summary.json)."
-echo "== The results take $(du -sh "$OUT" | cut -f1) on disk (nearly all trajectories, $OUT/runs/)."
+echo "== The results take $(du -sh "$OUT" | cut -f1) on disk (checkpoints and in-situ tables in $OUT/runs/)."
 echo "   Delete them with: rm -r $(printf '%q' "$OUT")"

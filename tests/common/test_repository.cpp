@@ -167,3 +167,26 @@ TEST_CASE("every docs/model.md section cited exists", "[common][repository]") {
   CHECK(bad.empty());
   CHECK(citations > 50);  // the code and docs do cite it (about 150 references)
 }
+
+TEST_CASE("md, analysis and meanfield never include each other, nor study or cli",
+          "[common][repository]") {
+  // the one rule of the layout (docs/ARCHITECTURE.md): what passes between them is files, and
+  // where md and analysis meet in one process (study/insitu) it is above both
+  const std::vector<std::string> modules = {"md", "analysis", "meanfield"};
+  const std::regex include("#include\\s+\"([a-z_]+)/");
+  std::vector<std::string> bad;
+  for (const std::string& m : modules)
+    for (auto it = fs::recursive_directory_iterator(ROOT / m);
+         it != fs::recursive_directory_iterator(); ++it) {
+      if (!it->is_regular_file()) continue;
+      const std::string text = readAll(it->path());
+      for (auto i = std::sregex_iterator(text.begin(), text.end(), include);
+           i != std::sregex_iterator(); ++i) {
+        const std::string target = (*i)[1].str();
+        if (target != m && target != "common")
+          bad.push_back(fs::relative(it->path(), ROOT).string() + " includes " + target + "/");
+      }
+    }
+  for (const auto& b : bad) UNSCOPED_INFO(b);
+  CHECK(bad.empty());
+}
