@@ -55,7 +55,7 @@ struct StructureFactor {
 };
 
 /// The FFTW mesh of structureFactor (one in-place transform buffer, ~8 M^3 bytes, and the plan;
-/// velocityStructure adds ~4 M^3 bytes while it runs),
+/// velocityStructure adds ~4 M^3 bytes, kept between frames),
 /// kept between calls of the same mesh size M, so that a trajectory's frames share one pair of
 /// buffers. Allocated afresh per frame, they grow glibc's heap by about their size at every frame
 /// (its mmap threshold rises to the freed size, and smaller allocations in between take the freed
