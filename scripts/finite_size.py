@@ -4,8 +4,10 @@ docs/validation.md, "The box of L = 280").
 
 Inputs: the validation study's ensemble tables of L = 70 (20 runs) and L = 140 (2 runs)
 (docs/validation/dominance_neutral_20runs.csv, dominance_box_L140.csv: l_density_mean, _se) and
-one or more analysis folders of L = 280 runs (`granagg analyze RUN` or RUN/analysis of
-`granagg md --analyze`: per_run/S_t.csv with l_density and l_perp).
+one or more L = 280 runs: an analysis folder (`granagg analyze RUN` or RUN/analysis of
+`granagg md --analyze`: per_run/S_t.csv with l_density and l_perp), or, for a run still going,
+its in-situ state RUN/analysis-state.h5 (the S_t rows up to its last checkpoint; the local slope
+is then computed here with the same rule).
 
 Output: OUT.csv (t, l and its standard error per box, the local slope d ln l / d ln t of each as
 ln[l(t)/l(t/p)] / ln p with p = 2, and whether L = 140 and L = 280 agree within their combined
@@ -35,6 +37,17 @@ def read_table(path):
     return {k: np.array(v) for k, v in cols.items()}
 
 
+def read_state(path):
+    """The S_t rows of an in-situ analysis state (analysis/pipeline/RunAnalysis.cpp's layout)."""
+    import h5py
+    with h5py.File(path, "r") as f:
+        rows, cols = (int(x) for x in f["integers/table.S_t.shape"][:])
+        names = f["texts/table.S_t.columns"][()]
+        names = (names.decode() if isinstance(names, bytes) else names).split("\n")
+        flat = f["reals/table.S_t"][:].reshape(rows, cols)
+    return {n: flat[:, k] for k, n in enumerate(names)}
+
+
 def local_slope(t, y, p=2.0):
     """ln[y(t)/y(t/p)] / ln p with y(t/p) interpolated in (ln t, ln y); NaN before t0 p."""
     out = np.full_like(y, np.nan)
@@ -50,7 +63,8 @@ def local_slope(t, y, p=2.0):
 def l280(folders):
     """Mean and standard error of l_density (and l_perp) over the L = 280 runs, on the first
     run's frame times (the runs share the frame schedule)."""
-    runs = [read_table(os.path.join(f, "per_run", "S_t.csv")) for f in folders]
+    runs = [read_state(f) if f.endswith(".h5") else
+            read_table(os.path.join(f, "per_run", "S_t.csv")) for f in folders]
     t = runs[0]["t"]
     n = min(len(r["t"]) for r in runs)
     t = t[:n]
