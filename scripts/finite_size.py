@@ -80,6 +80,9 @@ def main():
     ap.add_argument("--l70", default="docs/validation/dominance_neutral_20runs.csv")
     ap.add_argument("--l140", default="docs/validation/dominance_box_L140.csv")
     ap.add_argument("--l280", nargs="+", required=True)
+    ap.add_argument("--traj", nargs="*", default=[],
+                    help="traj.h5 of the first L = 280 run: tau, the mean number of collisions "
+                         "per particle (2 collisions / N), for the slope against tau")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     boxes = {}
@@ -101,6 +104,18 @@ def main():
         si = np.where(inside, np.interp(np.log(t), np.log(tt[ok]), ss[ok]), np.nan)
         return li, si
 
+    # tau(t) = 2 C(t) / N from the observables of the first run (Brito & Ernst state their
+    # late-time law in tau); the slope of l against tau by the same rule
+    tau = np.full_like(t3, np.nan)
+    if a.traj:
+        import h5py
+        with h5py.File(a.traj[0], "r") as f:
+            g = f["granagg/observables/collisions"]
+            tc, c = g["time"][:], g["value"][:]
+            n = f["particles/all/position/value"].shape[1]
+        tau = np.interp(t3, tc, 2.0 * c / n, left=np.nan, right=np.nan)
+    z_tau = local_slope(tau, l3) if a.traj else np.full_like(t3, np.nan)
+    z_perp = local_slope(t3, lp3)
     rows = []
     z = {name: local_slope(*boxes[name][:2]) for name in boxes}
     l70, s70 = at("70", t3)
@@ -114,14 +129,15 @@ def main():
         if ok:
             agree.append(t)
         rows.append([t, l70[i], s70[i], l140[i], s140[i], l3[i], se3[i], lp3[i], z70[i], z140[i],
-                     z["280"][i], int(ok) if np.isfinite(l140[i]) else -1])
+                     z["280"][i], z_perp[i], tau[i], z_tau[i], int(ok) if np.isfinite(l140[i]) else -1])
     with open(a.out + ".csv", "w") as f:
         f.write("# l(t) of the neutral gas at L = 70 (20 runs), 140 (2 runs), 280 (%d run(s)); "
                 "z_*: local slope ln[l(t)/l(t/2)]/ln 2; agree_140_280: |l_140 - l_280| <= 2 "
-                "sigma of the difference (1), not (0), no L = 140 row (-1); "
+                "sigma of the difference (1), not (0), no L = 140 row (-1); z_perp_280: local slope of l_perp; tau_280: collisions per "
+                "particle; z_tau_280: d ln l / d ln tau; "
                 "scripts/finite_size.py\n" % runs)
         f.write("t,l_70,l_70_se,l_140,l_140_se,l_280,l_280_se,l_perp_280,z_70,z_140,z_280,"
-                "agree_140_280\n")
+                "z_perp_280,tau_280,z_tau_280,agree_140_280\n")
         for r in rows:
             f.write(",".join("%.6g" % x for x in r) + "\n")
     print("L = 280: %d run(s), frames to t = %.4g" % (runs, t3.max()))
