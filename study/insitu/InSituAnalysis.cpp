@@ -167,6 +167,13 @@ an::AnalysisOptions analysisOptions(const md::MdConfig& c) {
                             "analysis." + key);
     assign(c, key, it->second, text, s);
   }
+  // all time origins need evenly spaced frames: only output.frame_interval alone gives them
+  if (s.msd_origins == "all" &&
+      (c.output.frames_per_decade > 0 || !(c.output.frame_interval > 0.0)))
+    refuse(c, "msd_origins",
+           "= \"all\" needs evenly spaced frames: output.frame_interval > 0 and "
+           "output.frames_per_decade = 0 (this run has " +
+               std::to_string(c.output.frames_per_decade) + " per decade); use \"auto\" or \"t0\"");
   try {
     return an::analysisOptions(s, /*write_grid=*/false);
   } catch (const std::invalid_argument& e) {

@@ -142,6 +142,7 @@ TEST_CASE("bad [analysis] input is refused before the first step, with exit 2 na
       {"analysis.tolerance=abc", "analysis.tolerance must be a number"},
       {"analysis.fit_window=[1.0]", "analysis.fit_window must be two times"},
       {"analysis.msd_origins=some", "analysis.msd_origins must be auto, t0 or all"},
+      {"analysis.msd_origins=all", "analysis.msd_origins = \"all\" needs evenly spaced frames"},
   };
   for (const auto& c : cases) {
     INFO(c.set);
