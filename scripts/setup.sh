@@ -14,7 +14,8 @@ PACKAGES=(build-essential cmake pkg-config git
           librandom123-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libthrust-dev
           libomp-dev
           liblammps-dev libfmt-dev libopenmpi-dev openmpi-bin lammps
-          python3-matplotlib python3-numpy python3-h5py python3-mdanalysis)
+          python3-matplotlib python3-numpy python3-h5py python3-mdanalysis
+          python3-dev pybind11-dev python3-pybind11 python3-pytest python3-scipy python3-pandas)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -36,8 +37,9 @@ JOBS=${GRANAGG_JOBS:-$(nproc)}
 # that failed (say, before the packages above were installed) holds a CMakeCache.txt but no
 # Makefile, and skipping the configure then failed the build with "No rule to make target".
 if [ -f "$BUILD_DIR/CMakeCache.txt" ]; then
-  cmake -S . -B "$BUILD_DIR" >/dev/null
+  cmake -S . -B "$BUILD_DIR" -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
 else
-  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 \
+    >/dev/null
 fi
 cmake --build "$BUILD_DIR" -j "$JOBS"

@@ -57,6 +57,34 @@ else
 fi
 
 T_CUDA=$((SECONDS - T0 - T_BUILD - T_CTEST))
+
+# The Python package's pytest suite (issue 46; docs/python.md), with Debian's interpreter, from
+# a folder outside the source tree, so that `import granagg` can only find the built package.
+# Each pytest test counts as one test in the summary line.
+echo "== Python package: pytest tests/python"
+PY_DIR="$PWD/$BUILD_DIR/python"
+if [ -f "$PY_DIR/granagg/__init__.py" ] && ls "$PY_DIR"/granagg/_granagg*.so >/dev/null 2>&1; then
+  mkdir -p "$BUILD_DIR/pytest"
+  set +e
+  ROOT=$PWD
+  (cd "$BUILD_DIR/pytest" && PYTHONPATH="$PY_DIR" GRANAGG_BIN="$ROOT/$BUILD_DIR/bin/granagg" \
+     MPLBACKEND=Agg /usr/bin/python3 -m pytest -q -p no:cacheprovider \
+     --junitxml=pytest.xml "$ROOT/tests/python") | tee "$BUILD_DIR/pytest.log"
+  PYTEST_RC=${PIPESTATUS[0]}
+  set -e
+  PY_SUMMARY=$(tail -n 1 "$BUILD_DIR/pytest.log")   # "== 40 passed, 1 failed in 12.3s =="
+  PY_PASSED=$(echo "$PY_SUMMARY" | grep -o '[0-9]* passed' | grep -o '[0-9]*' || true)
+  PY_FAILED=$(echo "$PY_SUMMARY" | grep -o '[0-9]* \(failed\|errors\?\)' |
+              awk '{ n += $1 } END { print n + 0 }')
+  PY_PASSED=${PY_PASSED:-0}; PY_FAILED=${PY_FAILED:-0}
+  if [ "$PYTEST_RC" -ne 0 ] && [ "$PY_FAILED" -eq 0 ]; then PY_FAILED=1; fi
+  TOTAL=$((TOTAL + PY_PASSED + PY_FAILED)); FAILED=$((FAILED + PY_FAILED))
+  [ "$PYTEST_RC" -eq 0 ] || CTEST_RC=1
+else
+  echo "scripts/test.sh: the Python package was not built (see the configure output)" >&2
+  TOTAL=$((TOTAL + 1)); FAILED=$((FAILED + 1)); CTEST_RC=1
+fi
+T_PY=$((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA))
 # The GPU check script's dry run (the CPU build in place of the CUDA one), so that it cannot rot
 echo "== scripts/gpu_check.sh --dry-run"
 TOTAL=$((TOTAL + 1))   # counted as one more test in the summary line
@@ -85,8 +113,8 @@ else
   FAILED=$((FAILED + 1)); CTEST_RC=1
 fi
 
-T_DRY=$((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA))
+T_DRY=$((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA - T_PY))
 echo "time: set-up and build ${T_BUILD} s, tests ${T_CTEST} s, CUDA build ${T_CUDA} s," \
-  "GPU dry run ${T_DRY} s"
+  "pytest ${T_PY} s, GPU dry run ${T_DRY} s"
 echo "tests: $((TOTAL - FAILED)) passed, $FAILED failed"
 exit "$CTEST_RC"

@@ -128,6 +128,11 @@ std::int64_t TrajectoryReporter::nextStep(const Simulation&) const {
   return next;
 }
 
+bool TrajectoryReporter::needsObservables(const Simulation&) const {
+  const std::int64_t step = m_engine.step();
+  return step % m_cfg.output.observable_interval == 0 || step == m_last_step;
+}
+
 void TrajectoryReporter::report(const Simulation& sim) {
   if (m_writer) check();
   const std::int64_t step = m_engine.step();

@@ -63,6 +63,8 @@ class TrajectoryReporter : public Reporter {
   void setLastStep(std::int64_t step) { m_last_step = step; }
 
   std::int64_t nextStep(const Simulation& sim) const override;
+  /// At the observable steps (output.observable_interval) and the last step.
+  bool needsObservables(const Simulation& sim) const override;
   /// Checks the file, then writes the observables and the frame that fall on this step.
   void report(const Simulation& sim) override;
 
@@ -114,6 +116,8 @@ class CheckpointReporter : public Reporter {
   void setBeforeSave(std::function<void(std::int64_t)> before) { m_before = std::move(before); }
 
   std::int64_t nextStep(const Simulation& sim) const override;
+  /// Never: a checkpoint holds the state, not the observables.
+  bool needsObservables(const Simulation&) const override { return false; }
   void report(const Simulation& sim) override;
 
   /// Writes a checkpoint now (collective).

@@ -25,6 +25,12 @@ class Reporter {
   virtual std::int64_t nextStep(const Simulation&) const {
     return std::numeric_limits<std::int64_t>::max();
   }
+  /// Whether report() at the engine's present step reads Simulation::lastObservables(). The run
+  /// computes the observables at a chunk's end (a collective call that may evaluate the Coulomb
+  /// energy: about ten steps' worth in a charged gas) only when some reporter says yes, so that a
+  /// reporter which asks for short chunks (a Python callback's signal check) costs no
+  /// observables. Decide from the step alone, so that every rank decides alike.
+  virtual bool needsObservables(const Simulation&) const { return true; }
   /// Called after each chunk of steps, with the engine at the chunk's end.
   virtual void report(const Simulation& sim) = 0;
   /// Called once when run() ends (normally or not), after the final checkpoint.

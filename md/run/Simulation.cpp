@@ -86,7 +86,8 @@ struct Simulation::Impl {
   std::unique_ptr<TrajectoryReporter> trajectory;
   std::unique_ptr<CheckpointReporter> checkpoints;
   std::vector<std::shared_ptr<Reporter>> reporters;
-  Observables observables;  // at the end of the last chunk
+  Observables observables;  // at the end of the last chunk where a reporter needed them
+  std::int64_t observables_step = -1;  // the step of `observables`
 
   bool at_end = false;                     // resumed at run.t_end: nothing to do, no file opened
   std::size_t frames_at_end = 0;           // the trajectory's frames then
@@ -396,7 +397,10 @@ RunSummary Simulation::run() {
         if (const std::int64_t s = r->nextStep(*this); s > engine.step())
           target = std::min(target, s);
       engine.run(target - engine.step());
-      d.observables = engine.observables();
+      bool needed = false;
+      for (const Reporter* r : all) needed = r->needsObservables(*this) || needed;
+      if (needed) d.observables = engine.observables();
+      d.observables_step = needed ? engine.step() : d.observables_step;
       for (Reporter* r : all) r->report(*this);
     }
   } catch (const RunAborted& e) {
@@ -415,7 +419,8 @@ RunSummary Simulation::run() {
   s.neighbor_builds = engine.neighborBuilds() - first_builds;
   s.slow_evaluations = engine.slowEvaluations() - first_slow;
   s.stopped = !d.atEnd();
-  s.observables = s.steps > 0 ? d.observables : engine.observables();
+  s.observables = s.steps > 0 && d.observables_step == engine.step() ? d.observables
+                                                                      : engine.observables();
   d.trajectory->check();
   d.checkpoints->save();
   d.trajectory->close();

@@ -146,8 +146,10 @@ class Simulation {
   /// (output.trajectory) or not; -1 before the first. A reporter sees a frame time when this
   /// equals engine().step().
   std::int64_t frameStep() const;
-  /// The observables at the end of the last chunk of run() (what reporters should read: the
-  /// engine's observables() may evaluate the Coulomb energy afresh); zeros before the first.
+  /// The observables at the end of the last chunk of run() where some reporter needed them
+  /// (Reporter::needsObservables; what reporters should read: the engine's observables() may
+  /// evaluate the Coulomb energy afresh); zeros before the first. A reporter that said yes for
+  /// the present step reads this step's.
   const Observables& lastObservables() const;
 
   /// Steps at which frames are written for `config` and `dt` up to `last`: t = 0, log-spaced

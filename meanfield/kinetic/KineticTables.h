@@ -47,8 +47,25 @@ struct ChargingRequest {
   double kappa = 0.83, cooling_exponent = 5.0 / 3.0;
 };
 
-/// Writes a table. Warnings (an impact too fast for the Hertz law) go to stderr and into the
-/// table as comments.
+/// One table of `granagg kinetic` in memory: what writeTable writes, without the command line.
+struct KineticTable {
+  common::Provenance provenance;  ///< the parameters (no command line)
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;  ///< one entry per row, columns.size() values each
+  std::vector<std::string> comments;      ///< warnings the CSV carries as comment lines
+};
+
+/// Checks a request (std::invalid_argument as above) and computes its table. Nothing is printed:
+/// a warning (an impact too fast for the Hertz law) is one of the table's comments.
+KineticTable kineticTable(const RestitutionRequest& request);
+KineticTable kineticTable(const HaffRequest& request);
+KineticTable kineticTable(const CoolingRequest& request);
+KineticTable kineticTable(const EnskogRequest& request);
+KineticTable kineticTable(const ChargingRequest& request);
+
+/// Writes kineticTable(request) as one CSV: the request is checked and computed before the target
+/// is (CsvTarget::checkWritable), so bad input is named first. A warning comment precedes the row
+/// it is about and also goes to stderr.
 void writeTable(const RestitutionRequest& request, const CsvTarget& target);
 void writeTable(const HaffRequest& request, const CsvTarget& target);
 void writeTable(const CoolingRequest& request, const CsvTarget& target);

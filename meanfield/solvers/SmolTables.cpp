@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include "common/Strings.h"
 #include "meanfield/growth/GrowthExponent.h"
@@ -87,6 +88,12 @@ std::string zbetaAdvice(const SmolResult& r, const std::string& method) {
   return "";
 }
 
+/// The methods solveSmoluchowski dispatches to; the one sentence that names them.
+void requireSmolMethod(const std::string& method) {
+  requireRange(method == "sectional" || method == "discrete" || method == "mono",
+               "--method must be one of sectional, discrete, mono (got '" + method + "').");
+}
+
 /// "cause; advice", or "" when the solve reached its end.
 std::string stopLine(const SmolResult& r, const std::string& advice) {
   if (r.stopped_early.empty()) return "";
@@ -98,13 +105,14 @@ std::string stopLine(const SmolResult& r, const std::string& advice) {
 /// Runs the chosen method; all three return moments on the same output times.
 SmolResult solveSmoluchowski(const Kernel& kernel, const std::string& method,
                              const std::vector<double>& times, double s_end, int max_size,
-                             double ratio, double rtol, double atol,
-                             const std::string& integrator) {
+                             double ratio, double rtol, double atol, const std::string& integrator,
+                             int snapshot_max_size) {
   if (method == "discrete") {
     DiscreteOptions o;
     o.times = times;
     o.s_end = s_end;
     o.max_size = max_size;
+    o.snapshot_max_size = snapshot_max_size;
     o.rtol = rtol;
     o.atol = atol;
     o.integrator = integrator;
@@ -125,12 +133,21 @@ SmolResult solveSmoluchowski(const Kernel& kernel, const std::string& method,
     o.s_end = s_end;
     return solveMonodisperse(kernel, o);
   }
-  throw std::invalid_argument("--method must be one of sectional, discrete, mono (got '" + method +
-                              "').");
+  requireSmolMethod(method);
+  throw std::logic_error("solveSmoluchowski: method '" + method + "' has no solver");
 }
 
-void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const LogLine& log) {
-  const Kernel kernel = Kernel::fromName(a.kernel, a.beta, a.K0);
+namespace {
+
+/// A request that passed the checks: its kernel and output times, which the solve uses.
+struct CheckedSmol {
+  Kernel kernel;
+  std::vector<double> times;
+};
+
+/// The one check of a SmolRequest (checkSmolRequest, solveSmol, writeSmolTable).
+CheckedSmol checkedSmol(const SmolRequest& a) {
+  Kernel kernel = Kernel::fromName(a.kernel, a.beta, a.K0);
   requireRange(a.method != "discrete" ||
                    (a.max_size >= 2 && a.max_size <= std::numeric_limits<int>::max()),
                "--M must lie in [2, " + std::to_string(std::numeric_limits<int>::max()) +
@@ -142,24 +159,62 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
   if (kernel.gels() && a.t_end >= 1.0 / a.K0)
     throw std::invalid_argument("--t-end must be below the gel time 1/K0 = " +
                                 common::formatReal(1.0 / a.K0) + " for the multiplicative kernel.");
-  const auto times = outputTimes(a.t_min, a.t_end, a.per_decade);
-  target.checkWritable();
+  std::vector<double> times = outputTimes(a.t_min, a.t_end, a.per_decade);
+  requireSmolMethod(a.method);
+  // no option of the command sets it: the message names the field
+  requireRange(a.snapshot_max_size >= 0,
+               "snapshot_max_size must be >= 0 (got " + std::to_string(a.snapshot_max_size) + ").");
+  return CheckedSmol{std::move(kernel), std::move(times)};
+}
 
+/// The solve of a checked request, with the local slope per sample as the table has it.
+SmolSolution solveChecked(const SmolRequest& a, const CheckedSmol& c) {
+  SmolSolution out;
+  out.kernel_name = c.kernel.name();
   const auto wall0 = std::chrono::steady_clock::now();
   // only the discrete method uses M (its range checked above)
   const int M = static_cast<int>(
       std::clamp<long long>(a.max_size, 2, std::numeric_limits<int>::max()));
-  const SmolResult r = solveSmoluchowski(kernel, a.method, times, a.s_end, M, a.ratio, a.rtol,
-                                         a.atol, a.integrator);
-  const double wall =
+  out.result = solveSmoluchowski(c.kernel, a.method, c.times, a.s_end, M, a.ratio, a.rtol, a.atol,
+                                 a.integrator, a.snapshot_max_size);
+  out.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const SmolResult& r = out.result;
 
   std::vector<double> t, S;
   validSeries(r, t, S);
   const LocalSlope ls = t.size() >= 2 ? localSlope(t, S, a.p) : LocalSlope{};
+  out.z_local.reserve(r.samples.size());
+  std::size_t j = 0;
+  for (const auto& s : r.samples) {
+    if (!std::isfinite(s.S))  // an overflow is an error, never a table that ends in NaN rows
+      throw std::runtime_error("S(t) is no longer finite at t = " + common::formatReal(s.t) +
+                               " (the solver's numbers overflowed): lower --t-end");
+    double z = std::nan("");
+    if (s.valid && j < ls.t.size() && ls.t[j] == s.t) z = ls.z[j++];
+    out.z_local.push_back(z);
+  }
+  out.stopped = stopLine(r, smolAdvice(r, a.method));
+  return out;
+}
+
+}  // namespace
+
+void checkSmolRequest(const SmolRequest& request) { checkedSmol(request); }
+
+SmolSolution solveSmol(const SmolRequest& request) {
+  return solveChecked(request, checkedSmol(request));
+}
+
+void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const LogLine& log) {
+  const CheckedSmol checked = checkedSmol(a);
+  target.checkWritable();
+  const SmolSolution solution = solveChecked(a, checked);
+  const Kernel& kernel = checked.kernel;
+  const SmolResult& r = solution.result;
 
   common::Provenance prov(target.command_line);
-  prov.add("kernel", kernel.name());
+  prov.add("kernel", solution.kernel_name);
   if (kernel.type() == KernelType::Beta) prov.add("beta", a.beta);
   prov.add("K0", a.K0);
   prov.add("method", a.method);
@@ -179,16 +234,12 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
   common::CsvWriter w(target.path, prov,
                       {"t", "S", "M0", "M1", "M2", "z_local", "mass_loss", "valid", "max_size"},
                       target.force);
-  std::size_t j = 0;
-  for (const auto& s : r.samples) {
-    if (!std::isfinite(s.S))  // an overflow is an error, never a table that ends in NaN rows
-      throw std::runtime_error("S(t) is no longer finite at t = " + common::formatReal(s.t) +
-                               " (the solver's numbers overflowed): lower --t-end");
-    double z = std::nan("");
-    if (s.valid && j < ls.t.size() && ls.t[j] == s.t) z = ls.z[j++];
-    w.row({s.t, s.S, s.M0, s.M1, s.M2, z, s.mass_loss, s.valid ? 1.0 : 0.0, s.max_size});
+  for (std::size_t i = 0; i < r.samples.size(); ++i) {
+    const MomentSample& s = r.samples[i];
+    w.row({s.t, s.S, s.M0, s.M1, s.M2, solution.z_local[i], s.mass_loss, s.valid ? 1.0 : 0.0,
+           s.max_size});
   }
-  const std::string stopped = stopLine(r, smolAdvice(r, a.method));
+  const std::string& stopped = solution.stopped;
   if (!stopped.empty()) w.comment("stopped early: " + stopped);
   w.close();
 
@@ -196,14 +247,17 @@ void writeSmolTable(const SmolRequest& a, const common::CsvTarget& target, const
   log(common::printfString(
       "smol: kernel %s%s, method %s: %zu samples to t = %.4g, S = %.6g (%.2f s, %ld steps, %ld "
       "RHS)",
-      kernel.name().c_str(),
+      solution.kernel_name.c_str(),
       kernel.type() == KernelType::Beta ? (" beta=" + common::formatReal(a.beta)).c_str() : "",
       a.method.c_str(), r.samples.size(), r.samples.empty() ? 0.0 : r.samples.back().t,
-      r.samples.empty() ? 0.0 : r.samples.back().S, wall, r.stats.steps, r.stats.rhs_evaluations));
+      r.samples.empty() ? 0.0 : r.samples.back().S, solution.wall_seconds, r.stats.steps,
+      r.stats.rhs_evaluations));
   if (!stopped.empty()) log("smol: stopped early: " + stopped);
   if (kernel.homogeneity() < 1.0) {
     log(common::printfString("smol: scaling prediction z = 1/(1 - lambda) = %.6f",
                              kernel.scalingExponent()));
+    std::vector<double> t, S;
+    validSeries(r, t, S);
     try {
       const auto az = asymptoticExponent(t, S, a.p, a.z_tolerance);
       log("smol: asymptotic " + az.describe());

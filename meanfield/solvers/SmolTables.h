@@ -28,6 +28,7 @@ struct SmolRequest {
   double ratio = 1.05, rtol = 1e-8, atol = 1e-14;
   std::string integrator = "adams";
   double p = 2.0, z_tolerance = 1e-3;
+  int snapshot_max_size = 0;  ///< discrete: keep n_k for k <= this at every output time (0: none)
 };
 
 /// z(beta) from the full equation beside 3 beta/(beta + 3).
@@ -41,8 +42,25 @@ struct ZbetaRequest {
 /// Receives the summary lines (the command's log on stderr); may be empty (quiet).
 using LogLine = std::function<void(const std::string&)>;
 
-/// Solves and writes t, S, moments, z_local, mass_loss, valid. Throws std::runtime_error if S
-/// stops being finite (the table is not kept then).
+/// One solution of a SmolRequest in memory: what writeSmolTable writes.
+struct SmolSolution {
+  SmolResult result;            ///< samples (and snapshots with snapshot_max_size > 0, discrete)
+  std::vector<double> z_local;  ///< per sample of result.samples: the local slope, NaN where the
+                                ///  table has NaN (invalid samples, the first ones)
+  std::string stopped;          ///< "cause; advice" when the solve stopped early, else ""
+  std::string kernel_name;
+  double wall_seconds = 0.0;
+};
+
+/// Checks a request (std::invalid_argument naming the option, as writeSmolTable does).
+/// snapshot_max_size must be >= 0; the sectional and mono methods ignore it.
+void checkSmolRequest(const SmolRequest& request);
+/// Checks and solves; throws std::runtime_error when S stops being finite, as writeSmolTable.
+SmolSolution solveSmol(const SmolRequest& request);
+
+/// checkSmolRequest, then the target (CsvTarget::checkWritable), then solveSmol, written as t, S,
+/// moments, z_local, mass_loss, valid, max_size (snapshots are not written). Nothing is written
+/// when solveSmol throws.
 void writeSmolTable(const SmolRequest& request, const common::CsvTarget& target,
                     const LogLine& log);
 /// Solves once per beta and writes the z(beta) table, logging a line per beta.
@@ -50,8 +68,10 @@ void writeZbetaTable(const ZbetaRequest& request, const common::CsvTarget& targe
                      const LogLine& log);
 
 /// Runs the chosen method ("sectional", "discrete", "mono"); all return moments on `times`.
+/// snapshot_max_size > 0 keeps n_k for k <= it at every output time (discrete only).
 SmolResult solveSmoluchowski(const Kernel& kernel, const std::string& method,
                              const std::vector<double>& times, double s_end, int max_size,
-                             double ratio, double rtol, double atol, const std::string& integrator);
+                             double ratio, double rtol, double atol, const std::string& integrator,
+                             int snapshot_max_size = 0);
 
 }  // namespace granagg::meanfield

@@ -59,6 +59,8 @@ class InSituAnalysis : public md::Reporter {
   ~InSituAnalysis() override;
 
   std::int64_t nextStep(const md::Simulation& sim) const override;
+  /// Never: the analysis reads the frame, not the observables.
+  bool needsObservables(const md::Simulation&) const override { return false; }
   void report(const md::Simulation& sim) override;
   void beforeCheckpoint(const md::Simulation& sim, std::int64_t step) override;
 
