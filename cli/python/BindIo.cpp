@@ -109,9 +109,10 @@ void bindIo(py::module_& top) {
 
   py::class_<PyTrajectory>(m, "Trajectory", "An iterator over the frames of a trajectory.")
       .def("__iter__", [](PyTrajectory& t) -> PyTrajectory& { return t; },
-           py::return_value_policy::reference_internal)
-      .def("__next__", &PyTrajectory::next)
-      .def_property_readonly("path", [](const PyTrajectory& t) { return t.reader->path(); })
+           py::return_value_policy::reference_internal, "The iterator itself.")
+      .def("__next__", &PyTrajectory::next, "The next Frame (StopIteration at the end).")
+      .def_property_readonly("path", [](const PyTrajectory& t) { return t.reader->path(); },
+                             "The file being read.")
       .def_property_readonly("format", [](const PyTrajectory& t) { return t.reader->format(); },
                              "'h5md' or 'lammps-dump'.")
       .def_property_readonly(

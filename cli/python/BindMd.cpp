@@ -460,11 +460,15 @@ void bindMd(py::module_& top) {
                       "positions (wrapped into [0, L)), velocities, images (N, 3) and charges "
                       "(N,) are read-only arrays in particle-id order, made when first read.")
       .def_property_readonly("time",
-                             [](const PyState& s) { return s.get("time").engine().time(); })
+                             [](const PyState& s) { return s.get("time").engine().time(); },
+                             "Time, in sqrt(m d^2 / T0).")
       .def_property_readonly("step",
-                             [](const PyState& s) { return s.get("step").engine().step(); })
-      .def_property_readonly("box", [](const PyState& s) { return s.get("box").engine().box(); })
-      .def_property_readonly("N", [](const PyState& s) { return s.get("N").engine().size(); })
+                             [](const PyState& s) { return s.get("step").engine().step(); },
+                             "Integration step.")
+      .def_property_readonly("box", [](const PyState& s) { return s.get("box").engine().box(); },
+                             "Edge L of the cubic periodic box, in d.")
+      .def_property_readonly("N", [](const PyState& s) { return s.get("N").engine().size(); },
+                             "Number of particles.")
       .def_property_readonly(
           "at_frame",
           [](const PyState& s) {
@@ -472,10 +476,12 @@ void bindMd(py::module_& top) {
             return sim.frameStep() == sim.engine().step();
           },
           "True at a frame time of the run's schedule.")
-      .def_property_readonly("positions", &PyState::getPositions)
-      .def_property_readonly("velocities", &PyState::getVelocities)
-      .def_property_readonly("images", &PyState::getImages)
-      .def_property_readonly("charges", &PyState::getCharges);
+      .def_property_readonly("positions", &PyState::getPositions,
+                             "(N, 3) float64, wrapped into [0, L), in d.")
+      .def_property_readonly("velocities", &PyState::getVelocities, "(N, 3) float64.")
+      .def_property_readonly("images", &PyState::getImages,
+                             "(N, 3) int32 image counts: unwrapped = positions + images * box.")
+      .def_property_readonly("charges", &PyState::getCharges, "(N,) float64, in q_ref.");
 
   py::class_<PySimulation>(m, "Simulation",
                            "An MD run (granagg md) driven from Python. config: a TOML file, a "
@@ -508,10 +514,14 @@ void bindMd(py::module_& top) {
       .def_property_readonly("observables", &PySimulation::observables,
                              "The observables recorded by this object's runs "
                              "(every output.observable_interval steps) as a DataFrame.")
-      .def_property_readonly("time", [](PySimulation& s) { return s.sim().engine().time(); })
-      .def_property_readonly("step", [](PySimulation& s) { return s.sim().engine().step(); })
-      .def_property_readonly("box", [](PySimulation& s) { return s.sim().engine().box(); })
-      .def_property_readonly("N", [](PySimulation& s) { return s.sim().engine().size(); })
+      .def_property_readonly(
+          "time", [](PySimulation& s) { return s.sim().engine().time(); }, "The run's time.")
+      .def_property_readonly(
+          "step", [](PySimulation& s) { return s.sim().engine().step(); }, "The run's step.")
+      .def_property_readonly(
+          "box", [](PySimulation& s) { return s.sim().engine().box(); }, "Box edge L, in d.")
+      .def_property_readonly(
+          "N", [](PySimulation& s) { return s.sim().engine().size(); }, "Particles.")
       .def_property_readonly(
           "folder",
           [](const PySimulation& s) -> py::object {

@@ -259,13 +259,14 @@ void bindMeanfield(py::module_& top) {
       .def_readonly("N_s", &SmolCurve::N_s,
                     "Discrete method: n_k at every output time, shape (times, sizes); else None.")
       .def_readonly("sizes", &SmolCurve::sizes, "The sizes k of N_s's columns, or None.")
-      .def_readonly("method", &SmolCurve::method)
-      .def_readonly("kernel", &SmolCurve::kernel)
+      .def_readonly("method", &SmolCurve::method, "'sectional', 'discrete' or 'mono'.")
+      .def_readonly("kernel", &SmolCurve::kernel, "The kernel's name.")
       .def_readonly("stopped", &SmolCurve::stopped,
                     "Why the solve stopped before t_end, with advice; '' when it reached it.")
-      .def_readonly("wall_seconds", &SmolCurve::wall_seconds)
-      .def_readonly("steps", &SmolCurve::steps)
-      .def_readonly("rhs_evaluations", &SmolCurve::rhs_evaluations)
+      .def_readonly("wall_seconds", &SmolCurve::wall_seconds, "Wall time of the solve.")
+      .def_readonly("steps", &SmolCurve::steps, "Integrator steps.")
+      .def_readonly("rhs_evaluations", &SmolCurve::rhs_evaluations,
+                    "Right-hand side evaluations.")
       .def("__repr__", [](const SmolCurve& c) {
         return "<SmolCurve " + c.kernel + ", " + c.method + ", " +
                std::to_string(py::len(c.t)) + " samples>";
