@@ -132,7 +132,8 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
     sim->addReporter(analysis);
   }
   if (!sim->clearedStaleLock().empty() && !a.quiet)
-    std::fprintf(stderr, "md: cleared the stale lock of %s\n", sim->clearedStaleLock().c_str());
+    std::fprintf(stderr, "md: took over the stale lock of %s, which ended without releasing it\n",
+                 sim->clearedStaleLock().c_str());
   if (!a.quiet) {
     log(md::runStartLines(*sim));
     sim->addReporter(std::make_shared<md::ProgressReporter>(*sim));

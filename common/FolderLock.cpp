@@ -137,7 +137,7 @@ bool LockHolder::deadHere() const { return host == thisHost() && !pidRuns(pid); 
 
 FolderLock FolderLock::acquire(const fs::path& folder, const std::string& command_line,
                                bool clear_stale, const std::string& option,
-                               const std::string& clear_hint) {
+                               const std::string& clear_hint, bool take_over_dead) {
   std::error_code ec;
   if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
     throw std::invalid_argument(option + " '" + folder.string() +
@@ -171,7 +171,8 @@ FolderLock FolderLock::acquire(const fs::path& folder, const std::string& comman
       continue;
     }
     if (const std::optional<LockHolder> h = parseHolder(readAll(fd))) {
-      if (!clear_stale) {
+      // (the flock is ours: the process the file names no longer holds it)
+      if (!clear_stale && !(take_over_dead && h->host == thisHost())) {
         ::close(fd);  // the stale file stays as it was found
         throw stale(folder, option, *h, clear_hint);
       }
@@ -202,12 +203,14 @@ std::optional<LockHolder> FolderLock::staleHolder(const fs::path& folder) {
 }
 
 void FolderLock::checkAvailable(const fs::path& folder, bool clear_stale,
-                                const std::string& option, const std::string& clear_hint) {
+                                const std::string& option, const std::string& clear_hint,
+                                bool take_over_dead) {
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) return;
   const LockProbe p = probe(folder);
   if (p.live) throw inUse(folder, option, p.holder);
-  if (p.holder && !clear_stale) throw stale(folder, option, *p.holder, clear_hint);
+  if (p.holder && !clear_stale && !(take_over_dead && p.holder->host == thisHost()))
+    throw stale(folder, option, *p.holder, clear_hint);
 }
 
 void FolderLock::checkTreeAvailable(const fs::path& root, const std::string& option) {

@@ -9,7 +9,13 @@
 /// is for the message that names the holder, and for the one case flock cannot settle alone: a
 /// file left by a process that was killed (SIGKILL, a node lost) names a pid that no longer holds
 /// it. Such a stale lock is reported and cleared only when the user says so (--force): the folder
-/// may hold a run that ended in the middle of a write.
+/// may hold a run that ended in the middle of a write. The exception is a caller that checks the
+/// folder itself before it writes (`granagg md --restart`: the checkpoint it continues is
+/// written atomically, and the trajectory is checked against it): with `take_over_dead` it takes
+/// over a stale lock of this host, whose owner is known to be gone (its flock is free, and the
+/// kernel frees a flock only when its process ends), so that a job resubmitted after a SIGKILL (a
+/// time limit, an out-of-memory kill) continues without a person. A lock of another host may
+/// belong to a process that still runs there, and still needs --force.
 ///
 /// The file is removed when the lock is released. A process that opened the file just before
 /// and locks it just after would then hold a lock on a removed file, so acquire() checks, after
@@ -48,9 +54,10 @@ class FolderLock {
   /// false (naming it and --force). With `clear_stale` a stale lock is taken over;
   /// clearedStale() then describes it for the log.
   /// `clear_hint` replaces "Pass --force to clear the lock" where --force means more.
+  /// `take_over_dead`: also take over, without `clear_stale`, a stale lock of this host (above).
   static FolderLock acquire(const std::filesystem::path& folder, const std::string& command_line,
                             bool clear_stale, const std::string& option = "--out",
-                            const std::string& clear_hint = "");
+                            const std::string& clear_hint = "", bool take_over_dead = false);
 
   /// The live holder of `folder`'s lock, if any (the folder and its lock file are not created).
   static std::optional<LockHolder> liveHolder(const std::filesystem::path& folder);
@@ -62,7 +69,7 @@ class FolderLock {
   /// anything: for the checks a command makes before its expensive set-up.
   static void checkAvailable(const std::filesystem::path& folder, bool clear_stale,
                              const std::string& option = "--out",
-                             const std::string& clear_hint = "");
+                             const std::string& clear_hint = "", bool take_over_dead = false);
 
   /// Throws std::invalid_argument if any folder below `root` (or `root` itself) is held by a
   /// live process: for a command about to delete a tree of outputs (`pair --force`).

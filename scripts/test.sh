@@ -74,7 +74,7 @@ if [ -f "$PY_DIR/granagg/__init__.py" ] && ls "$PY_DIR"/granagg/_granagg*.so >/d
   set -e
   PY_SUMMARY=$(tail -n 1 "$BUILD_DIR/pytest.log")   # "== 40 passed, 1 failed in 12.3s =="
   PY_PASSED=$(echo "$PY_SUMMARY" | grep -o '[0-9]* passed' | grep -o '[0-9]*' || true)
-  PY_FAILED=$(echo "$PY_SUMMARY" | grep -o '[0-9]* \(failed\|errors\?\)' |
+  PY_FAILED=$( { echo "$PY_SUMMARY" | grep -o '[0-9]* \(failed\|errors\?\)' || true; } |
               awk '{ n += $1 } END { print n + 0 }')
   PY_PASSED=${PY_PASSED:-0}; PY_FAILED=${PY_FAILED:-0}
   if [ "$PYTEST_RC" -ne 0 ] && [ "$PY_FAILED" -eq 0 ]; then PY_FAILED=1; fi

@@ -297,8 +297,14 @@ Simulation Simulation::resume(const fs::path& out, const std::vector<std::string
   checkResumeOverrides(overrides);
   const fs::path cpath = out / "checkpoint.h5";  // (Engine::checkpointPath)
   if (!fs::exists(cpath))
-    throw std::invalid_argument("--restart: no checkpoint at " + cpath.string());
-  common::FolderLock::checkAvailable(out, options.overwrite, "--restart");
+    throw std::invalid_argument(
+        "--restart: no checkpoint at " + cpath.string() +
+        (fs::exists(out / "traj.h5")
+             ? ": the run stopped before its first checkpoint, so there is nothing to continue; "
+               "start it again with its command and --force (its configuration is in " +
+                   (out / "traj.h5").string() + ", /parameters/config_toml)"
+             : ""));
+  common::FolderLock::checkAvailable(out, options.overwrite, "--restart", "", true);
   const Checkpoint ck = readCheckpoint(cpath.string());
   return resumeWith(
       out, overrides, options, ck.run, cpath.string() + ":/config_toml",
@@ -335,7 +341,10 @@ Simulation Simulation::resumeWith(const fs::path& out, const std::vector<std::st
   RunEngine& e = *d->engine;
   if (!folder_checked)
     onWritingRank(e,
-                  [&] { common::FolderLock::checkAvailable(out, options.overwrite, "--restart"); });
+                  [&] {
+                    common::FolderLock::checkAvailable(out, options.overwrite, "--restart", "",
+                                                       true);
+                  });
   const bool before_checkpoint =
       d->epochs ? d->cfg.run.t_end < e.time() - d->tolerance() : d->last < e.step();
   if (before_checkpoint)  // (equal: a finished run; run() has nothing to do)
@@ -349,8 +358,9 @@ Simulation Simulation::resumeWith(const fs::path& out, const std::vector<std::st
     return Simulation(std::move(d));
   }
   onWritingRank(e, [&] {
-    d->lock =
-        common::FolderLock::acquire(out, options.command_line, options.overwrite, "--restart");
+    // a stale lock of this host is taken over: its owner is gone (FolderLock.h)
+    d->lock = common::FolderLock::acquire(out, options.command_line, options.overwrite,
+                                          "--restart", "", true);
   });
   e.begin(out);
   d->trajectory->reopen(d->cfg.run.t_end, options.command_line, common::versionString());

@@ -139,7 +139,7 @@ TEST_CASE("a run whose trajectory is truncated behind its back fails and never r
   fs::remove_all(dir);
 }
 
-TEST_CASE("md --restart: a stale lock needs --force, a finished run has nothing to do",
+TEST_CASE("md --restart takes over this host's stale lock, another host's needs --force",
           "[cli][lock]") {
   const fs::path dir = tempDir("lock-stale-cli");
   const std::string run = (dir / "run").string();
@@ -150,19 +150,30 @@ TEST_CASE("md --restart: a stale lock needs --force, a finished run has nothing 
   ::waitpid(dead, nullptr, 0);
   char host[256] = {};
   ::gethostname(host, sizeof host - 1);
-  std::ofstream(dir / "run" / granagg::common::FOLDER_LOCK_FILE)
-      << "pid = " << dead << "\nhost = " << host << "\ncommand = granagg md\nsince = x\n";
-
-  Run r = runGranagg("md --restart " + run + " --set run.t_end=1.5");
+  const auto writeLock = [&](const std::string& on) {
+    std::ofstream(dir / "run" / granagg::common::FOLDER_LOCK_FILE)
+        << "pid = " << dead << "\nhost = " << on << "\ncommand = granagg md\nsince = x\n";
+  };
+  // another host's: its owner may still run there, so --restart refuses without --force
+  writeLock("elsewhere.invalid");
+  Run r = runGranagg("md --restart " + run + " --set run.t_end=1.2");
   INFO(r.output);
   CHECK(r.status == 2);
   CHECK_THAT(r.output, Catch::Contains("stale lock") &&
                            Catch::Contains("pid " + std::to_string(dead)) &&
                            Catch::Contains("Pass --force"));
-  r = runGranagg("md --restart " + run + " --set run.t_end=1.5 --force");
+  r = runGranagg("md --restart " + run + " --set run.t_end=1.2 --force");
   INFO(r.output);
   CHECK(r.status == 0);
-  CHECK_THAT(r.output, Catch::Contains("cleared the stale lock of pid " + std::to_string(dead)));
+  CHECK_THAT(r.output, Catch::Contains("took over the stale lock of pid " + std::to_string(dead)));
+  CHECK_FALSE(fs::exists(dir / "run" / granagg::common::FOLDER_LOCK_FILE));
+  // this host's (a SIGKILL, a time limit): the owner is gone, --restart takes over by itself
+  writeLock(host);
+  r = runGranagg("md --restart " + run + " --set run.t_end=1.5");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK_THAT(r.output, Catch::Contains("took over the stale lock of pid " +
+                                       std::to_string(dead) + " on host " + host));
   CHECK_FALSE(fs::exists(dir / "run" / granagg::common::FOLDER_LOCK_FILE));
 
   // at its run.t_end: nothing to do, nothing written, and the way to go further
@@ -177,6 +188,21 @@ TEST_CASE("md --restart: a stale lock needs --force, a finished run has nothing 
   CHECK_THAT(r.output, !Catch::Contains("0 steps"));
   CHECK(slurp(dir / "run" / "traj.h5") == traj);
   CHECK(slurp(dir / "run" / "checkpoint.h5") == ck);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("md --restart of a run killed before its first checkpoint says how to start again",
+          "[cli][lock]") {
+  const fs::path dir = tempDir("lock-no-checkpoint");
+  const std::string run = (dir / "run").string();
+  REQUIRE(runGranagg(SMALL_RUN + "--out " + run).status == 0);
+  fs::remove(dir / "run" / "checkpoint.h5");  // what a kill -9 before the first one leaves
+  const Run r = runGranagg("md --restart " + run);
+  INFO(r.output);
+  CHECK(r.status == 2);
+  CHECK_THAT(r.output, Catch::Contains("no checkpoint at") &&
+                           Catch::Contains("before its first checkpoint") &&
+                           Catch::Contains("--force") && Catch::Contains("config_toml"));
   fs::remove_all(dir);
 }
 
