@@ -2,6 +2,8 @@
 /// The package's argument conversions (Arrays.h).
 #include "cli/python/Arrays.h"
 
+#include <pybind11/stl.h>
+
 #include <cmath>
 #include <limits>
 
@@ -107,6 +109,22 @@ std::vector<std::uint64_t> countsArg(py::handle obj, const char* name) {
     out[i] = static_cast<std::uint64_t>(v[i]);
   }
   return out;
+}
+
+py::object dataFrame(const std::vector<std::string>& columns,
+                     const std::vector<std::vector<double>>& rows, py::dict attrs) {
+  using namespace pybind11::literals;
+  py::dict data;
+  for (std::size_t j = 0; j < columns.size(); ++j) {
+    std::vector<double> col;
+    col.reserve(rows.size());
+    for (const auto& row : rows) col.push_back(row[j]);
+    data[py::str(columns[j])] = py::array(py::cast(col));
+  }
+  py::object df =
+      py::module_::import("pandas").attr("DataFrame")(data, "columns"_a = py::cast(columns));
+  df.attr("attrs") = attrs;
+  return df;
 }
 
 std::string pathArg(py::handle obj, const char* name) {

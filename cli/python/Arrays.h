@@ -62,6 +62,10 @@ py::array readOnlyCopy(const std::vector<T>& v, std::vector<py::ssize_t> shape =
   return readOnlyArray(std::vector<T>(v), std::move(shape));
 }
 
+/// A table of named columns (rows of doubles) as a pandas DataFrame, with `attrs` as its .attrs.
+py::object dataFrame(const std::vector<std::string>& columns,
+                     const std::vector<std::vector<double>>& rows, py::dict attrs = py::dict());
+
 /// A str or os.PathLike argument as a path (TypeError naming `name` otherwise).
 std::string pathArg(py::handle obj, const char* name);
 

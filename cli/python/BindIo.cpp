@@ -67,19 +67,10 @@ py::object readTable(const std::string& path) {
   if (!std::filesystem::is_regular_file(path))
     throw py::value_error("read_table: no file '" + path + "'.");
   const common::CsvTable t = common::readCsv(path);
-  py::module_ pd = py::module_::import("pandas");
-  py::dict data;
-  for (std::size_t j = 0; j < t.columns.size(); ++j) {
-    std::vector<double> col;
-    col.reserve(t.rows.size());
-    for (const auto& row : t.rows) col.push_back(row[j]);
-    data[py::str(t.columns[j])] = py::array(py::cast(col));
-  }
-  py::object df = pd.attr("DataFrame")(data, "columns"_a = py::cast(t.columns));
   py::dict attrs;
   for (const auto& [k, v] : t.meta) attrs[py::str(k)] = v;
   attrs["source"] = path;
-  df.attr("attrs") = attrs;
+  py::object df = dataFrame(t.columns, t.rows, attrs);
   return df;
 }
 

@@ -377,15 +377,7 @@ class PySimulation {
   }
 
   py::object observables() const {
-    py::module_ pd = py::module_::import("pandas");
-    py::dict data;
-    const auto& cols = observableColumns();
-    for (std::size_t j = 0; j < cols.size(); ++j) {
-      std::vector<double> v;
-      for (const auto& row : m_rows) v.push_back(row[j]);
-      data[py::str(cols[j])] = py::array(py::cast(v));
-    }
-    py::object df = pd.attr("DataFrame")(data, "columns"_a = py::cast(cols));
+    py::object df = dataFrame(observableColumns(), m_rows);
     df["step"] = df["step"].attr("astype")("int64");
     df["collisions"] = df["collisions"].attr("astype")("int64");
     return df;

@@ -108,20 +108,10 @@ SmolCurve smoluchowski(double beta, const std::string& method, double t_end,
 
 /// A KineticTable as a pandas DataFrame, its parameters and comments in .attrs.
 py::object dataFrame(const mf::KineticTable& table) {
-  py::module_ pd = py::module_::import("pandas");
-  py::dict data;
-  for (std::size_t j = 0; j < table.columns.size(); ++j) {
-    std::vector<double> col;
-    col.reserve(table.rows.size());
-    for (const auto& row : table.rows) col.push_back(row[j]);
-    data[py::str(table.columns[j])] = py::array(py::cast(col));
-  }
-  py::object df = pd.attr("DataFrame")(data, "columns"_a = py::cast(table.columns));
   py::dict attrs;
   for (const auto& [k, v] : table.provenance.parameters()) attrs[py::str(k)] = v;
   if (!table.comments.empty()) attrs["comments"] = py::cast(table.comments);
-  df.attr("attrs") = attrs;
-  return df;
+  return python::dataFrame(table.columns, table.rows, attrs);
 }
 
 /// Keyword arguments into a request's fields, by name; an unknown one is a TypeError that
