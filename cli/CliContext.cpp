@@ -25,6 +25,10 @@ void catchStopSignals() {
   // the signal to its runs as well) must not kill a run while it writes its checkpoint
   ::sigaction(SIGINT, &sa, nullptr);
   ::sigaction(SIGTERM, &sa, nullptr);
+  // A file-size limit (ulimit -f, a batch system's) then fails the write with EFBIG, as a full
+  // disk fails it with ENOSPC, instead of killing the run without a word: both end with the
+  // error line, the last checkpoint and the trajectory's journal (docs/robustness.md).
+  ::signal(SIGXFSZ, SIG_IGN);
 }
 
 const volatile std::sig_atomic_t* stopSignal() { return &g_stop_signal; }

@@ -134,11 +134,22 @@ void runMd(const MdArgs& a, const CliContext& ctx) {
   if (!sim->clearedStaleLock().empty() && !a.quiet)
     std::fprintf(stderr, "md: took over the stale lock of %s, which ended without releasing it\n",
                  sim->clearedStaleLock().c_str());
+  if (!sim->trajectoryRepair().empty() && !a.quiet)
+    std::fprintf(stderr, "md: %s\n", sim->trajectoryRepair().c_str());
   if (!a.quiet) {
     log(md::runStartLines(*sim));
     sim->addReporter(std::make_shared<md::ProgressReporter>(*sim));
   }
-  const md::RunSummary s = sim->run();
+  md::RunSummary s;
+  try {
+    s = sim->run();
+  } catch (const std::runtime_error& e) {
+    // A write that failed mid-run (a full disk, a quota): the last checkpoint and the journaled
+    // trajectory stand, so the run continues once the cause is gone.
+    if (dynamic_cast<const md::RunAborted*>(&e)) throw;
+    throw std::runtime_error(std::string(e.what()) + "; once that is fixed, continue with " +
+                             "granagg md --restart " + sim->folder().string());
+  }
   if (a.profile) log(md::profileLines(sim->engine(), s.steps, s.loop_seconds));
   if (!a.quiet) log(md::runSummaryLines(*sim, s));
   if (analysis && !s.stopped) {

@@ -3,10 +3,12 @@
 #include <sys/stat.h>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <unordered_map>
 
 #include "common/Box.h"
 #include "common/Csv.h"
+#include "common/H5Journal.h"
 #include "common/Hdf5.h"
 
 namespace granagg::common {
@@ -188,6 +190,16 @@ void H5mdReader::Impl::open(const std::string& requested_group) {
   h5::silenceErrors();
   struct stat st;
   if (::stat(path.c_str(), &st) != 0) error(0, "the file does not exist");
+  // A writer killed half-way through a frame leaves its undo journal: roll back to the last
+  // complete frame first, as `granagg md --restart` would (a live writer's file is refused).
+  if (h5journal::pending(path)) {
+    try {
+      const std::string note = h5journal::recover(path).summary(path);
+      if (!note.empty()) std::fprintf(stderr, "granagg: %s\n", note.c_str());
+    } catch (const std::runtime_error& e) {
+      error(0, e.what());
+    }
+  }
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     h5::lastError();
     error(0, "not an HDF5 file (so not an H5MD trajectory)");

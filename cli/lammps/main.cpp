@@ -106,6 +106,8 @@ void runLammps(const Args& a, const std::string& command_line, int rank) {
     if (!sim->clearedStaleLock().empty())
       std::fprintf(stderr, "granagg-lammps: cleared the stale lock of %s\n",
                    sim->clearedStaleLock().c_str());
+    if (!sim->trajectoryRepair().empty())
+      std::fprintf(stderr, "granagg-lammps: %s\n", sim->trajectoryRepair().c_str());
     // the input LAMMPS got (also OUT/lammps.in)
     for (const auto& c : engine->input().commands) std::fprintf(stderr, "lammps: %s\n", c.c_str());
     for (const auto& n : engine->input().notes)

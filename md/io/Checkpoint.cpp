@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/FaultInjection.h"
 #include "common/Hdf5.h"
 #include "common/Version.h"
 
@@ -86,6 +87,11 @@ void writeFile(const std::string& file_path, const Checkpoint& e) {
     for (const auto& [name, v] : ints)
       writeArray(g.get(), name, H5T_STD_I32LE, H5T_NATIVE_INT32, v->data(), n, c);
   }
+  // The crash trials' hook (common/FaultInjection.h): half-way, the particles written, the rest
+  // not. The temporary file is renamed only once complete, so the previous checkpoint stands.
+  if (common::faultPoint("checkpoint"))
+    throw std::runtime_error("cannot write " + c + ": " + std::strerror(ENOSPC) +
+                             " (fault injected)");
   {
     h5::Handle g = h5::createGroup(f, "integrator", c);
     h5::writeAttribute(g.get(), "dt", e.dt, c);

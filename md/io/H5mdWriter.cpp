@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "common/Csv.h"
+#include "common/H5Journal.h"
 #include "common/Hdf5.h"
 #include "common/Version.h"
 #include "md/io/InitialState.h"
@@ -98,6 +99,7 @@ struct H5mdWriter::Impl {
   // A reopened file's observables may differ from what the restarted program writes (a run
   // continued by a newer granagg, which has an observable more): see writeObservables.
   bool reopened = false;
+  std::string repair_note;  // what reopen() rolled back ("" if nothing)
 
   std::string ctx() const { return "H5MD file '" + path + "'"; }
 
@@ -352,8 +354,10 @@ struct H5mdWriter::Impl {
     for (auto& b : buf_values) b.clear();
   }
 
+  /// The file is complete after a flush: make it the state a killed run rolls back to.
   void flushFile() {
     h5::checkStatus(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), ctx() + ": flush failed");
+    common::h5journal::commit(file.get());
   }
 
   std::string xdmfText() const {
@@ -444,8 +448,9 @@ H5mdWriter::H5mdWriter(const std::string& path, std::size_t N,
   m.n = N;
   m.velocities = write_velocities;
   m.forces = write_forces;
+  const h5::Handle fapl(common::h5journal::fileAccess());
   m.file = h5::check(
-      H5Fcreate(path.c_str(), overwrite ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT),
+      H5Fcreate(path.c_str(), overwrite ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, fapl.get()),
       "cannot create H5MD file '" + path + "'");
   try {
     m.createLayout(parameters, config_toml);
@@ -469,11 +474,14 @@ H5mdWriter H5mdWriter::reopen(const std::string& path, std::size_t N, std::int64
   m.n = N;
   m.velocities = write_velocities;
   m.forces = write_forces;
+  // A run killed while it wrote leaves the write unfinished: back to the last complete state
+  m.repair_note = common::h5journal::recover(path).summary(path);
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     h5::lastError();
     throw std::invalid_argument("cannot reopen '" + path + "': no such HDF5 file");
   }
-  m.file = h5::check(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT),
+  const h5::Handle fapl(common::h5journal::fileAccess());
+  m.file = h5::check(H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.get()),
                      "cannot reopen H5MD file '" + path + "'");
   m.openLayout();
   m.reopened = true;
@@ -703,6 +711,7 @@ std::size_t H5mdWriter::observableSamples() const {
   return m_impl->obs_written + m_impl->buf_step.size();
 }
 std::size_t H5mdWriter::size() const { return m_impl->n; }
+const std::string& H5mdWriter::repairNote() const { return m_impl->repair_note; }
 const std::string& H5mdWriter::path() const { return m_impl->path; }
 const std::string& H5mdWriter::xdmfPath() const { return m_impl->xdmf_path; }
 

@@ -43,9 +43,11 @@
 /// A sidecar `<stem>.xdmf` (see xdmfPathFor) lets ParaView's "XDMF Reader" show the particles as a
 /// Polyvertex point cloud with velocity, charge and image attributes and one time step per frame.
 ///
-/// Robustness: the HDF5 file is flushed after every frame, so a killed run leaves a readable
-/// file with all complete frames (step/time are extended last: a frame counts only once they
-/// are written; common::H5mdReader takes the shortest of value/step/time). Not thread-safe.
+/// Robustness: the HDF5 file is flushed after every frame and each flush is committed through an
+/// undo journal (common/H5Journal.h, `traj.h5.journal` while the file is open), so a run killed
+/// at any moment leaves a file that reopen() and common::H5mdReader return to its last complete
+/// frame (step/time are extended last: a frame counts only once they are written;
+/// common::H5mdReader takes the shortest of value/step/time). Not thread-safe.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -129,6 +131,9 @@ class H5mdWriter {
   /// flush() then closes the file; further writes throw std::logic_error. Idempotent.
   void close();
 
+  /// What reopen() repaired, in one line for the log ("" if nothing): the write that a killed
+  /// run left unfinished, rolled back to the last complete frame (common/H5Journal.h).
+  const std::string& repairNote() const;
   /// Frames written so far (including those kept by reopen()).
   std::size_t frames() const;
   /// Observable samples written or buffered so far.

@@ -572,7 +572,12 @@ LammpsCheckpoint readLammpsCheckpoint(const fs::path& folder, MPI_Comm comm) {
   };
   onRankZero(rank, comm, [&] {
     if (!fs::exists(path))
-      throw std::invalid_argument("--restart: no checkpoint at " + path.string());
+      throw std::invalid_argument(
+          "--restart: no checkpoint at " + path.string() +
+          (fs::exists(path.parent_path() / "traj.h5")
+               ? ": the run stopped before its first checkpoint, so there is nothing to "
+                 "continue; start it again with its command and --force"
+               : std::string()));
     std::ifstream in(path, std::ios::binary);
     std::ostringstream s;
     s << in.rdbuf();

@@ -111,6 +111,7 @@ void TrajectoryReporter::reopen(double t_end, const std::string& command_line,
   m_writer = std::make_unique<H5mdWriter>(
       H5mdWriter::reopen(m_file.string(), m_engine.size(), m_engine.step(),
                          m_cfg.output.write_velocities, m_cfg.output.write_forces));
+  m_repair_note = m_writer->repairNote();
   m_writer->recordRestart(m_engine.step(), m_engine.time(), t_end, command_line, version);
   watch();
 }

@@ -78,6 +78,8 @@ class TrajectoryReporter : public Reporter {
   void checkpointWritten(std::filesystem::path file, std::int64_t step);
 
   const std::filesystem::path& file() const { return m_file; }
+  /// What reopen() repaired in the file ("" if nothing; H5mdWriter::repairNote).
+  const std::string& repairNote() const { return m_repair_note; }
   std::size_t framesWritten() const;
   /// The step of the last frame time reached (stored or not); -1 before the first.
   std::int64_t frameStep() const { return m_frame_step; }
@@ -96,6 +98,7 @@ class TrajectoryReporter : public Reporter {
   std::int64_t m_last_step;
   std::int64_t m_frame_step = -1;
   std::unique_ptr<H5mdWriter> m_writer;  // on the writing rank
+  std::string m_repair_note;
   struct stat m_stat {};                 // the file as this run last left it
   std::filesystem::path m_checkpoint_file;
   std::int64_t m_checkpoint_step = -1;   // -1: none written by this process or found

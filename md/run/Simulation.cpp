@@ -409,6 +409,9 @@ RunSummary Simulation::run() {
       engine.run(target - engine.step());
       bool needed = false;
       for (const Reporter* r : all) needed = r->needsObservables(*this) || needed;
+      // observables() is collective, and a rank may carry reporters that another lacks (the
+      // progress line lives on rank 0 only): every rank computes them if any rank needs them
+      needed = engine.anyRank(needed);
       if (needed) d.observables = engine.observables();
       d.observables_step = needed ? engine.step() : d.observables_step;
       for (Reporter* r : all) r->report(*this);
@@ -453,6 +456,10 @@ std::int64_t Simulation::frameStep() const { return m_impl->trajectory->frameSte
 const std::string& Simulation::clearedStaleLock() const {
   static const std::string none;
   return m_impl->lock ? m_impl->lock->clearedStale() : none;
+}
+
+const std::string& Simulation::trajectoryRepair() const {
+  return m_impl->trajectory->repairNote();
 }
 
 bool Simulation::finished() const { return m_impl->at_end; }

@@ -137,6 +137,9 @@ class Simulation {
   bool resumed() const;
   /// The stale folder lock that RunOptions::overwrite cleared ("" if none), for the log.
   const std::string& clearedStaleLock() const;
+  /// What a resumed run repaired in traj.h5 ("" if nothing), for the log: the write that a
+  /// killed run left unfinished, rolled back to its last complete frame (common/H5Journal.h).
+  const std::string& trajectoryRepair() const;
   /// True if it was resumed at its run.t_end: run() has nothing to do and opens no file.
   bool finished() const;
   /// Frames in the trajectory so far.
