@@ -443,8 +443,8 @@ std::string Recovery::summary(const std::string& path) const {
   char buf[256];
   const double cut = size_before > size_after ? double(size_before - size_after) : 0.0;
   std::snprintf(buf, sizeof buf,
-                "rolled back the unfinished write of '%s' that an interrupted run left (%zu blocks, "
-                "%.1f kB restored; %.1f kB cut off)",
+                "rolled back the unfinished write of '%s' that an interrupted run left "
+                "(%zu blocks, %.1f kB restored; %.1f kB cut off)",
                 path.c_str(), entries, bytes_restored / 1e3, cut / 1e3);
   return buf;
 }
