@@ -46,6 +46,29 @@ def run(cmd, env=None, timeout=300):
                           text=True, timeout=timeout)
 
 
+def kill_leftovers(folder):
+    """SIGKILLs every process whose command line names `folder` (the MPI ranks that outlive a
+    killed mpirun, which a node failure would take with it) and waits until none is left."""
+    for _ in range(200):
+        left = []
+        for pid in filter(str.isdigit, os.listdir("/proc")):
+            try:
+                with open(f"/proc/{pid}/cmdline", "rb") as f:
+                    argv = f.read().split(b"\0")
+            except OSError:
+                continue
+            if folder.encode() in argv and int(pid) != os.getpid():
+                left.append(int(pid))
+        if not left:
+            return
+        for pid in left:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+        time.sleep(0.05)
+
+
 def run_killed_after(cmd, delay):
     """Starts cmd, SIGKILLs it after `delay` seconds unless it ended; returns (rc, output)."""
     e = dict(os.environ)
@@ -57,6 +80,7 @@ def run_killed_after(cmd, delay):
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
         out, _ = p.communicate()
+        kill_leftovers(cmd[cmd.index("--out") + 1] if "--out" in cmd else cmd[-1])
     return p.returncode, out
 
 
@@ -140,7 +164,10 @@ def trial(args, launch, ref, index, kind, budget, wall_ref):
             cmd = restart
         else:  # killed before the first checkpoint: --restart must say so and how to start again
             r = run(restart)
-            if r.returncode != 2 or "start it again with its command and --force" not in r.stdout:
+            # (the hint to start again needs traj.h5: a kill before it was created left nothing)
+            hint = ("start it again with its command and --force"
+                    if os.path.exists(traj) else "no checkpoint at")
+            if r.returncode != 2 or hint not in r.stdout:
                 return False, log + [f"{moment}: --restart without a checkpoint gave exit "
                                      f"{r.returncode}:\n{r.stdout}"], kills, torn
             moment += " (before the first checkpoint: started again with --force)"
