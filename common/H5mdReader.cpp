@@ -89,6 +89,7 @@ struct H5mdReader::Impl {
     const std::string c = ctx(where(e));
     if (t == H5I_DATASET) {
       e.value = h5::check(H5Dopen2(part, name.c_str(), H5P_DEFAULT), c);
+      h5::checkStoredSize(e.value.get(), c);  // before any frame buffer is sized from it
       e.dims = h5::datasetDims(e.value.get(), c);
       return e;
     }
@@ -98,6 +99,7 @@ struct H5mdReader::Impl {
     if (h5::objectType(g.get(), "value") != H5I_DATASET)
       error(0, "missing dataset " + where(e) + "/value");
     e.value = h5::check(H5Dopen2(g.get(), "value", H5P_DEFAULT), c + "/value");
+    h5::checkStoredSize(e.value.get(), c + "/value");
     e.dims = h5::datasetDims(e.value.get(), c + "/value");
     if (e.dims.empty()) error(0, where(e) + "/value is a scalar, expected a time series");
     e.steps = readGrid<std::int64_t>(g.get(), "step", H5T_NATIVE_INT64, e.dims[0], where(e));

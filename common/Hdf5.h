@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -285,6 +286,63 @@ inline void writeStringDataset(hid_t loc, const std::string& name, const std::st
               ctx + ": cannot write dataset '" + name + "'");
 }
 
+/// Bytes a dataset may claim beyond what it stores: fill values of chunks never written, and
+/// granagg's own small datasets. Above it the claim must be backed by stored bytes.
+inline constexpr double UNSTORED_ALLOWANCE_BYTES = 16.0 * (1 << 20);
+/// The largest expansion of a filtered (compressed) dataset: zlib's deflate, the filter that
+/// HDF5 writers use, expands its input at most about 1032-fold (RFC 1951's longest match of 258
+/// bytes in a code of 2 bits); shuffle and fletcher32 do not change the size.
+inline constexpr double MAX_FILTER_EXPANSION = 1100.0;
+
+/// "1.2 GB", "34.0 kB": a byte count for error messages (decimal units).
+inline std::string byteText(double bytes) {
+  const char* unit[] = {"bytes", "kB", "MB", "GB", "TB", "PB", "EB"};
+  int k = 0;
+  while (bytes >= 1000.0 && k < 6) {
+    bytes /= 1000.0;
+    ++k;
+  }
+  char buf[48];
+  std::snprintf(buf, sizeof buf, k == 0 ? "%.0f %s" : "%.1f %s", bytes, unit[k]);
+  return buf;
+}
+
+/// Checks, before anything is allocated, that a dataset's extent is backed by the bytes the file
+/// stores for it: a corrupt or hostile file can claim 1e12 particles in a header of a few bytes,
+/// which would otherwise end in std::bad_alloc or an allocation of the whole memory. Throws
+/// std::invalid_argument (bad input: the CLI's exit status 2) naming the dataset (ctx).
+inline void checkStoredSize(hid_t dset, const std::string& ctx) {
+  const std::vector<hsize_t> dims = datasetDims(dset, ctx);
+  Handle type = check(H5Dget_type(dset), ctx + ": cannot read its type");
+  double claimed = static_cast<double>(H5Tget_size(type.get()));
+  std::string shape;
+  for (hsize_t d : dims) {
+    claimed *= static_cast<double>(d);
+    shape += (shape.empty() ? "" : " x ") + std::to_string(d);
+  }
+  if (claimed <= UNSTORED_ALLOWANCE_BYTES) return;
+  Handle dcpl = check(H5Dget_create_plist(dset), ctx + ": cannot read its creation properties");
+  const bool filtered = H5Pget_nfilters(dcpl.get()) > 0;
+  const double stored = static_cast<double>(H5Dget_storage_size(dset));
+  if (claimed <= UNSTORED_ALLOWANCE_BYTES + stored * (filtered ? MAX_FILTER_EXPANSION : 1.0))
+    return;
+  throw std::invalid_argument(ctx + " claims " + (shape.empty() ? "one" : shape) +
+                              " values (" + byteText(claimed) + ") but the file stores " +
+                              byteText(stored) + " for it (a corrupt or truncated file?)");
+}
+
+/// The same for an attribute: granagg reads only small attributes (units, box dimension,
+/// strings), so one that claims more than UNSTORED_ALLOWANCE_BYTES is refused.
+inline void checkAttributeSize(hid_t type, hid_t space, const std::string& ctx) {
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  const double claimed = static_cast<double>(n > 0 ? n : 0) *
+                         static_cast<double>(H5Tget_size(type));
+  if (n < 0 || claimed > UNSTORED_ALLOWANCE_BYTES)
+    throw std::invalid_argument(ctx + " claims " + std::to_string(n) + " values (" +
+                                byteText(claimed) + "), more than an attribute of a granagg " +
+                                "input holds (a corrupt file?)");
+}
+
 /// Reads a string stored in an attribute or a scalar dataset of fixed or variable length.
 /// `is_attr` selects H5Aread/H5Dread. Throws when the object is not a scalar string.
 inline std::string readString(hid_t obj, bool is_attr, const std::string& ctx) {
@@ -295,6 +353,10 @@ inline std::string readString(hid_t obj, bool is_attr, const std::string& ctx) {
       check(is_attr ? H5Aget_space(obj) : H5Dget_space(obj), ctx + ": cannot read its dataspace");
   if (H5Sget_simple_extent_npoints(space.get()) != 1)
     throw std::runtime_error(ctx + ": not a single string");
+  if (is_attr)
+    checkAttributeSize(type.get(), space.get(), ctx);
+  else
+    checkStoredSize(obj, ctx);
   if (H5Tis_variable_str(type.get()) > 0) {
     Handle mem = varStringType();
     H5Tset_cset(mem.get(), H5Tget_cset(type.get()));
@@ -323,6 +385,7 @@ inline std::vector<std::string> readStringArrayAttribute(hid_t attr, const std::
   if (H5Tget_class(type.get()) != H5T_STRING)
     throw std::runtime_error(ctx + ": not a string attribute");
   Handle space = check(H5Aget_space(attr), ctx + ": cannot read its dataspace");
+  checkAttributeSize(type.get(), space.get(), ctx);
   const hssize_t n = H5Sget_simple_extent_npoints(space.get());
   std::vector<std::string> out;
   if (n <= 0) return out;
@@ -355,6 +418,7 @@ std::vector<T> readNumericAttribute(hid_t attr, hid_t mem_type, const std::strin
   const H5T_class_t cls = H5Tget_class(type.get());
   if (cls != H5T_INTEGER && cls != H5T_FLOAT) throw std::runtime_error(ctx + ": not a number");
   Handle space = check(H5Aget_space(attr), ctx + ": cannot read its dataspace");
+  checkAttributeSize(type.get(), space.get(), ctx);
   const hssize_t n = H5Sget_simple_extent_npoints(space.get());
   std::vector<T> out(static_cast<std::size_t>(n > 0 ? n : 0));
   if (!out.empty() && H5Aread(attr, mem_type, out.data()) < 0) fail(ctx + ": cannot read");
@@ -471,6 +535,7 @@ inline void readRows(hid_t dset, hsize_t row, hsize_t count, hid_t mem_type, voi
 /// Reads a whole dataset converted to `mem_type` (T must match it).
 template <class T>
 std::vector<T> readAll(hid_t dset, hid_t mem_type, const std::string& ctx) {
+  checkStoredSize(dset, ctx);
   const std::vector<hsize_t> dims = datasetDims(dset, ctx);
   std::size_t n = 1;
   for (hsize_t d : dims) n *= static_cast<std::size_t>(d);

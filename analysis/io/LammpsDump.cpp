@@ -17,6 +17,9 @@ namespace granagg::analysis {
 
 LammpsDump::LammpsDump(const std::string& path, double dt) : m_path(path), m_dt(dt), m_in(path) {
   if (!m_in) throw std::invalid_argument("cannot open LAMMPS dump '" + path + "'");
+  if (m_in.seekg(0, std::ios::end)) m_bytes = static_cast<std::int64_t>(m_in.tellg());
+  m_in.clear();
+  m_in.seekg(0, std::ios::beg);
   if (!(dt >= 0.0) || !std::isfinite(dt))
     throw std::invalid_argument("the LAMMPS timestep dt must be >= 0, got " +
                                 common::formatReal(dt));
@@ -86,8 +89,17 @@ LammpsDump::Header LammpsDump::readHeader(std::string& line) {
     } else if (item == "NUMBER OF ATOMS") {
       need(line, "the number of atoms");
       char* end = nullptr;
+      errno = 0;
       const long long v = std::strtoll(line.c_str(), &end, 10);
-      if (end == line.c_str() || v <= 0) error("bad number of atoms " + quoted(line, 40));
+      if (errno || end == line.c_str() || v <= 0) {
+        // in frame 0 the file is not a dump granagg can size (bad input, exit 2); later, a
+        // damaged frame that --allow-partial may leave out
+        const std::string what = "bad NUMBER OF ATOMS " + quoted(line, 40) + " (line " +
+                                 std::to_string(m_line) + "; expected an integer >= 1)";
+        if (m_frame == 0) throw std::invalid_argument("LAMMPS dump '" + m_path + "': " + what);
+        error("bad number of atoms " + quoted(line, 40));
+      }
+      m_count_line = m_line;
       h.atoms = static_cast<std::size_t>(v);
       have_n = true;
     } else if (item.rfind("BOX BOUNDS", 0) == 0) {
@@ -100,7 +112,7 @@ LammpsDump::Header LammpsDump::readHeader(std::string& line) {
       for (int d = 0; d < 3; ++d) {
         need(line, "the box bounds");
         std::istringstream is(line);
-        if (!(is >> h.lo[d] >> hi[d]) || !(hi[d] > h.lo[d]))
+        if (!(is >> h.lo[d] >> hi[d]) || !(hi[d] > h.lo[d]) || !std::isfinite(hi[d] - h.lo[d]))
           error("bad box bounds " + quoted(line, 60));
       }
       have_box = true;
@@ -158,6 +170,24 @@ LammpsDump::Columns LammpsDump::columns(const std::string& atoms_line) const {
 
 LammpsDump::Atoms LammpsDump::readAtoms(const Header& h, const Columns& c) {
   const std::size_t n = h.atoms;
+  // Before anything is sized from the header: an atom line holds c.count values, each of at least
+  // one character and a separator (or the newline), so the rest of the file bounds the count.
+  const std::int64_t here = m_bytes >= 0 ? static_cast<std::int64_t>(m_in.tellg()) : -1;
+  if (here >= 0) {
+    const double most = static_cast<double>(m_bytes - here) / (2.0 * static_cast<double>(c.count));
+    if (static_cast<double>(n) > most) {
+      const std::string what = "NUMBER OF ATOMS = " + std::to_string(n) + " (line " +
+                               std::to_string(m_count_line) + "), but the rest of the file " +
+                               "has room for at most " + std::to_string(static_cast<long long>(most)) +
+                               " atom lines of " + std::to_string(c.count) + " values";
+      // frame 0: the file is not what its header says (bad input); a later frame: a cut tail,
+      // which --allow-partial may leave out like any truncated frame.
+      if (m_frame == 0)
+        throw std::invalid_argument("LAMMPS dump '" + m_path + "': " + what +
+                                    " (a corrupt dump or a wrong count?)");
+      error(what + " (truncated dump?)");
+    }
+  }
   Atoms a;
   a.ids.resize(n);
   a.pos.resize(3 * n);
@@ -181,12 +211,20 @@ LammpsDump::Atoms LammpsDump::readAtoms(const Header& h, const Columns& c) {
               " values: " + quoted(line, 80));
       p = end;
     }
+    // Integers are range-checked before the cast: a double out of range converts undefined.
+    if (c.id >= 0 && !(std::fabs(values[c.id]) <= 9007199254740992.0 &&  // 2^53: exact in double
+                       values[c.id] == std::floor(values[c.id])))
+      error("atom id " + common::formatReal(values[c.id]) + " is not an integer");
     a.ids[k] = c.id >= 0 ? static_cast<std::int64_t>(values[c.id]) : static_cast<std::int64_t>(k);
     for (int d = 0; d < 3; ++d) {
       const double v = values[c.pos[d]];
       a.pos[3 * k + d] = c.kind == Columns::SCALED ? v * h.L : v - h.lo[d];
-      if (c.images && c.kind != Columns::UNWRAPPED)
-        a.img[3 * k + d] = static_cast<std::int32_t>(values[c.img[d]]);
+      if (c.images && c.kind != Columns::UNWRAPPED) {
+        const double im = values[c.img[d]];
+        if (!(std::fabs(im) <= 1073741824.0 && im == std::floor(im)))  // |image| <= 2^30
+          error("image flag " + common::formatReal(im) + " is not an integer of at most 2^30");
+        a.img[3 * k + d] = static_cast<std::int32_t>(im);
+      }
       if (c.velocities) a.vel[3 * k + d] = values[c.vel[d]];
     }
     if (c.q >= 0) a.q[k] = values[c.q];
@@ -227,6 +265,10 @@ void LammpsDump::fill(const Header& h, const Columns& c, const Atoms& a, Frame& 
       double x = a.pos[3 * i + d];
       if (!std::isfinite(x))
         errorAt(a.line_of[i], "atom " + std::to_string(a.ids[i]) + " has a non-finite position");
+      // the image count must stay an int: 1e9 box lengths is beyond any physical trajectory
+      if (std::fabs(x) > 1e9 * h.L)
+        errorAt(a.line_of[i], "atom " + std::to_string(a.ids[i]) + " lies " +
+                                  common::formatReal(x / h.L) + " box lengths from the box");
       const int shift = box.wrap(x);
       f.position[3 * k + d] = x;
       if (images) f.image[3 * k + d] = a.img[3 * i + d] + shift;

@@ -249,6 +249,7 @@ struct CheckpointFile {
           dc + " has " +
           (dims.size() == 1 ? std::to_string(dims[0]) : std::string("a wrong shape")) +
           " entries, expected N = " + std::to_string(n));
+    h5::checkStoredSize(d.get(), dc);  // N comes from the file: refuse a claim it does not back
     out.resize(static_cast<std::size_t>(n));
     h5::checkStatus(H5Dread(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()),
                     dc + ": cannot read (corrupt: checksum mismatch?)");

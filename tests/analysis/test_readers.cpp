@@ -368,3 +368,41 @@ TEST_CASE("the charging-rate fit recovers the exponent of d<|q|>/dt, kappa comes
   CHECK(analyzeRun(p, o).kappa == 0.5);
   fs::remove_all(dir);
 }
+
+TEST_CASE("a dump header's counts are checked before anything is allocated", "[analysis][io]") {
+  const fs::path dir = tempDir("dumpsize");
+  auto dump = [&](const std::string& name, const std::string& count, const std::string& atom) {
+    const std::string p = (dir / name).string();
+    std::ofstream(p) << "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n"
+                     << count << "\nITEM: BOX BOUNDS pp pp pp\n0 10\n0 10\n0 10\n"
+                     << "ITEM: ATOMS id x y z ix iy iz\n"
+                     << atom << "\n";
+    return p;
+  };
+  Frame f;
+  // 1e12 atoms in a file of ~150 bytes: refused from the file size, not by std::bad_alloc
+  LammpsDump big(dump("big.dump", "1000000000000", "1 1 1 1 0 0 0"));
+  CHECK_THROWS_AS(big.next(f), std::invalid_argument);
+  LammpsDump big2(dump("big.dump", "1000000000000", "1 1 1 1 0 0 0"));
+  CHECK_THROWS_WITH(big2.next(f), Catch::Contains("big.dump") &&
+                                      Catch::Contains("NUMBER OF ATOMS = 1000000000000") &&
+                                      Catch::Contains("room for at most 1 atom lines"));
+  for (const char* count : {"-5", "99999999999999999999999", "many"}) {
+    LammpsDump bad(dump("count.dump", count, "1 1 1 1 0 0 0"));
+    CHECK_THROWS_WITH(bad.next(f), Catch::Contains("count.dump") &&
+                                       Catch::Contains("NUMBER OF ATOMS") &&
+                                       Catch::Contains("line 4"));
+  }
+  // values whose conversion to an integer would be undefined behaviour
+  LammpsDump id(dump("id.dump", "1", "1e300 1 1 1 0 0 0"));
+  CHECK_THROWS_WITH(id.next(f), Catch::Contains("atom id 1e+300 is not an integer"));
+  LammpsDump img(dump("img.dump", "1", "1 1 1 1 0 5e9 0"));
+  CHECK_THROWS_WITH(img.next(f), Catch::Contains("image flag 5e+09"));
+  LammpsDump far(dump("far.dump", "1", "1 1e300 1 1 0 0 0"));
+  CHECK_THROWS_WITH(far.next(f), Catch::Contains("box lengths from the box"));
+  // the same file with a true count reads
+  LammpsDump ok(dump("ok.dump", "1", "7 1 2 3 0 0 0"));
+  REQUIRE(ok.next(f));
+  CHECK(f.id.at(0) == 7);
+  fs::remove_all(dir);
+}

@@ -90,3 +90,40 @@ TEST_CASE("H5MD reader: the default group, other grids, missing time, crossings"
   }
   std::remove(path.c_str());
 }
+
+TEST_CASE("a dataset's extent is checked against the bytes the file stores before allocation",
+          "[common][io]") {
+  // A chunked position/value of 1 x 1e9 x 3 doubles (24 GB) with no chunk written: HDF5 accepts
+  // the file (unwritten chunks read as fill values), granagg refuses it before sizing a frame.
+  const std::string path = tempPath("reader_claims.h5");
+  writeFile(path);
+  {
+    h5::Handle file(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    REQUIRE(file.valid());
+    REQUIRE(H5Ldelete(file.get(), "particles/all/position/value", H5P_DEFAULT) >= 0);
+    const hsize_t dims[3] = {1, 1000000000, 3}, chunk[3] = {1, 1024, 3};
+    h5::Handle space(H5Screate_simple(3, dims, nullptr));
+    h5::Handle dcpl(H5Pcreate(H5P_DATASET_CREATE));
+    H5Pset_chunk(dcpl.get(), 3, chunk);
+    h5::Handle d(H5Dcreate2(file.get(), "particles/all/position/value", H5T_IEEE_F64LE,
+                            space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT));
+    REQUIRE(d.valid());
+  }
+  try {
+    H5mdReader r(path, "all");
+    FAIL("the reader accepted a dataset of 24 GB that stores nothing");
+  } catch (const std::invalid_argument& e) {
+    CHECK_THAT(e.what(), Catch::Contains("reader_claims.h5") &&
+                             Catch::Contains("position/value") &&
+                             Catch::Contains("1 x 1000000000 x 3") &&
+                             Catch::Contains("24.0 GB") && Catch::Contains("stores 0 bytes"));
+  }
+  std::remove(path.c_str());
+}
+
+TEST_CASE("byteText writes byte counts in decimal units", "[common][io]") {
+  CHECK(h5::byteText(0) == "0 bytes");
+  CHECK(h5::byteText(999) == "999 bytes");
+  CHECK(h5::byteText(13400) == "13.4 kB");
+  CHECK(h5::byteText(24e9) == "24.0 GB");
+}
