@@ -10,6 +10,7 @@
 
 #include "cli/CliContext.h"
 #include "common/Csv.h"
+#include "common/Strings.h"
 #include "common/Version.h"
 
 namespace {
@@ -81,10 +82,11 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // One line, naming the option; exit status 2 for every kind of bad input.
-    std::fprintf(stderr, "%s%s (see --help)\n", common::ERROR_PREFIX, e.what());
+    std::fprintf(stderr, "%s%s (see --help)\n", common::ERROR_PREFIX,
+                 common::terminalSafe(e.what()).c_str());
     return 2;
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "%s%s\n", common::ERROR_PREFIX, e.what());
+    std::fprintf(stderr, "%s%s\n", common::ERROR_PREFIX, common::terminalSafe(e.what()).c_str());
     return 2;
   } catch (const std::filesystem::filesystem_error& e) {
     // Outputs are checked before the work (common/OutputPath.h); this is a write that failed
@@ -93,10 +95,10 @@ int main(int argc, char** argv) {
                  e.code().message().c_str());
     return 1;
   } catch (const cli::Interrupted& e) {
-    std::fprintf(stderr, "granagg: stopped: %s\n", e.what());
+    std::fprintf(stderr, "granagg: stopped: %s\n", common::terminalSafe(e.what()).c_str());
     return e.status();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "granagg: failed: %s\n", e.what());
+    std::fprintf(stderr, "granagg: failed: %s\n", common::terminalSafe(e.what()).c_str());
     return 1;
   }
   return 0;

@@ -185,6 +185,8 @@ struct H5mdReader::Impl {
   }
 
   void open(const std::string& requested_group);
+  /// The checks of an open file, shared by open() and the file-image constructor.
+  void openGroups(const std::string& requested_group);
   void openBox(hid_t part);
 };
 
@@ -213,6 +215,10 @@ void H5mdReader::Impl::open(const std::string& requested_group) {
                  "); a file cut short by a crash or an interrupted copy cannot be opened by HDF5 "
                  "at all");
   }
+  openGroups(requested_group);
+}
+
+void H5mdReader::Impl::openGroups(const std::string& requested_group) {
   const hid_t f = file.get();
   if (h5::objectType(f, "/h5md") == H5I_GROUP) {
     h5::Handle g = h5::check(H5Gopen2(f, "/h5md", H5P_DEFAULT), ctx("/h5md"));
@@ -309,6 +315,30 @@ H5mdReader::H5mdReader(const std::string& path, const std::string& particle_grou
   m_impl->path = path;
   m_impl->open(particle_group);
 }
+
+H5mdReader H5mdReader::fromImage(const void* data, std::size_t size, const std::string& name,
+                                  const std::string& particle_group) {
+  h5::silenceErrors();
+  H5mdReader r;
+  Impl& m = *r.m_impl;
+  m.path = name;
+  // HDF5's file-image API (what H5LTopen_file_image does): the core driver over a copy of the
+  // bytes, never written back.
+  h5::Handle fapl = h5::check(H5Pcreate(H5P_FILE_ACCESS), m.ctx("file access properties"));
+  h5::checkStatus(H5Pset_fapl_core(fapl.get(), 1 << 16, 0), m.ctx("core driver"));
+  h5::checkStatus(H5Pset_file_image(fapl.get(), const_cast<void*>(data), size),
+                  m.ctx("file image"));
+  m.file = h5::Handle(H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl.get()));
+  if (!m.file) {
+    const std::string msg = h5::lastError();
+    m.error(0, "cannot open the HDF5 file image (" +
+                   (msg.empty() ? std::string("unknown error") : msg) + ")");
+  }
+  m.openGroups(particle_group);
+  return r;
+}
+
+H5mdReader::H5mdReader() : m_impl(std::make_unique<Impl>()) {}
 
 H5mdReader::~H5mdReader() = default;
 H5mdReader::H5mdReader(H5mdReader&&) noexcept = default;

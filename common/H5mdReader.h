@@ -60,6 +60,10 @@ class H5mdReader {
  public:
   /// Opens `path` read-only; `particle_group` as described above ("" = the default rule).
   explicit H5mdReader(const std::string& path, const std::string& particle_group = "");
+  /// Reads an H5MD file held in memory (HDF5's file-image API; the bytes are copied). `name`
+  /// stands for the file in errors. Used by the fuzz harnesses (tests/fuzz).
+  static H5mdReader fromImage(const void* data, std::size_t size, const std::string& name,
+                              const std::string& particle_group = "");
   ~H5mdReader();
   H5mdReader(H5mdReader&&) noexcept;
   H5mdReader& operator=(H5mdReader&&) noexcept;
@@ -110,6 +114,7 @@ class H5mdReader {
   ObservableSeries readObservable(const std::string& name) const;
 
  private:
+  H5mdReader();  // for fromImage
   struct Impl;
   std::unique_ptr<Impl> m_impl;
 };

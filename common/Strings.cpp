@@ -56,4 +56,19 @@ std::string printfString(const char* fmt, ...) {
 
 std::string formatShort(double x) { return printfString("%.4g", x); }
 
+std::string terminalSafe(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (unsigned char c : text) {
+    if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) {
+      char buf[5];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
 }  // namespace granagg::common

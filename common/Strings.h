@@ -8,6 +8,10 @@ namespace granagg::common {
 std::string trim(const std::string& s);
 std::vector<std::string> split(const std::string& s, char sep);
 std::string join(const std::vector<std::string>& parts, const std::string& sep);
+/// `text` safe to print on a terminal: control bytes other than newline and tab (and DEL) as
+/// "\xNN". Error messages quote the offending token of an input file, which may be binary; the
+/// CLIs print every error through this.
+std::string terminalSafe(const std::string& text);
 /// Parses a whole string as a double (also "nan", "inf"); false if anything is left over.
 bool parseReal(const std::string& s, double& out);
 /// printf into a std::string, of any length (the compiler checks the arguments against fmt).

@@ -46,6 +46,7 @@ std::string quoted(const std::string& line, std::size_t max) {
 bool LammpsDump::getLine(std::string& line) {
   if (!std::getline(m_in, line)) return false;
   ++m_line;
+  m_offset += line.size() + 1;  // (tellg is -1 once a last line without newline set eof)
   if (!line.empty() && line.back() == '\r') line.pop_back();
   return true;
 }
@@ -172,9 +173,10 @@ LammpsDump::Atoms LammpsDump::readAtoms(const Header& h, const Columns& c) {
   const std::size_t n = h.atoms;
   // Before anything is sized from the header: an atom line holds c.count values, each of at least
   // one character and a separator (or the newline), so the rest of the file bounds the count.
-  const std::int64_t here = m_bytes >= 0 ? static_cast<std::int64_t>(m_in.tellg()) : -1;
-  if (here >= 0) {
-    const double most = static_cast<double>(m_bytes - here) / (2.0 * static_cast<double>(c.count));
+  if (m_bytes >= 0) {
+    const double left =
+        std::max(0.0, static_cast<double>(m_bytes) - static_cast<double>(m_offset));
+    const double most = left / (2.0 * static_cast<double>(c.count));
     if (static_cast<double>(n) > most) {
       const std::string what = "NUMBER OF ATOMS = " + std::to_string(n) + " (line " +
                                std::to_string(m_count_line) + "), but the rest of the file " +

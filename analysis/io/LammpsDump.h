@@ -71,7 +71,8 @@ class LammpsDump final : public TrajectoryReader {
   std::string m_path;
   double m_dt;
   std::ifstream m_in;
-  std::int64_t m_bytes = -1;  // the file's size (-1: not seekable); bounds the atoms a header claims
+  std::int64_t m_bytes = -1;  // file size (-1: not seekable); bounds the atoms a header claims
+  std::size_t m_offset = 0;      // bytes read so far
   std::size_t m_count_line = 0;  // the line of the NUMBER OF ATOMS value, for errors
   std::size_t m_frame = 0, m_line = 0;
   std::size_t m_n = 0;  // atoms of the first frame: later frames must match

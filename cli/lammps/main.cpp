@@ -24,6 +24,7 @@
 
 #include "cli/CliContext.h"
 #include "common/Csv.h"
+#include "common/Strings.h"
 #include "common/Version.h"
 #include "md/config/ConfigParser.h"
 #include "md/lammps/CollisionLog.h"
@@ -178,21 +179,25 @@ int run(int argc, char** argv, int rank) {
   } catch (const CLI::CallForVersion& e) {
     return rank == 0 ? app.exit(e) : 0;
   } catch (const CLI::ParseError& e) {
-    if (rank == 0) std::fprintf(stderr, "granagg-lammps: %s\n", e.what());
+    if (rank == 0)
+      std::fprintf(stderr, "granagg-lammps: %s\n", common::terminalSafe(e.what()).c_str());
     return 2;
   }
   try {
     runLammps(a, common::commandLine(argc, argv), rank);
     return 0;
   } catch (const std::invalid_argument& e) {  // (on every rank: the checks agree)
-    if (rank == 0) std::fprintf(stderr, "granagg-lammps: %s\n", e.what());
+    if (rank == 0)
+      std::fprintf(stderr, "granagg-lammps: %s\n", common::terminalSafe(e.what()).c_str());
     return 2;
   } catch (const cli::Interrupted& e) {  // (on every rank: the stop is agreed on)
-    if (rank == 0) std::fprintf(stderr, "granagg-lammps: stopped: %s\n", e.what());
+    if (rank == 0)
+      std::fprintf(stderr, "granagg-lammps: stopped: %s\n", common::terminalSafe(e.what()).c_str());
     return e.status();
   } catch (const std::exception& e) {
     // may have happened on one rank only (a file rank 0 could not write): end every rank
-    std::fprintf(stderr, "granagg-lammps: error on rank %d: %s\n", rank, e.what());
+    std::fprintf(stderr, "granagg-lammps: error on rank %d: %s\n", rank,
+                 common::terminalSafe(e.what()).c_str());
     MPI_Abort(MPI_COMM_WORLD, 1);
     return 1;
   }

@@ -467,8 +467,15 @@ void readTable(const toml::table& root, const std::string& source_name, MdConfig
   std::stable_sort(issues.begin(), issues.end(), [](const Issue& a, const Issue& b) {
     return a.line != b.line ? a.line < b.line : a.column < b.column;
   });
+  // One line per issue, at most MAX_REPORTED: a file that is not a config at all (a binary, a
+  // different format) would otherwise print a line for every word in it.
+  constexpr std::size_t MAX_REPORTED = 10;
   std::string message;
-  for (const auto& i : issues) message += (message.empty() ? "" : "\n") + i.message;
+  for (std::size_t k = 0; k < issues.size() && k < MAX_REPORTED; ++k)
+    message += (message.empty() ? "" : "\n") + issues[k].message;
+  if (issues.size() > MAX_REPORTED)
+    message += "\n(and " + std::to_string(issues.size() - MAX_REPORTED) + " more errors in " +
+               source_name + ")";
   throw ConfigError(message, issues.size() == 1 ? issues.front().key : "");
 }
 
