@@ -1,4 +1,5 @@
 /// granagg: one executable, subcommands over the md / analysis / meanfield libraries.
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -48,6 +49,9 @@ std::string unknownSubcommand(const CLI::App& app, int argc, const char* const* 
 
 int main(int argc, char** argv) {
   using namespace granagg;
+  // A file-size limit (ulimit -f) fails a write with EFBIG, as a full disk does with ENOSPC,
+  // instead of killing the command without a word (every command: md, analyze, smol...).
+  ::signal(SIGXFSZ, SIG_IGN);
   cli::CliContext ctx{common::commandLine(argc, argv)};
 
   CLI::App app{

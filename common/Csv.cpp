@@ -1,6 +1,8 @@
 #include "common/Csv.h"
 
 #include <sys/stat.h>
+#include <cerrno>
+#include <cstring>
 #include <charconv>
 #include <fstream>
 #include <sstream>
@@ -92,23 +94,33 @@ void CsvWriter::row(const std::vector<double>& values) {
     line += formatReal(values[c]);
   }
   line += '\n';
-  std::fputs(line.c_str(), m_file);
+  if (std::fputs(line.c_str(), m_file) == EOF && m_errno == 0) m_errno = errno;
 }
 
 void CsvWriter::comment(const std::string& text) { std::fprintf(m_file, "# %s\n", text.c_str()); }
 
 void CsvWriter::close() {
   if (!m_file) return;
+  errno = 0;
   bool bad = std::ferror(m_file) != 0;
+  int err = bad ? m_errno : 0;
   if (m_owns) {
-    bad = (std::fclose(m_file) != 0) || bad;
-    if (!bad) bad = std::rename(m_partial.c_str(), m_path.c_str()) != 0;
+    if (std::fclose(m_file) != 0) {
+      bad = true;
+      if (!err) err = errno;
+    }
+    if (!bad && std::rename(m_partial.c_str(), m_path.c_str()) != 0) {
+      bad = true;
+      err = errno;
+    }
     if (bad) std::remove(m_partial.c_str());
   } else {
     std::fflush(m_file);
   }
   m_file = nullptr;
-  if (bad) throw std::runtime_error("writing '" + m_path + "' failed");
+  if (bad)
+    throw std::runtime_error("writing '" + m_path + "' failed" +
+                             (err ? ": " + writeErrorReason(err) : std::string()));
 }
 
 bool CsvTable::hasColumn(const std::string& name) const {

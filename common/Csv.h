@@ -68,6 +68,7 @@ class CsvWriter {
   std::size_t m_ncol;
   std::FILE* m_file = nullptr;
   bool m_owns = false;
+  int m_errno = 0;  // of the first failed write
 };
 
 /// Throws std::invalid_argument if `path` exists and `overwrite` is false.

@@ -15,6 +15,7 @@
 
 #include "common/FaultInjection.h"
 #include "common/Hdf5.h"
+#include "common/Strings.h"
 
 namespace granagg::common::h5journal {
 static_assert(std::is_same<hid_t, std::int64_t>::value, "H5Journal.h hands hid_t as int64_t");
@@ -121,6 +122,7 @@ struct JournaledFile {
   // cleanly: a close that fails leaves HDF5 a half-closed file that it crashes on at exit),
   // commits are refused, and the journal is kept for recover().
   bool failed = false;
+  std::string failure;  // the first failed write's message (what writeFailure returns)
   bool in_txn = false;    // the journal holds this transaction's header
   off_t journal_end = 0;  // where the next entry goes
   haddr_t eoa = 0, eof = 0;
@@ -128,6 +130,11 @@ struct JournaledFile {
   dev_t device = 0;
   ino_t inode = 0;
   std::string path, journal;
+
+  void fail(const std::string& why) {
+    if (!failed) failure = why;
+    failed = true;
+  }
 
   bool openJournal() {
     if (jfd >= 0) return true;
@@ -317,21 +324,19 @@ herr_t jWrite(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, const 
   }
   if (f->failed) return 0;  // frozen at the last commit (see JournaledFile::failed)
   if (common::faultPoint("h5write")) {
-    f->failed = true;
-    pushError(H5E_WRITEERROR, "h5journal: write to '" + f->path + "' failed: " +
-                                  std::strerror(ENOSPC) + " (fault injected)");
+    f->fail("writing '" + f->path + "' failed: " + writeErrorReason(ENOSPC) +
+            " (fault injected)");
+    pushError(H5E_WRITEERROR, "h5journal: " + f->failure);
     return -1;
   }
   if (!f->journalRegion(addr, size)) {
-    f->failed = true;
-    pushError(H5E_WRITEERROR, "h5journal: cannot save the old bytes in '" + f->journal + "': " +
-                                  std::strerror(errno));
+    f->fail("saving the old bytes in '" + f->journal + "' failed: " + writeErrorReason(errno));
+    pushError(H5E_WRITEERROR, "h5journal: " + f->failure);
     return -1;
   }
   if (!writeAll(f->fd, buf, size, static_cast<off_t>(addr))) {
-    f->failed = true;
-    pushError(H5E_WRITEERROR, "h5journal: write to '" + f->path + "' failed: " +
-                                  std::strerror(errno));
+    f->fail("writing '" + f->path + "' failed: " + writeErrorReason(errno));
+    pushError(H5E_WRITEERROR, "h5journal: " + f->failure);
     return -1;
   }
   f->eof = std::max<haddr_t>(f->eof, addr + size);
@@ -344,14 +349,14 @@ herr_t jTruncate(H5FD_t* file, hid_t, hbool_t) {
   JournaledFile* f = self(file);
   if (f->failed || f->eoa == f->eof) return 0;
   if (f->eoa < f->eof && !f->journalRegion(f->eoa, f->eof - f->eoa)) {
-    f->failed = true;
-    pushError(H5E_WRITEERROR, "h5journal: cannot save the bytes that a truncation cuts off");
+    f->fail("saving the bytes that a truncation of '" + f->path + "' cuts off failed: " +
+            writeErrorReason(errno));
+    pushError(H5E_WRITEERROR, "h5journal: " + f->failure);
     return -1;
   }
   if (::ftruncate(f->fd, static_cast<off_t>(f->eoa)) != 0) {
-    f->failed = true;
-    pushError(H5E_SEEKERROR, "h5journal: cannot set the size of '" + f->path + "': " +
-                                 std::strerror(errno));
+    f->fail("setting the size of '" + f->path + "' failed: " + writeErrorReason(errno));
+    pushError(H5E_SEEKERROR, "h5journal: " + f->failure);
     return -1;
   }
   f->eof = f->eoa;
@@ -419,9 +424,20 @@ void commit(std::int64_t file) {
   auto* f = static_cast<JournaledFile*>(handle);
   if (!f->commitNow())
     throw std::runtime_error(
-        f->failed ? "'" + f->path + "' stays at its last complete state: an earlier write failed"
+        f->failed ? "'" + f->path + "' stays at its last complete state: " + f->failure
                   : "cannot commit '" + f->path + "': emptying '" + f->journal + "' failed (" +
                         std::strerror(errno) + ")");
+}
+
+std::string writeFailure(std::int64_t file) {
+  const h5::Handle fapl(H5Fget_access_plist(file));
+  if (!fapl || H5Pget_driver(fapl.get()) != driverId())
+    throw std::invalid_argument("h5journal::writeFailure: the file does not use the journaled "
+                                "driver");
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(file, fapl.get(), &handle) < 0 || !handle)
+    h5::fail("h5journal::writeFailure");
+  return static_cast<JournaledFile*>(handle)->failure;
 }
 
 bool pending(const std::string& path) {

@@ -48,6 +48,13 @@ std::int64_t fileAccess();
 /// use this driver.
 void commit(std::int64_t file);
 
+/// "" while every write to `file` (an open hid_t through fileAccess()) succeeded; after a failed
+/// write, its message ("writing 'X' failed: the disk is full (...)"). A failed write freezes the
+/// file and later writes are dropped, and HDF5 does not report every failure to its caller (a
+/// dataset closed by a destructor flushes without a return value anyone reads): a writer checks
+/// this before it calls its file complete.
+std::string writeFailure(std::int64_t file);
+
 /// True when `<path>.journal` holds an unfinished transaction (a header and at least one complete
 /// entry, or a file longer than its committed size): `path` may be torn until recover() runs.
 bool pending(const std::string& path);

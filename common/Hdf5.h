@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -27,6 +28,24 @@ namespace granagg::common::h5 {
 /// Turns off HDF5's automatic printing of its error stack to stderr; our exceptions carry the
 /// message instead. Affects the calling thread's default error stack (HDF5 keeps one per thread).
 inline void silenceErrors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+/// HDF5's POSIX driver describes a failed read or write in one long text over two lines
+/// ("file write failed: time = ..., filename = ..., errno = 28, error message = 'No space left on
+/// device', buf = ..."): this keeps what a person needs, "file write failed: the disk is full
+/// (No space left on device)". Other texts are returned unchanged.
+inline std::string conciseIoError(const std::string& text) {
+  const std::size_t m = text.find("error message = '");
+  const std::size_t colon = text.find(':');
+  if (m == std::string::npos || colon == std::string::npos || colon > m) return text;
+  const std::size_t b = m + 17, e = text.find('\'', b);
+  const std::string why = text.substr(b, e == std::string::npos ? std::string::npos : e - b);
+  std::string head = text.substr(0, colon) + ": ";
+  const std::size_t en = text.find("errno = ");
+  const int err = en == std::string::npos ? 0 : std::atoi(text.c_str() + en + 8);
+  if (err == 28 || err == 122) return head + "the disk is full (" + why + ")";  // ENOSPC, EDQUOT
+  if (err == 27) return head + "the file-size limit is reached (" + why + ")";   // EFBIG
+  return head + why;
+}
 
 /// The most specific message on HDF5's current error stack ("" when empty), e.g.
 /// "truncated file: eof = 1024, sblock->base_addr = 0, stored_eof = 4096".
@@ -41,7 +60,7 @@ inline std::string lastError() {
   };
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, cb, &walk);
   H5Eclear2(H5E_DEFAULT);
-  return walk.text;
+  return conciseIoError(walk.text);
 }
 
 /// Throws std::runtime_error("<context>: <HDF5 message>").

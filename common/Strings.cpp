@@ -1,8 +1,10 @@
 #include "common/Strings.h"
 
+#include <cerrno>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 namespace granagg::common {
 
@@ -69,6 +71,13 @@ std::string terminalSafe(const std::string& text) {
     }
   }
   return out;
+}
+
+std::string writeErrorReason(int err) {
+  const std::string why = std::strerror(err);
+  if (err == ENOSPC || err == EDQUOT) return "the disk is full (" + why + ")";
+  if (err == EFBIG) return "the file-size limit is reached (" + why + ")";
+  return why;
 }
 
 }  // namespace granagg::common

@@ -12,6 +12,10 @@ std::string join(const std::vector<std::string>& parts, const std::string& sep);
 /// "\xNN". Error messages quote the offending token of an input file, which may be binary; the
 /// CLIs print every error through this.
 std::string terminalSafe(const std::string& text);
+/// Why a write failed, for its one-line message: "the disk is full (No space left on device)"
+/// for ENOSPC and EDQUOT, "the file-size limit is reached (File too large)" for EFBIG, else
+/// strerror(err).
+std::string writeErrorReason(int err);
 /// Parses a whole string as a double (also "nan", "inf"); false if anything is left over.
 bool parseReal(const std::string& s, double& out);
 /// printf into a std::string, of any length (the compiler checks the arguments against fmt).

@@ -174,14 +174,14 @@ LammpsDump::Atoms LammpsDump::readAtoms(const Header& h, const Columns& c) {
   // Before anything is sized from the header: an atom line holds c.count values, each of at least
   // one character and a separator (or the newline), so the rest of the file bounds the count.
   if (m_bytes >= 0) {
-    const double left =
-        std::max(0.0, static_cast<double>(m_bytes) - static_cast<double>(m_offset));
+    const double left = std::max(0.0, static_cast<double>(m_bytes) - static_cast<double>(m_offset));
     const double most = left / (2.0 * static_cast<double>(c.count));
     if (static_cast<double>(n) > most) {
       const std::string what = "NUMBER OF ATOMS = " + std::to_string(n) + " (line " +
                                std::to_string(m_count_line) + "), but the rest of the file " +
-                               "has room for at most " + std::to_string(static_cast<long long>(most)) +
-                               " atom lines of " + std::to_string(c.count) + " values";
+                               "has room for at most " +
+                               std::to_string(static_cast<long long>(most)) + " atom lines of " +
+                               std::to_string(c.count) + " values";
       // frame 0: the file is not what its header says (bad input); a later frame: a cut tail,
       // which --allow-partial may leave out like any truncated frame.
       if (m_frame == 0)

@@ -13,6 +13,7 @@
 #include "analysis/io/AnalysisFile.h"
 #include "analysis/stats/PowerLawFit.h"
 #include "common/FolderLock.h"
+#include "common/H5Journal.h"
 #include "common/OutputPath.h"
 #include "common/Strings.h"
 
@@ -125,10 +126,14 @@ AnalysisFolder analyseIntoFolder(
       results.push_back(stored ? std::move(*stored) : analyzeRun(request.runs[k], o, cb));
       checkSameSystem(results.front(), results.back());  // before analysing the rest
     }
+    // inside the try: a table that cannot be written (a full disk) leaves no folder behind
+    // that would pass for a complete analysis
+    return writeTables(out, *file, std::move(results), o, request.command_line, request.force);
   } catch (...) {
     file.reset();
     std::error_code ec;
     fs::remove(h5path, ec);
+    fs::remove(common::h5journal::journalPathFor(h5path), ec);  // (kept after a failed write)
     // nothing left that would block the rerun: a folder made here goes, an empty per_run too
     if (lock.createdFolder()) {
       lock.release();
@@ -138,7 +143,6 @@ AnalysisFolder analyseIntoFolder(
     }
     throw;
   }
-  return writeTables(out, *file, std::move(results), o, request.command_line, request.force);
 }
 
 AnalysisFolder writeRunAnalysis(const std::string& out_path, RunResult result,

@@ -6,6 +6,7 @@
 #include "RunCommand.h"
 
 #include <unistd.h>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -266,5 +267,37 @@ TEST_CASE("analyze says when a trajectory ends before its run.t_end", "[cli][ana
   CHECK_THAT(r.output,
              Catch::Contains("analyze: warning: run 0 (" + cut.string() + ") ends at t = "));
   CHECK_THAT(r.output, Catch::Contains("before its run.t_end = 2: an unfinished run"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("analyze on a full disk: one line naming the file, exit 1, no folder left behind",
+          "[cli][analyze][faults]") {
+  const fs::path dir = tempDir("fulldisk");
+  const fs::path run = mdRun(dir, "run", 5);
+  // the size of a complete analysis, to place the limits inside it
+  const Run ok = runGranagg("analyze " + run.string() + " --out " + (dir / "ok").string() + " -q");
+  REQUIRE(ok.status == 0);
+  const auto h5 = fs::file_size(dir / "ok" / "analysis.h5");
+  // A file-size limit (ulimit -f, in kB) fails each write past it with EFBIG, as a full disk
+  // fails it with ENOSPC: first on a CSV table (4 kB), then inside analysis.h5 (h5/2).
+  for (const std::uintmax_t kb : {std::uintmax_t{4}, h5 / 2048}) {
+    INFO("limit " << kb << " kB, analysis.h5 " << h5 << " bytes");
+    const fs::path out = dir / ("full" + std::to_string(kb));
+    const Run r = sh("ulimit -f " + std::to_string(kb) + " && " + GRANAGG_BINARY + " analyze " +
+                     run.string() + " --out " + out.string() + " -q");
+    CHECK(r.status == 1);  // not 153 (SIGXFSZ) nor 139 (HDF5 at exit after a failed close)
+    CHECK_THAT(r.output, Catch::Contains("the file-size limit is reached") &&
+                             Catch::Contains(out.string()));
+    CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
+    CHECK_FALSE(fs::exists(out));  // no table, no analysis.h5, no lock that would pass for done
+  }
+  // a full disk inside analysis.h5 (the fault hook of common/FaultInjection.h: the 20th write
+  // through the journaled driver and all later ones report ENOSPC)
+  const fs::path out = dir / "enospc";
+  const Run e = sh("GRANAGG_FAULT=enospc:h5write:20 " + std::string(GRANAGG_BINARY) +
+                   " analyze " + run.string() + " --out " + out.string() + " -q");
+  CHECK(e.status == 1);
+  CHECK_THAT(e.output, Catch::Contains("analysis.h5") && Catch::Contains("the disk is full"));
+  CHECK_FALSE(fs::exists(out));
   fs::remove_all(dir);
 }
