@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The test command (README, .ci/run): installs what is missing, builds, runs the whole Catch2
 # suite through CTest, and -- when nvcc is present -- compiles the CUDA build without running it,
-# so that it never rots (no GPU on the CI machines).
+# so that it never rots (no GPU on the CI machines), runs pytest and the GPU scripts' dry runs,
+# and ends with the sanitizer stage (scripts/sanitize.sh --subset).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 T0=$SECONDS
@@ -117,7 +118,35 @@ else
 fi
 
 T_DRY=$((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA - T_PY))
+
+# The sanitizer stage (issue 47; docs/robustness.md): AddressSanitizer, LeakSanitizer and UBSan
+# over the readers, the parsers, the unit suites that need no MD engine and the fuzz corpus
+# replays (scripts/sanitize.sh says what --subset leaves out). Its cases count in the summary.
+echo "== sanitizer stage: scripts/sanitize.sh --subset (ASan, LSan, UBSan)"
+SAN_LOG="$BUILD_DIR/sanitize.log"
+set +e
+GRANAGG_JOBS=$JOBS bash scripts/sanitize.sh --subset > "$SAN_LOG" 2>&1
+SAN_RC=$?
+set -e
+SAN_TOTAL=$(sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' "$SAN_LOG" | tail -n 1)
+SAN_FAILED=$(sed -n 's/.*tests passed, \([0-9]*\) tests failed out of.*/\1/p' "$SAN_LOG" |
+             tail -n 1)
+if [ -z "$SAN_TOTAL" ]; then
+  tail -n 40 "$SAN_LOG"
+  echo "scripts/sanitize.sh --subset failed before its tests ran (exit $SAN_RC)"
+  TOTAL=$((TOTAL + 1)); FAILED=$((FAILED + 1)); CTEST_RC=1
+else
+  TOTAL=$((TOTAL + SAN_TOTAL)); FAILED=$((FAILED + SAN_FAILED))
+  if [ "$SAN_RC" -ne 0 ]; then
+    sed -n '/The following tests FAILED/,$p' "$SAN_LOG"
+    grep -B2 -A30 -m 3 'ERROR: \(AddressSanitizer\|LeakSanitizer\)\|runtime error:' "$SAN_LOG" ||
+      true
+    CTEST_RC=1
+  fi
+  echo "sanitizer stage: $((SAN_TOTAL - SAN_FAILED)) of $SAN_TOTAL passed (log $SAN_LOG)"
+fi
+T_SAN=$((SECONDS - T0 - T_BUILD - T_CTEST - T_CUDA - T_PY - T_DRY))
 echo "time: set-up and build ${T_BUILD} s, tests ${T_CTEST} s, CUDA build ${T_CUDA} s," \
-  "pytest ${T_PY} s, GPU dry run ${T_DRY} s"
+  "pytest ${T_PY} s, GPU dry run ${T_DRY} s, sanitizer stage ${T_SAN} s"
 echo "tests: $((TOTAL - FAILED)) passed, $FAILED failed"
 exit "$CTEST_RC"

@@ -12,6 +12,7 @@
 
 #include "common/Csv.h"
 #include "common/FaultInjection.h"
+#include "common/H5Journal.h"
 #include "common/Hdf5.h"
 #include "common/Version.h"
 
@@ -63,7 +64,12 @@ void writeU64(hid_t obj, const std::string& name, std::uint64_t v, const std::st
 void writeFile(const std::string& file_path, const Checkpoint& e) {
   const Frame& s = e.state;
   const std::string c = "checkpoint '" + file_path + "'";
-  h5::Handle file = h5::check(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+  // Through the journaled driver (common/H5Journal.h) for its handling of a failed write: the file
+  // freezes and HDF5 closes it cleanly. With HDF5's own driver a full disk made the close fail,
+  // and HDF5 then crashed at exit on the half-closed file. Nothing is committed: a failed
+  // checkpoint is a temporary file that is removed.
+  h5::Handle fapl(static_cast<hid_t>(common::h5journal::fileAccess()));
+  h5::Handle file = h5::check(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()),
                               "cannot create " + c);
   const hid_t f = file.get();
   h5::writeFixedStringAttribute(f, "format", FORMAT_NAME, c);
@@ -115,7 +121,14 @@ void writeFile(const std::string& file_path, const Checkpoint& e) {
     for (const auto& [k, v] : e.engine.arrays)
       writeArray(g.get(), k, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v.data(), n, c);
   }
-  if (!file.reset()) h5::fail("cannot close " + c + " (disk full?)");
+  // HDF5 does not report every failed write to its caller; the driver remembers the first
+  H5Fflush(f, H5F_SCOPE_GLOBAL);
+  h5::lastError();
+  if (const std::string failure = common::h5journal::writeFailure(f); !failure.empty()) {
+    file.reset();
+    throw std::runtime_error(failure);  // "writing '...checkpoint.h5.tmp' failed: the disk is full ..."
+  }
+  if (!file.reset()) h5::fail("cannot close " + c);
 }
 
 void validate(const Checkpoint& e) {

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <algorithm>
+#include <cerrno>
 #include <exception>
 #include <fstream>
 #include <limits>
@@ -15,6 +16,7 @@
 #include "common/Csv.h"
 #include "common/H5Journal.h"
 #include "common/Hdf5.h"
+#include "common/Strings.h"
 #include "common/Version.h"
 #include "md/io/InitialState.h"
 
@@ -413,9 +415,15 @@ struct H5mdWriter::Impl {
     {
       std::ofstream out(tmp, std::ios::trunc);
       if (!out) throw std::runtime_error("cannot write XDMF sidecar '" + tmp + "'");
+      errno = 0;
       out << xdmfText();
       out.close();
-      if (!out) throw std::runtime_error("cannot write XDMF sidecar '" + tmp + "' (disk full?)");
+      if (!out) {
+        const int err = errno;
+        std::remove(tmp.c_str());
+        throw std::runtime_error("writing the XDMF sidecar '" + tmp + "' failed" +
+                                 (err ? ": " + common::writeErrorReason(err) : std::string()));
+      }
     }
     if (std::rename(tmp.c_str(), xdmf_path.c_str()) != 0) {
       std::remove(tmp.c_str());

@@ -237,7 +237,60 @@ def disk_trials(args, ref):
               + (errors[0] if ok and errors else problem), flush=True)
         if ok:
             shutil.rmtree(d, ignore_errors=True)
+    failures += tmpfs_trials(args, ref, rng)
     print(f"crash_trials disk: {len(cases)} trials, {failures} failed", flush=True)
+    return failures
+
+
+def tmpfs_trials(args, ref, rng):
+    """A real full disk: the run goes into a tmpfs smaller than its folder would grow (0.3-0.9 of
+    the uninterrupted run's folder, so that the trajectory, its journal or a checkpoint's
+    temporary file fills it). It must stop with exit status 1 and one line that names the file
+    and says the disk is full; the folder, copied to a larger disk, must continue to the
+    uninterrupted run, bit for bit. Needs mount (root, as in CI); skipped with a note otherwise."""
+    full = sum(os.path.getsize(os.path.join(ref, f)) for f in os.listdir(ref))
+    mnt = os.path.join(args.work, "tmpfs")
+    os.makedirs(mnt, exist_ok=True)
+    failures = 0
+    for i in range(2):
+        size = int(full * rng.uniform(0.3, 0.9)) // 4096 * 4096
+        m = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", mnt],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if m.returncode != 0:
+            print("skip tmpfs trials: cannot mount a tmpfs here (" + m.stdout.strip() + ")",
+                  flush=True)
+            return failures
+        try:
+            d = os.path.join(mnt, "run")
+            r = run([args.granagg, "md"] + RUN + ["--out", d])
+            errors = [ln for ln in r.stdout.splitlines() if ln.startswith("granagg: failed")]
+            problem = ""
+            if r.returncode != 1 or len(errors) != 1:
+                problem = f"exit {r.returncode} with {len(errors)} error lines:\n{r.stdout}"
+            elif "the disk is full" not in errors[0] or d not in errors[0]:
+                problem = "the error line does not name the file and the full disk: " + errors[0]
+            elif any(f.endswith(".tmp") for f in os.listdir(d)):
+                problem = "a temporary file was left: " + " ".join(os.listdir(d))
+            copy = os.path.join(args.work, f"tmpfs-copy-{i}")
+            shutil.rmtree(copy, ignore_errors=True)
+            if not problem:
+                shutil.copytree(d, copy)
+        finally:
+            subprocess.run(["umount", mnt])
+        if not problem:
+            c = run([args.granagg, "md", "--restart", copy])
+            if "no checkpoint at" in c.stdout:
+                c = run([args.granagg, "md"] + RUN + ["--out", copy, "--force"])
+            problem = (f"the continuation failed (exit {c.returncode}):\n{c.stdout}"
+                       if c.returncode != 0 else compare(ref, copy))
+        ok = not problem
+        failures += not ok
+        print(f"{'ok  ' if ok else 'FAIL'} tmpfs trial {i}: a tmpfs of {size} B "
+              f"({size / full:.2f} of the run's folder): " + (errors[0] if ok else problem),
+              flush=True)
+        if ok:
+            shutil.rmtree(copy, ignore_errors=True)
+    print(f"crash_trials tmpfs: 2 trials, {failures} failed", flush=True)
     return failures
 
 
