@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 #include <algorithm>
+#include <type_traits>
 #include <cmath>
 #include <cstdio>
 #include <unordered_map>
@@ -66,8 +67,21 @@ struct H5mdReader::Impl {
         const auto o = h5::readNumericAttribute<T>(a.get(), mem_type, c + " offset");
         if (!o.empty()) offset = o[0];
       }
+      if (inc.empty()) error(0, elem + "/" + name + " holds no increment");
       std::vector<T> out(rows);
-      for (std::size_t k = 0; k < rows; ++k) out[k] = offset + static_cast<T>(k) * inc.at(0);
+      for (std::size_t k = 0; k < rows; ++k) {
+        if constexpr (std::is_integral_v<T>) {
+          // steps from a file: offset + k * increment must not overflow (undefined behaviour)
+          T kinc = 0;
+          if (__builtin_mul_overflow(static_cast<T>(k), inc[0], &kinc) ||
+              __builtin_add_overflow(offset, kinc, &out[k]))
+            error(0, elem + "/" + name + ": offset " + std::to_string(offset) + " + " +
+                         std::to_string(k) + " x increment " + std::to_string(inc[0]) +
+                         " overflows a 64-bit integer");
+        } else {
+          out[k] = offset + static_cast<T>(k) * inc[0];
+        }
+      }
       return out;
     }
     if (dims.size() != 1)

@@ -27,6 +27,7 @@ if [ ${#HARNESSES[@]} -eq 0 ]; then
   read -r -a HARNESSES <<< \
     "$(sed -n 's/^set(FUZZ_HARNESSES \(.*\))$/\1/p' tests/fuzz/CMakeLists.txt)"
 fi
+REV=$(git rev-parse --short=12 HEAD)$(git diff --quiet HEAD -- . ':!docs' || echo +)  # as built
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$CXX" \
       -DCMAKE_C_COMPILER="$CC" -DGRANAGG_FUZZ=ON -DGRANAGG_PYTHON=OFF >/dev/null
 cmake --build build-fuzz -j "$JOBS" --target "${HARNESSES[@]/#/fuzz_}"
@@ -74,7 +75,7 @@ for h in "${HARNESSES[@]}"; do
   for a in "$art"/*; do
     [ -f "$a" ] || continue
     report=$( { ASAN_OPTIONS="$ASAN_OPTIONS:allocator_may_return_null=1:detect_leaks=$leaks" \
-                "build-fuzz/tests/fuzz/fuzz_$h" -rss_limit_mb=1024 "$a" 2>&1 || true; } )
+                "build-fuzz/tests/fuzz/fuzz_$h" -rss_limit_mb=1024 -timeout=10 "$a" 2>&1 || true; } )
     frame=$(echo "$report" | grep -E '^ +#[0-9]+ ' |
             grep -E 'libhdf5|granagg|fuzz_[a-z_]+\.cpp' | head -n 1 || true)
     owner=granagg
@@ -94,8 +95,7 @@ for h in "${HARNESSES[@]}"; do
   corpus=$(find "$work" -type f | wc -l)
   fails=$ours
   [ "$rc" -eq 0 ] || failed=1
-  rev=$(git rev-parse --short=12 HEAD)
-  echo "$h,${execs:-0},$secs,$cov,$ft,$corpus,$fails,$(date -u +%FT%TZ),$rev" >> "$SUMMARY"
+  echo "$h,${execs:-0},$secs,$cov,$ft,$corpus,$fails,$(date -u +%FT%TZ),$REV" >> "$SUMMARY"
   tail -n 3 "$log"
 done
 column -s, -t < "$SUMMARY"

@@ -12,8 +12,8 @@
 #             rest of the test command): the md engine suite (test_md), the CLI, study and
 #             LAMMPS suites, the crash trials and pytest. Without --subset: everything.
 #   environment: GRANAGG_SANITIZE_DIR (build-sanitize), GRANAGG_JOBS (nproc)
-# Leaks inside Debian's libraries are suppressed, each with its reason, in
-# tests/sanitizers/lsan.supp.
+# Reports inside Debian's libraries are suppressed, each with its reason, in
+# tests/sanitizers/lsan.supp (leaks) and tests/sanitizers/ubsan.supp (undefined behaviour).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SUBSET=0
@@ -28,6 +28,7 @@ cmake -S . -B "$DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWIT
 export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1
 export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+UBSAN_OPTIONS+=:suppressions=$PWD/tests/sanitizers/ubsan.supp
 if [ "$SUBSET" = 1 ]; then
   HARNESSES=$(sed -n 's/^set(FUZZ_HARNESSES \(.*\))$/\1/p' tests/fuzz/CMakeLists.txt)
   TARGETS=(test_common test_analysis test_meanfield test_md_io)
