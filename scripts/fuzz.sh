@@ -74,8 +74,14 @@ for h in "${HARNESSES[@]}"; do
   ours=0
   for a in "$art"/*; do
     [ -f "$a" ] || continue
+    # (an out-of-memory input is replayed with a higher rss limit than its malloc limit, so that
+    # the report is the large malloc's, with its stack, not the rss watchdog's, without one)
+    limits=(-rss_limit_mb=1024)
+    case "$(basename "$a")" in
+      oom-*|timeout-*) limits=(-rss_limit_mb=8192 -malloc_limit_mb=1024) ;;
+    esac
     report=$( { ASAN_OPTIONS="$ASAN_OPTIONS:allocator_may_return_null=1:detect_leaks=$leaks" \
-                "build-fuzz/tests/fuzz/fuzz_$h" -rss_limit_mb=1024 -timeout=10 "$a" 2>&1 || true; } )
+                "build-fuzz/tests/fuzz/fuzz_$h" "${limits[@]}" -timeout=10 "$a" 2>&1 || true; } )
     frame=$(echo "$report" | grep -E '^ +#[0-9]+ ' |
             grep -E 'libhdf5|granagg|fuzz_[a-z_]+\.cpp' | head -n 1 || true)
     owner=granagg

@@ -38,5 +38,12 @@ if [ "$SUBSET" = 1 ]; then
         -R '^(common|analysis|meanfield|md_io|fuzz):' "$@"
 else
   cmake --build "$DIR" -j "$JOBS"
-  ctest --test-dir "$DIR" --output-on-failure -j "$JOBS" "$@"
+  rc=0
+  ctest --test-dir "$DIR" --output-on-failure -j "$JOBS" -E '^lammps:' "$@" || rc=$?
+  # The LAMMPS suite without leak checking: Open MPI's components are dlopen'ed and unloaded
+  # again at MPI_Finalize, so LSan reports their allocations from "<unknown module>", which no
+  # suppression can name exactly. ASan's and UBSan's other checks stay on.
+  ASAN_OPTIONS=${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0} \
+    ctest --test-dir "$DIR" --output-on-failure -j "$JOBS" -R '^lammps:' "$@" || rc=$?
+  exit "$rc"
 fi
