@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "common/Strings.h"
+
 namespace granagg::common {
 namespace fs = std::filesystem;
 
@@ -21,15 +23,6 @@ std::string thisHost() {
   char name[256] = {};
   if (::gethostname(name, sizeof name - 1) != 0) return "unknown";
   return name;
-}
-
-std::string utcNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  ::gmtime_r(&now, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return b;
 }
 
 std::string readAll(int fd) {
@@ -72,7 +65,7 @@ std::optional<LockHolder> parseHolder(const std::string& text) {
 
 std::string holderText(const std::string& command_line) {
   return "pid = " + std::to_string(static_cast<long>(::getpid())) + "\nhost = " + thisHost() +
-         "\ncommand = " + command_line + "\nsince = " + utcNow() + "\n";
+         "\ncommand = " + command_line + "\nsince = " + utcTimestamp() + "\n";
 }
 
 bool pidRuns(long pid) { return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM; }

@@ -80,4 +80,14 @@ std::string writeErrorReason(int err) {
   return why;
 }
 
+std::string utcTimestamp(std::time_t t) {
+  std::tm tm{};
+  ::gmtime_r(&t, &tm);
+  char b[32];
+  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return b;
+}
+
+std::string utcTimestamp() { return utcTimestamp(std::time(nullptr)); }
+
 }  // namespace granagg::common

@@ -1,6 +1,7 @@
 #pragma once
 /// \file Strings.h
 /// Small string helpers shared by the CLI and the readers.
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,10 @@ std::string join(const std::vector<std::string>& parts, const std::string& sep);
 /// "\xNN". Error messages quote the offending token of an input file, which may be binary; the
 /// CLIs print every error through this.
 std::string terminalSafe(const std::string& text);
+/// A UTC time stamp, ISO 8601 to the second ("2026-12-08T02:45:10Z"): of `t`, or of now. The one
+/// format of every time stamp granagg writes (H5MD run records, folder locks, study logs).
+std::string utcTimestamp(std::time_t t);
+std::string utcTimestamp();
 /// Why a write failed, for its one-line message: "the disk is full (No space left on device)"
 /// for ENOSPC and EDQUOT, "the file-size limit is reached (File too large)" for EFBIG, else
 /// strerror(err).

@@ -19,6 +19,7 @@
 #include "common/Csv.h"
 #include "common/FolderLock.h"
 #include "common/Interrupted.h"
+#include "common/Strings.h"
 #include "common/Version.h"
 #include "study/JobPool.h"
 #include "study/Process.h"
@@ -97,7 +98,7 @@ bool stageDone(const fs::path& marker, const std::string& spec) {
 }  // namespace
 
 void PairStudy::say(const std::string& line, bool terminal) {
-  appendText(m_out / "pair.log", "[" + nowUtc() + "] " + line + "\n");
+  appendText(m_out / "pair.log", "[" + common::utcTimestamp() + "] " + line + "\n");
   if (terminal && !m_a.quiet) {
     std::fprintf(stderr, "pair: %s\n", line.c_str());
   }
@@ -401,12 +402,12 @@ pid_t PairStudy::startRun(const RunJob& j, int threads, bool echo) {
     for (const char* f : {"traj.h5", "traj.xdmf", "checkpoint.h5", "checkpoint.toml", "done.json"})
       fs::remove(j.dir / f);
     nlohmann::ordered_json rec = runRecord(j);
-    rec["started"] = nowUtc();
+    rec["started"] = common::utcTimestamp();
     writeText(j.dir / "run.json", rec.dump(2) + "\n");
   }
   const std::vector<std::string> argv = mdCommand(m_launch, j, threads);
   appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
-  appendText(j.log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
+  appendText(j.log, "# " + common::utcTimestamp() + ": " + joinCommand(argv) + "\n");
   say("md " + kName(j.K) + " run " + std::to_string(j.r) + ": " +
           (j.restart ? "restarting from its checkpoint" : "started") + " (seed " +
           std::to_string(j.seed) + ")",
@@ -424,7 +425,7 @@ void PairStudy::recordFinished(const RunJob& job, double wall, int threads) {
   else
     rec["threads"] = threads;
   rec["restarted"] = job.restart;
-  rec["finished"] = nowUtc();
+  rec["finished"] = common::utcTimestamp();
   rec["granagg"] = common::versionString();
   writeText(job.dir / "done.json", rec.dump(2) + "\n");
   m_changed_k.insert(kName(job.K));
@@ -453,7 +454,7 @@ int PairStudy::runStep(const std::string& label, std::vector<std::string> argv,
                        const std::string& logname, bool quiet_failure) {
   const fs::path log = m_out / "logs" / (logname + ".log");
   appendText(m_out / "commands.txt", joinCommand(argv) + "\n");
-  appendText(log, "# " + nowUtc() + ": " + joinCommand(argv) + "\n");
+  appendText(log, "# " + common::utcTimestamp() + ": " + joinCommand(argv) + "\n");
   if (!m_a.quiet && ::isatty(2)) {
     std::fprintf(stderr, "\rpair: %s ...%40s\r", label.c_str(), "");
     std::fflush(stderr);

@@ -43,8 +43,6 @@ std::string selfExe();
 bool findProgram(const std::string& program);
 /// Cores this process may run on (its affinity mask).
 int availableCores();
-/// The current UTC time, ISO 8601 to the second.
-std::string nowUtc();
 
 /// The whole file ("" when it does not exist).
 std::string readText(const std::filesystem::path& p);

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "common/Csv.h"
+#include "common/Strings.h"
 #include "common/Version.h"
 #include "study/PairStudy.h"
 #include "study/Process.h"
@@ -617,7 +618,7 @@ void PairStudy::writeSummary() {
                  {"source_config", m_c.source},
                  {"out", m_out.string()},
                  {"command", m_s.command_line},
-                 {"written", nowUtc()},
+                 {"written", common::utcTimestamp()},
                  {"cores", m_cores},
                  {"backend", m_s.backend}};
   s["paper"] = {{"reference", paper.reference},

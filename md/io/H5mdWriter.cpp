@@ -537,10 +537,7 @@ void H5mdWriter::recordRestart(std::int64_t step, double time, double t_end,
   h5::writeAttribute(g.get(), "t_end", t_end, ctx);
   h5::writeStringAttribute(g.get(), "command", command, ctx);
   h5::writeStringAttribute(g.get(), "version", version, ctx);
-  char utc[32];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(utc, sizeof utc, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  h5::writeStringAttribute(g.get(), "utc", utc, ctx);
+  h5::writeStringAttribute(g.get(), "utc", common::utcTimestamp(), ctx);
   m.flushFile();
 }
 
