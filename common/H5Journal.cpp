@@ -11,6 +11,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "common/FaultInjection.h"
@@ -438,6 +439,13 @@ std::string writeFailure(std::int64_t file) {
   if (H5Fget_vfd_handle(file, fapl.get(), &handle) < 0 || !handle)
     h5::fail("h5journal::writeFailure");
   return static_cast<JournaledFile*>(handle)->failure;
+}
+
+void requireWritten(std::int64_t file) {
+  H5Fflush(file, H5F_SCOPE_GLOBAL);  // a failure here is recorded by the driver, read below
+  h5::lastError();
+  if (std::string failure = writeFailure(file); !failure.empty())
+    throw std::runtime_error(std::move(failure));
 }
 
 bool pending(const std::string& path) {

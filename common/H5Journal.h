@@ -55,6 +55,11 @@ void commit(std::int64_t file);
 /// this before it calls its file complete.
 std::string writeFailure(std::int64_t file);
 
+/// Flushes `file` and throws std::runtime_error(writeFailure(file)) if any write failed: what a
+/// writer calls before it closes a file it will call complete. The file still closes cleanly
+/// afterwards (it is frozen at its last commit).
+void requireWritten(std::int64_t file);
+
 /// True when `<path>.journal` holds an unfinished transaction (a header and at least one complete
 /// entry, or a file longer than its committed size): `path` may be torn until recover() runs.
 bool pending(const std::string& path);

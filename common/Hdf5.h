@@ -23,6 +23,8 @@
 #include <utility>
 #include <vector>
 
+#include "common/Strings.h"
+
 namespace granagg::common::h5 {
 
 /// Turns off HDF5's automatic printing of its error stack to stderr; our exceptions carry the
@@ -42,9 +44,7 @@ inline std::string conciseIoError(const std::string& text) {
   std::string head = text.substr(0, colon) + ": ";
   const std::size_t en = text.find("errno = ");
   const int err = en == std::string::npos ? 0 : std::atoi(text.c_str() + en + 8);
-  if (err == 28 || err == 122) return head + "the disk is full (" + why + ")";  // ENOSPC, EDQUOT
-  if (err == 27) return head + "the file-size limit is reached (" + why + ")";   // EFBIG
-  return head + why;
+  return head + (err > 0 ? writeErrorReason(err) : why);
 }
 
 /// The most specific message on HDF5's current error stack ("" when empty), e.g.

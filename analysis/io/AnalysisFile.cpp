@@ -154,12 +154,7 @@ void AnalysisFile::close() {
   m.step.reset();
   // every write must have reached the file: HDF5 does not report each failure to us (a closed
   // dataset flushes its buffer without a status anyone reads), the journaled driver does
-  H5Fflush(m.file.get(), H5F_SCOPE_GLOBAL);
-  h5::lastError();
-  if (const std::string failure = common::h5journal::writeFailure(m.file.get()); !failure.empty()) {
-    m.file.reset();
-    throw std::runtime_error(failure);
-  }
+  common::h5journal::requireWritten(m.file.get());
   if (!m.file.reset()) h5::fail("'" + m.path + "': closing failed");
 }
 

@@ -31,6 +31,13 @@ void LammpsDump::errorAt(std::size_t line, const std::string& what) const {
   throw TrajectoryError(m_path, m_frame, what + " (line " + std::to_string(line) + ")");
 }
 
+void LammpsDump::countError(const std::string& what) const {
+  // In frame 0 the file is not a dump whose header can be believed: bad input (exit 2). In a
+  // later frame it is a damaged tail, which --allow-partial may leave out like any other.
+  if (m_frame == 0) throw std::invalid_argument("LAMMPS dump '" + m_path + "': " + what);
+  error(what);
+}
+
 namespace {
 
 /// A line for an error message: at most `max` characters, quoted; a line with bytes that are not
@@ -92,14 +99,9 @@ LammpsDump::Header LammpsDump::readHeader(std::string& line) {
       char* end = nullptr;
       errno = 0;
       const long long v = std::strtoll(line.c_str(), &end, 10);
-      if (errno || end == line.c_str() || v <= 0) {
-        // in frame 0 the file is not a dump granagg can size (bad input, exit 2); later, a
-        // damaged frame that --allow-partial may leave out
-        const std::string what = "bad NUMBER OF ATOMS " + quoted(line, 40) + " (line " +
-                                 std::to_string(m_line) + "; expected an integer >= 1)";
-        if (m_frame == 0) throw std::invalid_argument("LAMMPS dump '" + m_path + "': " + what);
-        error("bad number of atoms " + quoted(line, 40));
-      }
+      if (errno || end == line.c_str() || v <= 0)
+        countError("bad NUMBER OF ATOMS " + quoted(line, 40) + " (line " +
+                   std::to_string(m_line) + "; expected an integer >= 1)");
       m_count_line = m_line;
       h.atoms = static_cast<std::size_t>(v);
       have_n = true;
@@ -176,19 +178,11 @@ LammpsDump::Atoms LammpsDump::readAtoms(const Header& h, const Columns& c) {
   if (m_bytes >= 0) {
     const double left = std::max(0.0, static_cast<double>(m_bytes) - static_cast<double>(m_offset));
     const double most = left / (2.0 * static_cast<double>(c.count));
-    if (static_cast<double>(n) > most) {
-      const std::string what = "NUMBER OF ATOMS = " + std::to_string(n) + " (line " +
-                               std::to_string(m_count_line) + "), but the rest of the file " +
-                               "has room for at most " +
-                               std::to_string(static_cast<long long>(most)) + " atom lines of " +
-                               std::to_string(c.count) + " values";
-      // frame 0: the file is not what its header says (bad input); a later frame: a cut tail,
-      // which --allow-partial may leave out like any truncated frame.
-      if (m_frame == 0)
-        throw std::invalid_argument("LAMMPS dump '" + m_path + "': " + what +
-                                    " (a corrupt dump or a wrong count?)");
-      error(what + " (truncated dump?)");
-    }
+    if (static_cast<double>(n) > most)
+      countError("NUMBER OF ATOMS = " + std::to_string(n) + " (line " +
+                 std::to_string(m_count_line) + "), but the rest of the file has room for at " +
+                 "most " + std::to_string(static_cast<long long>(most)) + " atom lines of " +
+                 std::to_string(c.count) + " values (a corrupt, truncated or miscounted dump?)");
   }
   Atoms a;
   a.ids.resize(n);

@@ -61,6 +61,8 @@ class LammpsDump final : public TrajectoryReader {
     std::vector<std::int32_t> img;
     std::vector<std::size_t> line_of;  // each atom's line, for errors found after reading
   };
+  /// A header count that cannot be right: std::invalid_argument in frame 0, else error().
+  [[noreturn]] void countError(const std::string& what) const;
   /// Reads the header of a frame whose first line is `line`.
   Header readHeader(std::string& line);
   Columns columns(const std::string& atoms_line) const;

@@ -122,12 +122,7 @@ void writeFile(const std::string& file_path, const Checkpoint& e) {
       writeArray(g.get(), k, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v.data(), n, c);
   }
   // HDF5 does not report every failed write to its caller; the driver remembers the first
-  H5Fflush(f, H5F_SCOPE_GLOBAL);
-  h5::lastError();
-  if (const std::string failure = common::h5journal::writeFailure(f); !failure.empty()) {
-    file.reset();
-    throw std::runtime_error(failure);  // "writing '...checkpoint.h5.tmp' failed: the disk is full ..."
-  }
+  common::h5journal::requireWritten(f);  // "writing '...checkpoint.h5.tmp' failed: the disk ..."
   if (!file.reset()) h5::fail("cannot close " + c);
 }
 
